@@ -1,0 +1,216 @@
+//! A clip: named tracks of any kind, sampled together into flat rows of
+//! `f32` channels (the columns of `tcb sample`).
+
+use crate::rotation::RotationTrack;
+use crate::track::Track;
+use crate::vector::Value;
+use glam::{Vec2, Vec3, Vec4};
+use std::fmt;
+
+/// What a track's values are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TrackKind {
+    /// One number.
+    Scalar,
+    /// Two components.
+    Vec2,
+    /// Three components.
+    Vec3,
+    /// Four components.
+    Vec4,
+    /// A rotation `[x, y, z, w]`.
+    Quat,
+}
+
+impl TrackKind {
+    /// Every kind.
+    pub const ALL: [TrackKind; 5] = [
+        TrackKind::Scalar,
+        TrackKind::Vec2,
+        TrackKind::Vec3,
+        TrackKind::Vec4,
+        TrackKind::Quat,
+    ];
+
+    /// Number of components (channels).
+    pub const fn dim(self) -> usize {
+        match self {
+            TrackKind::Scalar => 1,
+            TrackKind::Vec2 => 2,
+            TrackKind::Vec3 => 3,
+            TrackKind::Vec4 | TrackKind::Quat => 4,
+        }
+    }
+
+    /// The clip file's name for it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            TrackKind::Scalar => "scalar",
+            TrackKind::Vec2 => "vec2",
+            TrackKind::Vec3 => "vec3",
+            TrackKind::Vec4 => "vec4",
+            TrackKind::Quat => "quat",
+        }
+    }
+
+    /// From the clip file's name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        TrackKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+impl fmt::Display for TrackKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A built track of any kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TrackData {
+    /// `scalar`.
+    Scalar(Track<f32>),
+    /// `vec2`.
+    Vec2(Track<Vec2>),
+    /// `vec3`.
+    Vec3(Track<Vec3>),
+    /// `vec4`.
+    Vec4(Track<Vec4>),
+    /// `quat`.
+    Quat(RotationTrack),
+}
+
+impl TrackData {
+    /// Its kind.
+    pub fn kind(&self) -> TrackKind {
+        match self {
+            TrackData::Scalar(_) => TrackKind::Scalar,
+            TrackData::Vec2(_) => TrackKind::Vec2,
+            TrackData::Vec3(_) => TrackKind::Vec3,
+            TrackData::Vec4(_) => TrackKind::Vec4,
+            TrackData::Quat(_) => TrackKind::Quat,
+        }
+    }
+
+    /// Key times.
+    pub fn times(&self) -> &[f64] {
+        match self {
+            TrackData::Scalar(t) => t.times(),
+            TrackData::Vec2(t) => t.times(),
+            TrackData::Vec3(t) => t.times(),
+            TrackData::Vec4(t) => t.times(),
+            TrackData::Quat(t) => t.times(),
+        }
+    }
+
+    /// Write the value (and velocity, if asked) at `time` into the first
+    /// `kind().dim()` entries of `value` (and `velocity`).
+    pub fn sample_into(&self, time: f64, value: &mut [f32], velocity: Option<&mut [f32]>) {
+        fn put<V: Value>(t: &Track<V>, time: f64, value: &mut [f32], velocity: Option<&mut [f32]>) {
+            let (v, d) = t.sample_with_velocity(time);
+            value[..V::DIM].copy_from_slice(&v.to_array()[..V::DIM]);
+            if let Some(out) = velocity {
+                out[..V::DIM].copy_from_slice(&d.to_array()[..V::DIM]);
+            }
+        }
+        match self {
+            TrackData::Scalar(t) => put(t, time, value, velocity),
+            TrackData::Vec2(t) => put(t, time, value, velocity),
+            TrackData::Vec3(t) => put(t, time, value, velocity),
+            TrackData::Vec4(t) => put(t, time, value, velocity),
+            TrackData::Quat(t) => {
+                let (q, d) = t.sample_with_velocity(time);
+                value[..4].copy_from_slice(&q.to_array());
+                if let Some(out) = velocity {
+                    out[..4].copy_from_slice(&d.to_array());
+                }
+            }
+        }
+    }
+}
+
+/// A track with its name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedTrack {
+    /// Name, unique in its clip (`ball.position`).
+    pub name: String,
+    /// The track.
+    pub data: TrackData,
+}
+
+/// Named tracks sampled together.
+///
+/// ```
+/// use tcb_core::{Clip, NamedTrack, Track, TrackData, TrackSettings};
+/// let squash = Track::new(vec![0.0, 1.25], vec![1.0f32, 0.6], vec![], &TrackSettings::default()).unwrap();
+/// let clip = Clip {
+///     name: "bounce".into(),
+///     tracks: vec![NamedTrack { name: "ball.squash".into(), data: TrackData::Scalar(squash) }],
+/// };
+/// assert_eq!(clip.column_names(), ["ball.squash"]);
+/// let mut row = vec![0.0; clip.channel_count()];
+/// clip.sample_into(1.25, &mut row, None);
+/// assert_eq!(row, [0.6]);
+/// ```
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Clip {
+    /// The clip's name.
+    pub name: String,
+    /// Its tracks, in file order.
+    pub tracks: Vec<NamedTrack>,
+}
+
+impl Clip {
+    /// Total number of `f32` channels (columns after `time`).
+    pub fn channel_count(&self) -> usize {
+        self.tracks.iter().map(|t| t.data.kind().dim()).sum()
+    }
+
+    /// Column names: `<name>` for scalars, `<name>.x` .. `<name>.w` otherwise.
+    pub fn column_names(&self) -> Vec<String> {
+        let mut out = Vec::with_capacity(self.channel_count());
+        for t in &self.tracks {
+            match t.data.kind() {
+                TrackKind::Scalar => out.push(t.name.clone()),
+                kind => {
+                    for c in ["x", "y", "z", "w"].iter().take(kind.dim()) {
+                        out.push(format!("{}.{c}", t.name));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Sample every track at `time` into `values` (and `velocities`), each
+    /// [`Clip::channel_count`] long.
+    pub fn sample_into(&self, time: f64, values: &mut [f32], mut velocities: Option<&mut [f32]>) {
+        let mut at = 0;
+        for t in &self.tracks {
+            let dim = t.data.kind().dim();
+            let vel = velocities.as_deref_mut().map(|v| &mut v[at..at + dim]);
+            t.data.sample_into(time, &mut values[at..at + dim], vel);
+            at += dim;
+        }
+    }
+
+    /// The sorted union of every track's key times.
+    pub fn key_times(&self) -> Vec<f64> {
+        let mut all: Vec<f64> = self
+            .tracks
+            .iter()
+            .flat_map(|t| t.data.times().iter().copied())
+            .collect();
+        all.sort_by(f64::total_cmp);
+        all.dedup();
+        all
+    }
+
+    /// The earliest first key and the latest last key (`None` without tracks).
+    pub fn time_range(&self) -> Option<(f64, f64)> {
+        let times = self.tracks.iter().map(|t| t.data.times());
+        let start = times.clone().map(|t| t[0]).reduce(f64::min)?;
+        let end = times.map(|t| t[t.len() - 1]).reduce(f64::max)?;
+        Some((start, end))
+    }
+}

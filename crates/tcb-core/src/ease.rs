@@ -1,0 +1,120 @@
+//! 3ds Max ease to / ease from: re-timing along a segment without changing
+//! its path.
+//!
+//! For segment k take `a = from_k` and `e = to_{k+1}`. If `a + e > 1`
+//! divide both by `a + e`; if both are 0 nothing changes; else with
+//! `K = 1 / (2 - a - e)` and `u` the plain local parameter:
+//!
+//! ```text
+//! s = K u^2 / a              u < a
+//! s = K (2u - a)             a <= u < 1 - e   (u <= 1 where e = 0)
+//! s = 1 - K (1 - u)^2 / e    u >= 1 - e, e > 0
+//! ```
+//!
+//! The speed along the path rises linearly from zero over the first `a` of
+//! the segment, is constant in the middle, and falls linearly to zero over the
+//! last `e`.
+
+/// The ease of one segment, normalized so that `from + to <= 1`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct SegmentEase {
+    /// `a`: ease leaving the segment's first key.
+    pub from: f64,
+    /// `e`: ease arriving at the segment's second key.
+    pub to: f64,
+}
+
+impl SegmentEase {
+    /// From `from_k` of the first key and `to_{k+1}` of the second, each in [0, 1].
+    pub fn new(from: f64, to: f64) -> Self {
+        let sum = from + to;
+        if sum > 1.0 {
+            SegmentEase {
+                from: from / sum,
+                to: to / sum,
+            }
+        } else {
+            SegmentEase { from, to }
+        }
+    }
+
+    /// No easing on this segment.
+    pub fn is_none(&self) -> bool {
+        self.from == 0.0 && self.to == 0.0
+    }
+
+    /// `(s, ds/du)` for the plain local parameter `u` in [0, 1].
+    ///
+    /// ```
+    /// use tcb_core::ease::SegmentEase;
+    /// let e = SegmentEase::new(0.5, 0.0); // ease from half the segment
+    /// assert_eq!(e.apply(0.0), (0.0, 0.0));
+    /// assert_eq!(e.apply(0.5).0, 1.0 / 3.0);
+    /// assert_eq!(e.apply(1.0).0, 1.0);
+    /// ```
+    pub fn apply(&self, u: f64) -> (f64, f64) {
+        let (a, e) = (self.from, self.to);
+        if self.is_none() {
+            return (u, 1.0);
+        }
+        let k = 1.0 / (2.0 - a - e);
+        if u < a {
+            (k * u * u / a, 2.0 * k * u / a)
+        } else if e > 0.0 && u >= 1.0 - e {
+            let w = 1.0 - u;
+            (1.0 - k * w * w / e, 2.0 * k * w / e)
+        } else {
+            (k * (2.0 * u - a), 2.0 * k)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn by_hand() {
+        // a = 0.25, e = 0.25: K = 2/3.
+        let e = SegmentEase::new(0.25, 0.25);
+        let (s, d) = e.apply(0.125);
+        assert!((s - 2.0 / 3.0 * 0.015625 / 0.25).abs() < 1e-15);
+        assert!((d - 2.0 * 2.0 / 3.0 * 0.5).abs() < 1e-15);
+        assert!((e.apply(0.5).0 - 0.5).abs() < 1e-15);
+        assert_eq!(e.apply(1.0), (1.0, 0.0));
+        // Middle speed 2K = 4/3.
+        assert!((e.apply(0.5).1 - 4.0 / 3.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn over_one_is_normalized() {
+        let e = SegmentEase::new(1.0, 1.0);
+        assert_eq!((e.from, e.to), (0.5, 0.5));
+        // K = 1: s = 2u^2 on the first half.
+        assert_eq!(e.apply(0.25).0, 0.125);
+        assert_eq!(e.apply(0.75).0, 0.875);
+    }
+
+    #[test]
+    fn continuous_and_monotone() {
+        for &(a, b) in &[
+            (0.3, 0.0),
+            (0.0, 0.6),
+            (0.2, 0.7),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (0.9, 0.9),
+        ] {
+            let e = SegmentEase::new(a, b);
+            let mut prev = 0.0;
+            for i in 0..=1000 {
+                let u = i as f64 / 1000.0;
+                let (s, d) = e.apply(u);
+                assert!(s >= prev - 1e-12, "{a} {b} at {u}");
+                assert!((s - prev).abs() < 3e-3 && d >= 0.0);
+                prev = s;
+            }
+            assert!((prev - 1.0).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,66 @@
+//! # tcb-core
+//!
+//! Kochanek–Bartels splines (Kochanek & Bartels 1984, "Interpolating Splines
+//! with Local Tension, Continuity, and Bias Control"): per-key tangents from
+//! tension, continuity and bias on even and uneven key times, end
+//! conditions, ease, extrapolation and rotations, with a scalar reference
+//! spline that the SIMD runtime is checked against.
+//!
+//! The mathematics follows the project's contract (`spec/math.md`) exactly;
+//! each module's documentation carries its formulas:
+//!
+//! | module | what |
+//! |---|---|
+//! | [`tangent`] | TCB weights, the four tangent rules, `match_speed`, ends, overrides |
+//! | [`basis`] | the Hermite basis row `[h1 h2 h3 h4]`, generic over lane types |
+//! | [`ease`] | 3ds Max ease to / ease from |
+//! | [`extrapolate`] | `pre` / `post` modes, in f64 |
+//! | [`track`] | [`Track`], the reference spline for `f32`, `Vec2`, `Vec3`, `Vec4` |
+//! | [`rotation`] | [`RotationTrack`]: `squad` and `hermite` on quaternions |
+//! | [`clip`] | [`Clip`]: named tracks sampled together |
+//! | [`sample_times`] | the paper's inbetweens, frame grids |
+//!
+//! Tracks are validated once when built ([`TrackError`] names the key at
+//! fault); after that, sampling never fails and never panics, for any f64
+//! time including NaN and infinities (see [`extrapolate`]).
+//!
+//! ```
+//! use glam::Vec3;
+//! use tcb_core::{KeyParams, Tcb, Track, TrackSettings};
+//!
+//! // The ball careening off a tree: a corner (c = -1) at the middle key.
+//! let mut keys = vec![KeyParams::default(); 3];
+//! keys[1] = KeyParams::with_tcb(Tcb::new(0.0, -1.0, 0.0));
+//! let path = Track::new(
+//!     vec![0.0, 1.0, 2.0],
+//!     vec![Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(2.0, 0.0, 0.0)],
+//!     keys,
+//!     &TrackSettings::default(),
+//! )
+//! .unwrap();
+//! for frame in 0..=8 {
+//!     let p = path.sample(frame as f64 * 0.25);
+//!     assert!(p.y >= 0.0 && p.y <= 1.0);
+//! }
+//! ```
+
+pub mod basis;
+pub mod clip;
+pub mod ease;
+pub mod error;
+pub mod extrapolate;
+pub mod params;
+pub mod rotation;
+pub mod sample_times;
+pub mod tangent;
+pub mod track;
+pub mod vector;
+
+pub use clip::{Clip, NamedTrack, TrackData, TrackKind};
+pub use error::TrackError;
+pub use params::{
+    Ease, Ends, Extrapolation, Interp, KeyParams, RotationMode, TangentRule, Tcb, TrackSettings,
+};
+pub use rotation::RotationTrack;
+pub use track::Track;
+pub use vector::{Value, Vector};

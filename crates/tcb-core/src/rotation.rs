@@ -1,0 +1,510 @@
+//! Rotation tracks: TCB on unit quaternions.
+//!
+//! Values are `[x, y, z, w]`, normalized when the track is built; each key is
+//! flipped to the hemisphere of the previous one (`q_k = -q_k` where
+//! `dot(q_{k-1}, q_k) < 0`), so every chord is the short way round.
+//!
+//! # `squad` (default; 3D Studio / 3ds Max TCB rotation)
+//!
+//! The tangent rules, ends and weights of [`crate::tangent`] applied to
+//! log-space chords:
+//!
+//! ```text
+//! log((v sin(th/2), cos(th/2))) = v th/2
+//! A = log(q_{k-1}^-1 q_k)      B = log(q_k^-1 q_{k+1})      -> DS_k, DD_k (log space)
+//! a_k = q_k exp((DD_k - B) / 2)          b_k = q_k exp((A - DS_k) / 2)
+//! segment k: squad(s) = slerp(slerp(q_k, q_{k+1}, s), slerp(a_k, b_{k+1}, s), 2s(1-s))
+//! ```
+//!
+//! (plain slerp, no hemisphere flip inside). With t = c = b = 0 on even keys
+//! this is Shoemake's squad. `natural` ends and explicit tangents are not
+//! defined for it.
+//!
+//! # `hermite` (glTF CUBICSPLINE style)
+//!
+//! The four components form a [`Track<Vec4>`](crate::Track) with every rule,
+//! end and override; the result is normalized.
+//!
+//! In both modes `interp: linear` is slerp and `step` holds. The reference
+//! works in f64 and returns f32 quaternions. Velocities are d/dt of the
+//! output quaternion's components; for `squad` segments they are taken by a
+//! five-point difference of the f64 segment function (error about 1e-10).
+
+use crate::ease::SegmentEase;
+use crate::error::TrackError;
+use crate::extrapolate::{Mapped, map_time};
+use crate::params::{Ends, Extrapolation, Interp, KeyParams, RotationMode, TrackSettings};
+use crate::tangent::{TangentKey, key_tangents};
+use crate::track::{Track, check_keys, keys_or_default, locate, segment_eases};
+use glam::{DQuat, DVec3, DVec4, Quat, Vec4};
+
+/// `log` of a unit quaternion: `(v sin(th/2), cos(th/2)) -> v th/2`.
+pub fn quat_log(q: DQuat) -> DVec3 {
+    let v = DVec3::new(q.x, q.y, q.z);
+    let sin = v.length();
+    if sin == 0.0 {
+        return DVec3::ZERO;
+    }
+    v * (sin.atan2(q.w) / sin)
+}
+
+/// `exp` of a pure quaternion: `v -> (v/|v| sin|v|, cos|v|)`.
+pub fn quat_exp(v: DVec3) -> DQuat {
+    let th = v.length();
+    // sin(th)/th, by its series where th is tiny.
+    let sinc = if th < 1e-6 {
+        1.0 - th * th / 6.0
+    } else {
+        th.sin() / th
+    };
+    let xyz = v * sinc;
+    DQuat::from_xyzw(xyz.x, xyz.y, xyz.z, th.cos())
+}
+
+/// Spherical linear interpolation without hemisphere correction:
+/// `p sin((1-s) th)/sin th + q sin(s th)/sin th`, th the angle between `p`
+/// and `q` as 4-vectors. Any `s` is allowed (it extrapolates along the arc).
+pub fn slerp(p: DQuat, q: DQuat, s: f64) -> DQuat {
+    let (pv, qv) = (DVec4::from(p), DVec4::from(q));
+    // Stable angle: th = 2 atan2(|p - q|, |p + q|).
+    let th = 2.0 * (pv - qv).length().atan2((pv + qv).length());
+    let sin = th.sin();
+    let r = if sin < 1e-9 {
+        let l = pv * (1.0 - s) + qv * s;
+        if l.length() < 1e-12 {
+            pv
+        } else {
+            l.normalize()
+        }
+    } else {
+        pv * (((1.0 - s) * th).sin() / sin) + qv * ((s * th).sin() / sin)
+    };
+    DQuat::from_vec4(r)
+}
+
+/// Shoemake's squad with inner points `a` (after `q0`) and `b` (before `q1`).
+pub fn squad(q0: DQuat, q1: DQuat, a: DQuat, b: DQuat, s: f64) -> DQuat {
+    slerp(slerp(q0, q1, s), slerp(a, b, s), 2.0 * s * (1.0 - s))
+}
+
+/// One `squad` segment: `squad(q0, q1, a, b, s)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SquadSegment {
+    /// `q_k`.
+    pub q0: DQuat,
+    /// `q_{k+1}`.
+    pub q1: DQuat,
+    /// `a_k` (`q_k` for `linear`, all four `q_k` for `step`).
+    pub a: DQuat,
+    /// `b_{k+1}`.
+    pub b: DQuat,
+    /// Re-timing of the segment.
+    pub ease: SegmentEase,
+    /// The segment's shape (already folded into the controls).
+    pub interp: Interp,
+}
+
+impl SquadSegment {
+    /// The segment at `s`.
+    pub fn at(&self, s: f64) -> DQuat {
+        squad(self.q0, self.q1, self.a, self.b, s)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Shape {
+    Squad(Vec<SquadSegment>),
+    Hermite(Track<Vec4>),
+}
+
+/// A validated rotation track.
+///
+/// ```
+/// use glam::Quat;
+/// use tcb_core::{RotationTrack, TrackSettings};
+/// let track = RotationTrack::new(
+///     vec![0.0, 1.0, 2.0],
+///     vec![Quat::IDENTITY, Quat::from_rotation_z(1.0), Quat::from_rotation_z(0.5)],
+///     vec![],
+///     &TrackSettings::default(), // squad
+/// )
+/// .unwrap();
+/// let q = track.sample(0.5);
+/// assert!((q.length() - 1.0).abs() < 1e-6);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct RotationTrack {
+    times: Vec<f64>,
+    keys: Vec<DQuat>,
+    values: Vec<Quat>,
+    interps: Vec<Interp>,
+    eases: Vec<SegmentEase>,
+    shape: Shape,
+    settings: TrackSettings,
+}
+
+impl RotationTrack {
+    /// Build a rotation track; `settings.rotation` chooses the mode.
+    /// Quaternions are normalized and made hemisphere-consistent.
+    pub fn new(
+        times: Vec<f64>,
+        values: Vec<Quat>,
+        keys: Vec<KeyParams<Quat>>,
+        settings: &TrackSettings,
+    ) -> Result<Self, TrackError> {
+        check_keys(&times, values.len(), &keys, settings.ends, Quat::is_finite)?;
+        for (side, mode) in [("pre", settings.pre), ("post", settings.post)] {
+            if matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat) {
+                return Err(TrackError::ExtrapolationOnRotation { side, mode });
+            }
+        }
+        let squad_mode = settings.rotation == RotationMode::Squad;
+        if squad_mode && settings.ends == Ends::Natural {
+            return Err(TrackError::NaturalOnSquad);
+        }
+        if squad_mode
+            && let Some(key) = keys
+                .iter()
+                .position(|k| k.tangent_in.is_some() || k.tangent_out.is_some())
+        {
+            return Err(TrackError::TangentOnSquad { key });
+        }
+        let n = times.len();
+        let mut qs: Vec<DQuat> = Vec::with_capacity(n);
+        for (key, q) in values.iter().enumerate() {
+            let v = DVec4::new(q.x.into(), q.y.into(), q.z.into(), q.w.into());
+            if !v.is_finite() {
+                return Err(TrackError::NonFiniteValue { key, what: "value" });
+            }
+            let len = v.length();
+            if len == 0.0 || !len.is_finite() {
+                return Err(TrackError::ZeroQuaternion { key });
+            }
+            let mut v = v / len;
+            if let Some(prev) = qs.last()
+                && DVec4::from(*prev).dot(v) < 0.0
+            {
+                v = -v;
+            }
+            qs.push(DQuat::from_vec4(v));
+        }
+        if settings.ends == Ends::Cyclic {
+            let (a, b) = (DVec4::from(qs[0]), DVec4::from(qs[n - 1]));
+            if (a - b).length().min((a + b).length()) > 1e-6 {
+                return Err(TrackError::CyclicNotClosed { key: n - 1 });
+            }
+        }
+        let keys = keys_or_default(keys, n);
+        let values: Vec<Quat> = qs.iter().map(|q| q.as_quat()).collect();
+        let eases: Vec<SegmentEase> = segment_eases(&keys).collect();
+        let interps: Vec<Interp> = keys.iter().map(|k| k.interp).collect();
+
+        let shape = if squad_mode {
+            Shape::Squad(squad_segments(&times, &qs, &keys, &eases, settings))
+        } else {
+            let as_vec4 = |q: Quat| Vec4::new(q.x, q.y, q.z, q.w);
+            let vkeys = keys
+                .iter()
+                .map(|k| KeyParams {
+                    tcb: k.tcb,
+                    ease: k.ease,
+                    interp: k.interp,
+                    tangent_in: k.tangent_in.map(as_vec4),
+                    tangent_out: k.tangent_out.map(as_vec4),
+                })
+                .collect();
+            let vs = values.iter().map(|&q| as_vec4(q)).collect();
+            Shape::Hermite(Track::new(times.clone(), vs, vkeys, settings)?)
+        };
+        Ok(RotationTrack {
+            times,
+            keys: qs,
+            values,
+            interps,
+            eases,
+            shape,
+            settings: *settings,
+        })
+    }
+
+    /// Key times.
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    /// Key rotations, normalized and hemisphere-consistent.
+    pub fn values(&self) -> &[Quat] {
+        &self.values
+    }
+
+    /// The settings the track was built with.
+    pub fn settings(&self) -> &TrackSettings {
+        &self.settings
+    }
+
+    /// The squad segments (`None` for `hermite` tracks).
+    pub fn squad_segments(&self) -> Option<&[SquadSegment]> {
+        match &self.shape {
+            Shape::Squad(s) => Some(s),
+            Shape::Hermite(_) => None,
+        }
+    }
+
+    /// The four-component track (`None` for `squad` tracks).
+    pub fn hermite_track(&self) -> Option<&Track<Vec4>> {
+        match &self.shape {
+            Shape::Hermite(t) => Some(t),
+            Shape::Squad(_) => None,
+        }
+    }
+
+    /// First and last key time.
+    pub fn time_range(&self) -> (f64, f64) {
+        (self.times[0], self.times[self.times.len() - 1])
+    }
+
+    /// The rotation at `time` (any f64; see [`crate::extrapolate`]).
+    pub fn sample(&self, time: f64) -> Quat {
+        self.sample_with_velocity(time).0
+    }
+
+    /// The rotation and the d/dt of its four components.
+    pub fn sample_with_velocity(&self, time: f64) -> (Quat, Vec4) {
+        let (t0, tn) = self.time_range();
+        let n = self.times.len();
+        let (q, d) = match map_time(time, t0, tn, self.settings.pre, self.settings.post) {
+            Mapped::Inside {
+                time, direction, ..
+            } => {
+                let (q, d) = self.evaluate(time);
+                (q, d * direction)
+            }
+            Mapped::Hold { last } => (self.keys[if last { n - 1 } else { 0 }], DVec4::ZERO),
+            // Linear extrapolation is rejected at build time.
+            Mapped::Reset | Mapped::Line { .. } => (DQuat::IDENTITY, DVec4::ZERO),
+        };
+        (q.as_quat(), d.as_vec4())
+    }
+
+    fn evaluate(&self, time: f64) -> (DQuat, DVec4) {
+        let (k, u) = locate(&self.times, time);
+        if u >= 1.0 && k == self.times.len() - 2 && self.interps[k] == Interp::Step {
+            return (self.keys[k + 1], DVec4::ZERO);
+        }
+        let (s, ds_du) = self.eases[k].apply(u);
+        let rate = ds_du / (self.times[k + 1] - self.times[k]);
+        match (self.interps[k], &self.shape) {
+            (Interp::Step, _) => (self.keys[k], DVec4::ZERO),
+            (_, Shape::Squad(segs)) => {
+                let seg = &segs[k];
+                let q = seg.at(s).normalize();
+                (q, derivative(|s| DVec4::from(seg.at(s)), s) * rate)
+            }
+            (Interp::Linear, Shape::Hermite(_)) => {
+                let (q0, q1) = (self.keys[k], self.keys[k + 1]);
+                let q = slerp(q0, q1, s);
+                // d/ds slerp(q0, q1, s) = slerp(s) * log(q0^-1 q1), as a quaternion product.
+                let w = quat_log(q0.conjugate() * q1);
+                let d = q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0);
+                (q, DVec4::from(d) * rate)
+            }
+            (_, Shape::Hermite(track)) => {
+                let (p, dp) = track.sample_with_velocity(time);
+                let (p, dp) = (p.as_dvec4(), dp.as_dvec4());
+                let len = p.length();
+                if len == 0.0 {
+                    return (self.keys[k], DVec4::ZERO);
+                }
+                let q = p / len;
+                // d/dt (p / |p|) = (p' - q (q . p')) / |p|
+                (DQuat::from_vec4(q), (dp - q * q.dot(dp)) / len)
+            }
+        }
+    }
+}
+
+/// Five-point central difference of `f` at `s` (h = 1e-3).
+fn derivative(f: impl Fn(f64) -> DVec4, s: f64) -> DVec4 {
+    let h = 1e-3;
+    (f(s - 2.0 * h) - f(s + 2.0 * h) + (f(s + h) - f(s - h)) * 8.0) / (12.0 * h)
+}
+
+fn squad_segments(
+    times: &[f64],
+    qs: &[DQuat],
+    keys: &[KeyParams<Quat>],
+    eases: &[SegmentEase],
+    settings: &TrackSettings,
+) -> Vec<SquadSegment> {
+    let n = qs.len();
+    let chords: Vec<DVec3> = qs
+        .windows(2)
+        .map(|w| quat_log(w[0].conjugate() * w[1]))
+        .collect();
+    let tkeys: Vec<TangentKey<DVec3>> = keys
+        .iter()
+        .map(|k| TangentKey {
+            tcb: k.tcb,
+            tangent_in: None,
+            tangent_out: None,
+        })
+        .collect();
+    let tangents = key_tangents(times, &chords, &tkeys, settings);
+    // Source chord A of key k (the wrap chord at key 0 of a cyclic track) and
+    // destination chord B.
+    let cyclic = settings.ends == Ends::Cyclic;
+    let a_chord = |k: usize| {
+        if k > 0 {
+            chords[k - 1]
+        } else if cyclic {
+            chords[n - 2]
+        } else {
+            chords[0]
+        }
+    };
+    (0..n - 1)
+        .map(|k| {
+            let (q0, q1) = (qs[k], qs[k + 1]);
+            let a = q0 * quat_exp((tangents[k].outgoing - chords[k]) / 2.0);
+            let b = q1 * quat_exp((a_chord(k + 1) - tangents[k + 1].incoming) / 2.0);
+            let interp = keys[k].interp;
+            let (q1, a, b) = match interp {
+                Interp::Curve => (q1, a, b),
+                Interp::Linear => (q1, q0, q1),
+                Interp::Step => (q0, q0, q0),
+            };
+            SquadSegment {
+                q0,
+                q1,
+                a,
+                b,
+                ease: eases[k],
+                interp,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Tcb;
+
+    fn close_f32(a: Quat, b: Quat) -> bool {
+        close(a.as_dquat(), b.as_dquat(), 1e-6)
+    }
+
+    fn close(a: DQuat, b: DQuat, tol: f64) -> bool {
+        let (a, b) = (DVec4::from(a), DVec4::from(b));
+        (a - b).length().min((a + b).length()) < tol
+    }
+
+    #[test]
+    fn log_exp_round_trip() {
+        let q = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 2.5);
+        assert!(close(quat_exp(quat_log(q)), q, 1e-14));
+        let v = quat_log(q);
+        assert!((v.length() - 1.25).abs() < 1e-14);
+        assert_eq!(quat_log(DQuat::IDENTITY), DVec3::ZERO);
+    }
+
+    #[test]
+    fn slerp_by_hand() {
+        let p = DQuat::IDENTITY;
+        let q = DQuat::from_rotation_z(1.0);
+        assert!(close(
+            slerp(p, q, 0.25),
+            DQuat::from_rotation_z(0.25),
+            1e-14
+        ));
+        assert!(close(slerp(p, p, 0.7), p, 1e-15));
+        // No hemisphere flip: slerp to -q goes the long way.
+        let long = slerp(p, -q, 0.5);
+        assert!(!close(long, DQuat::from_rotation_z(0.5), 1e-3));
+    }
+
+    #[test]
+    fn hemisphere_flip_at_load() {
+        let q1 = Quat::from_rotation_z(0.5);
+        let t = RotationTrack::new(
+            vec![0.0, 1.0],
+            vec![Quat::IDENTITY, -q1],
+            vec![],
+            &TrackSettings::default(),
+        )
+        .unwrap();
+        assert!(t.values()[1].dot(Quat::IDENTITY) > 0.0);
+        let mid = t.sample(0.5);
+        assert!(close_f32(mid, Quat::from_rotation_z(0.25)));
+    }
+
+    #[test]
+    fn two_key_squad_is_slerp_for_default_tcb() {
+        // Copy ends with one chord: DD_0 = DS_1 = B, so a_0 = q0, b_1 = q1.
+        let q1 = Quat::from_rotation_y(1.2);
+        let t = RotationTrack::new(
+            vec![0.0, 2.0],
+            vec![Quat::IDENTITY, q1],
+            vec![],
+            &TrackSettings::default(),
+        )
+        .unwrap();
+        for i in 0..=8 {
+            let s = i as f32 / 8.0;
+            let q = t.sample(2.0 * s as f64);
+            assert!(close_f32(q, Quat::from_rotation_y(1.2 * s)));
+        }
+        let (_, d) = t.sample_with_velocity(1.0);
+        // |dq/dt| = angular speed / 2 = 0.6 / 2
+        assert!((d.length() - 0.3).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rejections() {
+        let s = TrackSettings {
+            ends: Ends::Natural,
+            ..Default::default()
+        };
+        let q = vec![Quat::IDENTITY, Quat::from_rotation_x(1.0)];
+        assert_eq!(
+            RotationTrack::new(vec![0.0, 1.0], q.clone(), vec![], &s).unwrap_err(),
+            TrackError::NaturalOnSquad
+        );
+        let s = TrackSettings {
+            post: Extrapolation::Linear,
+            ..Default::default()
+        };
+        assert!(matches!(
+            RotationTrack::new(vec![0.0, 1.0], q.clone(), vec![], &s).unwrap_err(),
+            TrackError::ExtrapolationOnRotation { side: "post", .. }
+        ));
+        let zero = vec![Quat::IDENTITY, Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)];
+        assert_eq!(
+            RotationTrack::new(vec![0.0, 1.0], zero, vec![], &TrackSettings::default())
+                .unwrap_err(),
+            TrackError::ZeroQuaternion { key: 1 }
+        );
+        let mut keys = vec![KeyParams::default(); 2];
+        keys[1].tangent_in = Some(Quat::IDENTITY);
+        assert_eq!(
+            RotationTrack::new(vec![0.0, 1.0], q, keys, &TrackSettings::default()).unwrap_err(),
+            TrackError::TangentOnSquad { key: 1 }
+        );
+    }
+
+    #[test]
+    fn cyclic_up_to_sign() {
+        let s = TrackSettings {
+            ends: Ends::Cyclic,
+            ..Default::default()
+        };
+        let q = vec![
+            Quat::IDENTITY,
+            Quat::from_rotation_x(1.0),
+            Quat::from_rotation_x(2.0),
+            -Quat::IDENTITY,
+        ];
+        let keys = vec![KeyParams::with_tcb(Tcb::DEFAULT); 4];
+        assert!(RotationTrack::new(vec![0.0, 1.0, 2.0, 3.0], q, keys, &s).is_ok());
+    }
+}
