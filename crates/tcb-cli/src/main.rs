@@ -1,0 +1,175 @@
+//! `tcb`: sample Kochanek-Bartels animation clips from the command line.
+//!
+//! ```text
+//! tcb sample CLIP.json --at 0,0.25,1.5
+//! tcb sample CLIP.json --fps 60 [--from A] [--to B]
+//! tcb sample CLIP.json --inbetweens N [--scalar] [--velocity]
+//! ```
+//!
+//! CSV goes to stdout; errors go to stderr as one line, with a non-zero exit
+//! status and nothing on stdout.
+
+use clap::{Args, Parser, Subcommand};
+use std::io::{self, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tcb_core::Clip;
+use tcb_core::sample_times::{frame_count, frame_times, inbetweens};
+
+/// Most sample times one command will produce.
+const MAX_SAMPLES: u64 = 100_000_000;
+
+#[derive(Parser)]
+#[command(
+    name = "tcb",
+    version,
+    about = "Kochanek-Bartels (TCB) spline animation tool"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Sample a clip and print CSV: a `time` column, then one column per channel.
+    Sample(SampleArgs),
+}
+
+#[derive(Args)]
+#[command(group = clap::ArgGroup::new("times").required(true).args(["at", "fps", "inbetweens"]))]
+struct SampleArgs {
+    /// The clip file (tcb-clip/1 JSON).
+    clip: PathBuf,
+    /// Sample at these times (seconds, comma separated; may be negative or huge).
+    #[arg(long, value_name = "T,T,...", allow_hyphen_values = true)]
+    at: Option<String>,
+    /// Sample every 1/FPS seconds.
+    #[arg(long, value_name = "FPS", allow_hyphen_values = true)]
+    fps: Option<f64>,
+    /// With --fps: first time (default: the clip's first key).
+    #[arg(long, value_name = "A", allow_hyphen_values = true)]
+    from: Option<f64>,
+    /// With --fps: last time, included when on the grid (default: the clip's last key).
+    #[arg(long, value_name = "B", allow_hyphen_values = true)]
+    to: Option<f64>,
+    /// Every key time of the clip and N evenly spaced times inside each interval.
+    #[arg(long, value_name = "N")]
+    inbetweens: Option<u32>,
+    /// Use the scalar reference implementation.
+    #[arg(long)]
+    scalar: bool,
+    /// Add d/dt columns named `<column>.d` after the value columns.
+    #[arg(long)]
+    velocity: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Sample(args) => sample(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e)
+            if e.downcast_ref::<io::Error>()
+                .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("tcb: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+type BoxError = Box<dyn std::error::Error>;
+
+fn sample(args: &SampleArgs) -> Result<(), BoxError> {
+    let clip = tcb_io::load_clip(&args.clip)?;
+    let times = sample_times(args, &clip)?;
+    // Everything that can fail has been checked: from here on only writing can.
+    let stdout = io::stdout().lock();
+    let mut out = io::BufWriter::with_capacity(1 << 16, stdout);
+    write_csv(&mut out, &clip, &times, args.velocity)?;
+    out.flush()?;
+    Ok(())
+}
+
+fn sample_times(args: &SampleArgs, clip: &Clip) -> Result<Vec<f64>, BoxError> {
+    if args.fps.is_none() && (args.from.is_some() || args.to.is_some()) {
+        return Err("--from and --to go with --fps".into());
+    }
+    if let Some(list) = &args.at {
+        let times = list
+            .split(',')
+            .map(|s| {
+                let s = s.trim();
+                s.parse::<f64>()
+                    .map_err(|_| format!("--at: \"{s}\" is not a number"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        return Ok(times);
+    }
+    let (first, last) = clip.time_range().ok_or("the clip has no tracks")?;
+    if let Some(fps) = args.fps {
+        let from = args.from.unwrap_or(first);
+        let to = args.to.unwrap_or(last);
+        if !(fps > 0.0 && fps.is_finite()) {
+            return Err(format!("--fps must be a positive number, got {fps}").into());
+        }
+        if !from.is_finite() || !to.is_finite() {
+            return Err("--from and --to must be finite".into());
+        }
+        if to < from {
+            return Err(format!("--to {to} is before --from {from}").into());
+        }
+        let n = frame_count(from, to, fps).unwrap_or(u64::MAX);
+        if n > MAX_SAMPLES {
+            return Err(format!("{n} sample times requested; at most {MAX_SAMPLES}").into());
+        }
+        return Ok(frame_times(from, to, fps).collect());
+    }
+    let n = args.inbetweens.unwrap_or(0);
+    let keys = clip.key_times();
+    let total = (keys.len() as u64).saturating_mul(u64::from(n) + 1);
+    if total > MAX_SAMPLES {
+        return Err(format!("{total} sample times requested; at most {MAX_SAMPLES}").into());
+    }
+    Ok(inbetweens(&keys, n as usize))
+}
+
+fn write_csv(out: &mut impl Write, clip: &Clip, times: &[f64], velocity: bool) -> io::Result<()> {
+    let names = clip.column_names();
+    let mut header = String::from("time");
+    for n in &names {
+        header.push(',');
+        header.push_str(n);
+    }
+    if velocity {
+        for n in &names {
+            header.push(',');
+            header.push_str(n);
+            header.push_str(".d");
+        }
+    }
+    writeln!(out, "{header}")?;
+    let channels = clip.channel_count();
+    let mut values = vec![0.0f32; channels];
+    let mut velocities = vec![0.0f32; channels];
+    for &t in times {
+        clip.sample_into(t, &mut values, velocity.then_some(&mut velocities[..]));
+        write!(out, "{t}")?;
+        for v in &values {
+            write!(out, ",{v}")?;
+        }
+        if velocity {
+            for v in &velocities {
+                write!(out, ",{v}")?;
+            }
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}

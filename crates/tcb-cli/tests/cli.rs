@@ -1,0 +1,456 @@
+//! The `tcb` command as a user runs it: output format, options, and every
+//! bad input of the clip-format contract.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tcb(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tcb"))
+        .args(args)
+        .output()
+        .expect("run tcb")
+}
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/clips")
+}
+
+fn example(name: &str) -> String {
+    examples().join(name).to_string_lossy().into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).unwrap()
+}
+
+fn temp_clip(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tcb-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A one-track clip around `track` (a JSON object body), with `defaults`.
+fn clip_with(defaults: &str, track: &str) -> String {
+    format!(
+        r#"{{"format": "tcb-clip/1", "name": "t", "defaults": {{{defaults}}}, "tracks": [
+            {{"name": "ok", "kind": "scalar", "times": [0, 1], "values": [0, 1]}},
+            {{"name": "bad", {track}}}]}}"#
+    )
+}
+
+#[test]
+fn header_and_columns_follow_the_contract() {
+    let o = tcb(&["sample", &example("bounce.json"), "--at", "0,0.25,1.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(
+        lines[0],
+        "time,ball.position.x,ball.position.y,ball.position.z,ball.squash,\
+         ball.rotation.x,ball.rotation.y,ball.rotation.z,ball.rotation.w"
+    );
+    assert_eq!(lines.len(), 4);
+    assert_eq!(lines[1], "0,0,0,0,1,0,0,0,1");
+    assert!(lines[3].starts_with("1.5,"));
+    assert!(o.stderr.is_empty());
+}
+
+#[test]
+fn velocity_columns_follow_the_value_columns() {
+    let o = tcb(&[
+        "sample",
+        &example("bounce.json"),
+        "--at",
+        "0.25",
+        "--velocity",
+    ]);
+    assert!(o.status.success());
+    let out = stdout(&o);
+    let header: Vec<&str> = out.lines().next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 1 + 2 * 8);
+    assert_eq!(header[9], "ball.position.x.d");
+    assert_eq!(header[12], "ball.squash.d");
+    // ball.squash goes from 1 to 0.6 over 1.25 s, copy ends: a straight line.
+    let row: Vec<f32> = out
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!((row[12] - (-0.32)).abs() < 1e-6);
+}
+
+#[test]
+fn fps_grid_includes_the_end_when_on_it() {
+    let o = tcb(&["sample", &example("bounce.json"), "--fps", "4"]);
+    let out = stdout(&o);
+    let times: Vec<&str> = out
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(
+        times,
+        ["0", "0.25", "0.5", "0.75", "1", "1.25", "1.5", "1.75", "2"]
+    );
+    let o = tcb(&[
+        "sample",
+        &example("bounce.json"),
+        "--fps",
+        "2",
+        "--from",
+        "-1",
+        "--to",
+        "0.9",
+    ]);
+    let out = stdout(&o);
+    let times: Vec<&str> = out
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(times, ["-1", "-0.5", "0", "0.5"]);
+}
+
+#[test]
+fn inbetweens_use_the_union_of_key_times() {
+    // bounce: keys at 0, 0.5, 1.25, 2 (and 0, 1.25): one inbetween each.
+    let o = tcb(&["sample", &example("bounce.json"), "--inbetweens", "1"]);
+    let out = stdout(&o);
+    let times: Vec<&str> = out
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(times, ["0", "0.25", "0.5", "0.875", "1.25", "1.625", "2"]);
+}
+
+#[test]
+fn negative_huge_and_non_finite_times_work_as_written() {
+    let o = tcb(&[
+        "sample",
+        &example("spin.json"),
+        "--at",
+        "-2.5,0,1e6,nan,inf,-inf,1e300",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o).lines().count(), 8);
+    // spin repeats with period 2: 1e6 is a whole number of periods.
+    let rows: Vec<String> = stdout(&o).lines().map(str::to_owned).collect();
+    assert_eq!(
+        rows[2].split_once(',').unwrap().1,
+        rows[3].split_once(',').unwrap().1
+    );
+}
+
+#[test]
+fn scalar_flag_gives_the_same_numbers() {
+    let a = tcb(&["sample", &example("careen.json"), "--fps", "30"]);
+    let b = tcb(&["sample", &example("careen.json"), "--fps", "30", "--scalar"]);
+    assert_eq!(stdout(&a), stdout(&b));
+}
+
+#[test]
+fn usage_errors() {
+    for args in [
+        vec!["sample", "x.json"],
+        vec!["sample", "x.json", "--at", "0", "--fps", "3"],
+    ] {
+        let o = tcb(&args);
+        assert!(!o.status.success());
+        assert!(o.stdout.is_empty());
+    }
+    let clip = example("bounce.json");
+    for (args, message) in [
+        (vec!["--at", "0,x"], "--at: \"x\" is not a number"),
+        (vec!["--fps", "0"], "--fps must be a positive number"),
+        (vec!["--fps", "-3"], "--fps must be a positive number"),
+        (
+            vec!["--fps", "30", "--from", "2", "--to", "1"],
+            "is before --from",
+        ),
+        (
+            vec!["--at", "0", "--from", "1"],
+            "--from and --to go with --fps",
+        ),
+        (
+            vec!["--fps", "1e12", "--to", "1e6"],
+            "sample times requested",
+        ),
+    ] {
+        let mut all = vec!["sample", clip.as_str()];
+        all.extend(args);
+        let o = tcb(&all);
+        assert!(!o.status.success(), "{all:?}");
+        assert!(o.stdout.is_empty(), "{all:?}");
+        assert!(stderr(&o).contains(message), "{all:?}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn every_bad_input_is_one_clear_line_and_no_csv() {
+    let q = r#""kind": "quat", "times": [0, 1, 2], "values": [[0,0,0,1],[0,0,0.5,0.8660254],[0,0,0,1]]"#;
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        (
+            "few keys",
+            clip_with("", r#""kind": "scalar", "times": [0], "values": [1]"#),
+            "track 'bad'",
+            "at least 2",
+        ),
+        (
+            "times not increasing",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1, 1], "values": [1, 2, 3]"#,
+            ),
+            "track 'bad': key 2",
+            "not after",
+        ),
+        (
+            "lengths disagree",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1, 2], "values": [1, 2]"#,
+            ),
+            "track 'bad'",
+            "2 values for 3 times",
+        ),
+        (
+            "keys length",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "keys": [{}]"#,
+            ),
+            "track 'bad'",
+            "1 keys for 2 times",
+        ),
+        (
+            "wrong shape",
+            clip_with(
+                "",
+                r#""kind": "vec3", "times": [0, 1], "values": [[1, 2, 3], [1, 2]]"#,
+            ),
+            "track 'bad': key 1",
+            "must have 3 numbers",
+        ),
+        (
+            "scalar given an array",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [[1], 2]"#,
+            ),
+            "track 'bad': key 0",
+            "must be a number",
+        ),
+        (
+            "non-finite value",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 1e999]"#,
+            ),
+            "track 'bad': key 1",
+            "not a finite",
+        ),
+        (
+            "value beyond f32",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 1e300]"#,
+            ),
+            "track 'bad': key 1",
+            "not a finite f32",
+        ),
+        (
+            "non-finite time",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1e999], "values": [1, 2]"#,
+            ),
+            "track 'bad': key 1",
+            "not a finite",
+        ),
+        (
+            "non-finite tcb",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "keys": [{}, {"tcb": [0, 1e999, 0]}]"#,
+            ),
+            "track 'bad': key 1",
+            "tcb",
+        ),
+        (
+            "unknown rule",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "tangent_rule": "catmull""#,
+            ),
+            "track 'bad'",
+            "unknown tangent_rule \"catmull\"",
+        ),
+        (
+            "unknown interp",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "keys": [{"interp": "cubic"}, {}]"#,
+            ),
+            "track 'bad': key 0",
+            "unknown interp",
+        ),
+        (
+            "unknown kind",
+            clip_with("", r#""kind": "vec5", "times": [0, 1], "values": [1, 2]"#),
+            "track 'bad'",
+            "unknown kind",
+        ),
+        (
+            "unknown default",
+            clip_with(
+                r#""ends": "open""#,
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2]"#,
+            ),
+            "",
+            "unknown ends",
+        ),
+        (
+            "unknown field",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "tension": 1"#,
+            ),
+            "track 'bad'",
+            "unknown field \"tension\"",
+        ),
+        (
+            "zero quaternion",
+            clip_with(
+                "",
+                r#""kind": "quat", "times": [0, 1], "values": [[0,0,0,1],[0,0,0,0]]"#,
+            ),
+            "track 'bad': key 1",
+            "zero length",
+        ),
+        (
+            "cyclic not closed",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1, 2], "values": [1, 2, 3], "ends": "cyclic""#,
+            ),
+            "track 'bad': key 2",
+            "cyclic",
+        ),
+        (
+            "cyclic rotation not closed",
+            clip_with(
+                "",
+                &format!(
+                    r#"{}, "ends": "cyclic""#,
+                    q.replace("[0,0,0,1]]", "[0,0,1,0]]")
+                ),
+            ),
+            "track 'bad': key 2",
+            "cyclic",
+        ),
+        (
+            "cyclic rotation closed up to sign is fine",
+            clip_with(
+                "",
+                &format!(
+                    r#"{}, "ends": "cyclic""#,
+                    q.replace("[0,0,0,1]]", "[0,0,0,-1]]")
+                ),
+            ),
+            "",
+            "",
+        ),
+        (
+            "natural on squad",
+            clip_with("", &format!(r#"{q}, "ends": "natural""#)),
+            "track 'bad'",
+            "natural",
+        ),
+        (
+            "linear on rotation",
+            clip_with("", &format!(r#"{q}, "post": "linear""#)),
+            "track 'bad'",
+            "post \"linear\"",
+        ),
+        (
+            "offset-repeat on rotation",
+            clip_with(r#""pre": "offset-repeat""#, q),
+            "track 'bad'",
+            "pre \"offset-repeat\"",
+        ),
+        (
+            "ease out of range",
+            clip_with(
+                "",
+                r#""kind": "scalar", "times": [0, 1], "values": [1, 2], "keys": [{"ease": [0, -0.5]}, {}]"#,
+            ),
+            "track 'bad': key 0",
+            "ease",
+        ),
+        (
+            "missing format",
+            r#"{"tracks": []}"#.to_owned(),
+            "",
+            "format",
+        ),
+        (
+            "not json",
+            r#"{"format": "tcb-clip/1", "tracks": [}"#.to_owned(),
+            "",
+            "line 1",
+        ),
+        (
+            "duplicate names",
+            r#"{"format": "tcb-clip/1", "tracks": [
+                {"name": "a", "kind": "scalar", "times": [0, 1], "values": [0, 1]},
+                {"name": "a", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#
+                .to_owned(),
+            "track 'a'",
+            "already used",
+        ),
+    ];
+    for (what, text, location, message) in cases {
+        let path = temp_clip(&format!("{}.json", what.replace(' ', "_")), &text);
+        let o = tcb(&["sample", path.to_str().unwrap(), "--fps", "10"]);
+        let err = stderr(&o);
+        if message.is_empty() {
+            assert!(o.status.success(), "{what}: {err}");
+            continue;
+        }
+        assert!(!o.status.success(), "{what}: accepted");
+        assert!(o.stdout.is_empty(), "{what}: wrote {}", stdout(&o));
+        assert_eq!(err.lines().count(), 1, "{what}: {err}");
+        assert!(
+            err.contains(path.file_name().unwrap().to_str().unwrap()),
+            "{what}: no file name: {err}"
+        );
+        assert!(
+            err.contains(location),
+            "{what}: expected {location:?} in {err}"
+        );
+        assert!(
+            err.contains(message),
+            "{what}: expected {message:?} in {err}"
+        );
+    }
+}
+
+#[test]
+fn tcb_beyond_one_is_allowed() {
+    let text = clip_with(
+        "",
+        r#""kind": "scalar", "times": [0, 1, 2], "values": [1, 2, 0], "keys": [{}, {"tcb": [-2, 1.5, 3]}, {}]"#,
+    );
+    let path = temp_clip("beyond.json", &text);
+    let o = tcb(&["sample", path.to_str().unwrap(), "--at", "0.5,1.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
