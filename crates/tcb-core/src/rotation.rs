@@ -170,6 +170,7 @@ impl RotationTrack {
             return Err(TrackError::TangentOnSquad { key });
         }
         let n = times.len();
+        let mut keys = keys_or_default(keys, n);
         let mut qs: Vec<DQuat> = Vec::with_capacity(n);
         for (key, q) in values.iter().enumerate() {
             let v = DVec4::new(q.x.into(), q.y.into(), q.z.into(), q.w.into());
@@ -184,7 +185,12 @@ impl RotationTrack {
             if let Some(prev) = qs.last()
                 && DVec4::from(*prev).dot(v) < 0.0
             {
+                // The key's explicit tangents describe the curve through the
+                // value as given: they flip with it.
                 v = -v;
+                let k = &mut keys[key];
+                k.tangent_in = k.tangent_in.map(|t| -t);
+                k.tangent_out = k.tangent_out.map(|t| -t);
             }
             qs.push(DQuat::from_vec4(v));
         }
@@ -194,7 +200,6 @@ impl RotationTrack {
                 return Err(TrackError::CyclicNotClosed { key: n - 1 });
             }
         }
-        let keys = keys_or_default(keys, n);
         let values: Vec<Quat> = qs.iter().map(|q| q.as_quat()).collect();
         let eases: Vec<SegmentEase> = segment_eases(&keys).collect();
         let interps: Vec<Interp> = keys.iter().map(|k| k.interp).collect();
