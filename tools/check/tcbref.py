@@ -138,8 +138,13 @@ class Settings:
         self.rotation = d.get("rotation", "squad")
 
 
-def key_tangents(times, chords, keys, st, dim):
-    """DS_k, DD_k of every key (value per segment), per spec/math.md."""
+def key_tangents(times, chords, keys, st, dim, wrap_sign=1.0):
+    """DS_k, DD_k of every key (value per segment), per spec/math.md.
+
+    wrap_sign: -1 for a cyclic hermite rotation whose last key is -q_0 (a
+    full turn): each lap is the previous one negated, so key 0's source chord
+    is -A and DS_{n-1}, in the last key's sign, is -DS.
+    """
     n = len(times)
     D = [times[k + 1] - times[k] for k in range(n - 1)]
     DS, DD = [None] * n, [None] * n
@@ -153,10 +158,12 @@ def key_tangents(times, chords, keys, st, dim):
                 ds, dd = matched(ds, dd, dm, dp)
         elif st.ends == "cyclic":
             tcb = keys[0].get("tcb", st.tcb)
-            A, B, dm, dp = chords[n - 2], chords[0], D[n - 2], D[0]
+            A, B, dm, dp = mul(chords[n - 2], wrap_sign), chords[0], D[n - 2], D[0]
             ds, dd = rule_tangents(st.rule, st.fade, tcb, A, B, dm, dp)
             if st.match_speed:
                 ds, dd = matched(ds, dd, dm, dp)
+            if k == n - 1:
+                ds = mul(ds, wrap_sign)
         else:
             if k == 0:
                 B, dp = chords[0], D[0]
@@ -261,7 +268,8 @@ class Track:
                     self.b[k] = qmul(vals[k], qexp(mul(sub(self.chords[k - 1], self.DS[k]), 0.5)))
         else:
             self.chords = [sub(vals[k + 1], vals[k]) for k in range(n - 1)]
-            self.DS, self.DD = key_tangents(self.times, self.chords, self.keys, self.st, self.dim)
+            wrap = -1.0 if self.kind == "quat" and self.st.ends == "cyclic" and dot(vals[0], vals[-1]) < 0 else 1.0
+            self.DS, self.DD = key_tangents(self.times, self.chords, self.keys, self.st, self.dim, wrap)
 
     # value and d/dt inside [t0, tn]
     def inside(self, time):

@@ -14,7 +14,10 @@
 
 use std::ops::{Add, Mul, Sub};
 
-/// A lane of arithmetic: `f32`, or a SIMD vector of `f32`.
+/// A lane of arithmetic: `f32`, or a SIMD vector of `f32` (`wide::f32x8`).
+///
+/// Only `+`, `-` and `*` are used (no fused multiply-add), so a formula run
+/// on `f32` and on `f32x8` gives the same bits in every lane.
 pub trait Real: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
     /// Every lane set to `x`.
     fn splat(x: f32) -> Self;
@@ -24,6 +27,13 @@ impl Real for f32 {
     #[inline(always)]
     fn splat(x: f32) -> Self {
         x
+    }
+}
+
+impl Real for wide::f32x8 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        wide::f32x8::splat(x)
     }
 }
 

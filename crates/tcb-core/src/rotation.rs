@@ -219,7 +219,18 @@ impl RotationTrack {
                 })
                 .collect();
             let vs = values.iter().map(|&q| as_vec4(q)).collect();
-            Shape::Hermite(Track::new(times.clone(), vs, vkeys, settings)?)
+            let wrap_sign = if settings.ends == Ends::Cyclic && qs[0].dot(qs[n - 1]) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            Shape::Hermite(Track::new_wrapped(
+                times.clone(),
+                vs,
+                vkeys,
+                settings,
+                wrap_sign,
+            )?)
         };
         Ok(RotationTrack {
             times,
@@ -245,6 +256,16 @@ impl RotationTrack {
     /// The settings the track was built with.
     pub fn settings(&self) -> &TrackSettings {
         &self.settings
+    }
+
+    /// Ease of each segment.
+    pub fn eases(&self) -> &[SegmentEase] {
+        &self.eases
+    }
+
+    /// Shape of the segment leaving each key.
+    pub fn interps(&self) -> &[Interp] {
+        &self.interps
     }
 
     /// The squad segments (`None` for `hermite` tracks).
@@ -495,6 +516,26 @@ mod tests {
             RotationTrack::new(vec![0.0, 1.0], q, keys, &TrackSettings::default()).unwrap_err(),
             TrackError::TangentOnSquad { key: 1 }
         );
+    }
+
+    #[test]
+    fn hermite_full_turn_loop_is_smooth_across_the_wrap() {
+        // A spin about z: 0, 120, 240, 360 degrees; q(360) = -q(0).
+        let s = TrackSettings {
+            ends: Ends::Cyclic,
+            rotation: RotationMode::Hermite,
+            post: Extrapolation::Repeat,
+            ..Default::default()
+        };
+        let turn = |deg: f32| Quat::from_rotation_z(deg.to_radians());
+        let q = vec![turn(0.0), turn(120.0), turn(240.0), turn(360.0)];
+        let t = RotationTrack::new(vec![0.0, 1.0, 2.0, 3.0], q, vec![], &s).unwrap();
+        // Angular speed is the same just before and just after the wrap.
+        let speed = |time: f64| t.sample_with_velocity(time).1.length();
+        assert!((speed(3.0 - 1e-9) - speed(3.0 + 1e-9)).abs() < 1e-4);
+        assert!((speed(0.0) - speed(3.0)).abs() < 1e-4);
+        // And symmetric: the middle of the lap is a third of a turn from each end.
+        assert!(close_f32(t.sample(1.5), turn(180.0)));
     }
 
     #[test]

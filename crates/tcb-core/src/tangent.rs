@@ -224,6 +224,21 @@ pub fn key_tangents<V: Vector>(
     keys: &[TangentKey<V>],
     settings: &TrackSettings,
 ) -> Vec<KeyTangents<V>> {
+    key_tangents_wrapped(times, chords, keys, settings, 1.0)
+}
+
+/// [`key_tangents`] for a cyclic track whose last value is `wrap_sign`
+/// times its first: a `hermite` rotation that turns a full 360 degrees ends
+/// on `-q_0`, the same rotation. Each lap is then the previous one negated,
+/// so key 0's source chord is `wrap_sign A`, and `DS_{n-1}` (in the last
+/// key's sign) is `wrap_sign DS`.
+pub fn key_tangents_wrapped<V: Vector>(
+    times: &[f64],
+    chords: &[V],
+    keys: &[TangentKey<V>],
+    settings: &TrackSettings,
+    wrap_sign: f64,
+) -> Vec<KeyTangents<V>> {
     let n = times.len();
     debug_assert!(n >= 2 && chords.len() == n - 1 && keys.len() == n);
     let interval = |k: usize| times[k + 1] - times[k];
@@ -255,7 +270,9 @@ pub fn key_tangents<V: Vector>(
         } else if settings.ends == Ends::Cyclic {
             // Key 0 and key n-1 are one key, with key 0's parameters.
             let (d_in, d_out) = (interval(n - 2), interval(0));
-            let (ds, dd) = rule(keys[0].tcb, chords[n - 2], chords[0], d_in, d_out, true);
+            let a = chords[n - 2].scale(wrap_sign);
+            let (ds, dd) = rule(keys[0].tcb, a, chords[0], d_in, d_out, true);
+            let ds = if last { ds.scale(wrap_sign) } else { ds };
             (ds, dd, d_in, d_out)
         } else {
             // copy, zero, and the provisional value of natural ends.

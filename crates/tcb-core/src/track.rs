@@ -6,7 +6,7 @@ use crate::ease::SegmentEase;
 use crate::error::TrackError;
 use crate::extrapolate::{Mapped, map_time};
 use crate::params::{Ends, Interp, KeyParams, TrackSettings};
-use crate::tangent::{KeyTangents, TangentKey, key_tangents};
+use crate::tangent::{KeyTangents, TangentKey, key_tangents_wrapped};
 use crate::vector::{Value, Vector};
 
 /// The Hermite controls of one segment, in value per segment, after the
@@ -171,6 +171,18 @@ impl<V: Value> Track<V> {
         keys: Vec<KeyParams<V>>,
         settings: &TrackSettings,
     ) -> Result<Self, TrackError> {
+        Self::new_wrapped(times, values, keys, settings, 1.0)
+    }
+
+    /// [`Track::new`] for a cyclic track whose last value is `wrap_sign`
+    /// times its first (see [`crate::tangent::key_tangents_wrapped`]).
+    pub(crate) fn new_wrapped(
+        times: Vec<f64>,
+        values: Vec<V>,
+        keys: Vec<KeyParams<V>>,
+        settings: &TrackSettings,
+        wrap_sign: f64,
+    ) -> Result<Self, TrackError> {
         check_keys(&times, values.len(), &keys, settings.ends, V::is_finite)?;
         let n = times.len();
         for (key, v) in values.iter().enumerate() {
@@ -178,7 +190,8 @@ impl<V: Value> Track<V> {
                 return Err(TrackError::NonFiniteValue { key, what: "value" });
             }
         }
-        if settings.ends == Ends::Cyclic && !nearly_equal(values[0], values[n - 1]) {
+        if settings.ends == Ends::Cyclic && !nearly_equal(values[0], values[n - 1].scale(wrap_sign))
+        {
             return Err(TrackError::CyclicNotClosed { key: n - 1 });
         }
         let keys = keys_or_default(keys, n);
@@ -191,7 +204,7 @@ impl<V: Value> Track<V> {
                 tangent_out: k.tangent_out,
             })
             .collect();
-        let tangents = key_tangents(&times, &chords, &tangent_keys, settings);
+        let tangents = key_tangents_wrapped(&times, &chords, &tangent_keys, settings, wrap_sign);
         let segments = segment_eases(&keys)
             .enumerate()
             .map(|(k, ease)| {

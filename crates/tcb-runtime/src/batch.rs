@@ -1,0 +1,31 @@
+//! Many instances at once with rayon; the result is identical to sampling
+//! them one after another (each instance is independent).
+
+use crate::instance::Instance;
+use rayon::prelude::*;
+
+/// Sample `instances[i]` at `times[i]`, in parallel.
+///
+/// ```
+/// # use std::sync::Arc;
+/// # let text = r#"{"format": "tcb-clip/1", "tracks": [{"name": "x", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#;
+/// # let clip = Arc::new(tcb_runtime::Clip::compile(&tcb_io::ClipDoc::parse(text).unwrap().build().unwrap()));
+/// let mut crowd: Vec<_> = (0..100).map(|_| tcb_runtime::Instance::new(clip.clone(), false)).collect();
+/// let times: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
+/// tcb_runtime::batch::sample_all(&mut crowd, &times);
+/// ```
+pub fn sample_all(instances: &mut [Instance], times: &[f64]) {
+    instances
+        .par_iter_mut()
+        .zip(times.par_iter())
+        .for_each(|(inst, &t)| {
+            inst.sample(t);
+        });
+}
+
+/// As [`sample_all`], one after another on this thread.
+pub fn sample_all_sequential(instances: &mut [Instance], times: &[f64]) {
+    for (inst, &t) in instances.iter_mut().zip(times) {
+        inst.sample(t);
+    }
+}

@@ -1,0 +1,219 @@
+//! Key-time grids, playback cursors and the per-frame basis.
+//!
+//! Every channel of a [`crate::Clip`] group shares one grid: its key times,
+//! the ease of each segment, and its `pre`/`post` modes. Once per frame and
+//! group, [`TimeGrid::frame`] turns the sample time into a [`FrameBasis`]:
+//! which stored segment to read and the Hermite rows to weight it with. The
+//! kernels then do nothing but multiply-adds.
+//!
+//! Stored segments are numbered `0 ..= n`: `0` is the *pre sentinel*
+//! (`P0 = P_0`, `M0 = TO_0`), `1 ..= n-1` are the real segments, `n` is the
+//! *post sentinel* (`P0 = P_{n-1}`, `M0 = TI_{n-1}`, `M1` = the velocity
+//! arriving at the last key). Holding an end key, extrapolating along a
+//! line, resetting to zero and sampling exactly at the last key are all a
+//! choice of rows on these, with no branch per channel:
+//!
+//! ```text
+//! inside, segment k      segment k+1   h = H(s)          dh = H'(s), rate = ds/du / D_k
+//! exactly at t_{n-1}     n             h = [1 0 0 0]     dh = [0 0 0 1], rate = 1
+//! hold first / last      0 / n         h = [1 0 0 0]     rate = 0
+//! linear, dt from key    0 / n         h = [1 0 dt 0]    dh = [0 0 1 0], rate = 1
+//! reset                  0             h = [0 0 0 0]     rate = 0
+//! ```
+//!
+//! `rate` carries the direction of `oscillate` (-1 on backward legs).
+
+use tcb_core::Extrapolation;
+use tcb_core::basis::{hermite_basis, hermite_basis_derivative};
+use tcb_core::ease::SegmentEase;
+use tcb_core::extrapolate::{Mapped, map_time};
+
+/// Key times, segment eases and extrapolation shared by a group of channels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeGrid {
+    /// Key times (n >= 2, strictly increasing).
+    pub times: Vec<f64>,
+    /// Ease of each of the n-1 segments.
+    pub eases: Vec<SegmentEase>,
+    /// Before the first key.
+    pub pre: Extrapolation,
+    /// After the last key.
+    pub post: Extrapolation,
+}
+
+/// What one frame of one group reads: a stored segment and the rows to
+/// weight its controls with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameBasis {
+    /// Stored segment (`0` pre sentinel, `1..n` real, `n` post sentinel).
+    pub segment: usize,
+    /// Eased local parameter (for slerp-based rotations).
+    pub s: f32,
+    /// Value row `[h1 h2 h3 h4]`.
+    pub h: [f32; 4],
+    /// Derivative row before scaling by `rate`.
+    pub dh: [f32; 4],
+    /// d/dt = `rate * (dh . controls)`; includes the `oscillate` direction.
+    pub rate: f32,
+    /// Whole cycles of `offset-repeat` to add, times `P_{n-1} - P_0`.
+    pub cycles: f32,
+    /// `reset` extrapolation: zero, identity for rotations.
+    pub reset: bool,
+}
+
+impl FrameBasis {
+    fn fixed(segment: usize, h: [f32; 4], dh: [f32; 4], rate: f32) -> Self {
+        FrameBasis {
+            segment,
+            s: 0.0,
+            h,
+            dh,
+            rate,
+            cycles: 0.0,
+            reset: false,
+        }
+    }
+}
+
+/// Where a group's playback is: the last real segment found. Forward
+/// playback finds the next segment in O(1); a seek falls back to binary
+/// search.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cursor(usize);
+
+impl TimeGrid {
+    /// Number of keys.
+    pub fn keys(&self) -> usize {
+        self.times.len()
+    }
+
+    /// Segment k with `times[k] <= time < times[k+1]`, for `time` in
+    /// `[t_0, t_{n-1})`, starting from the cursor.
+    #[inline]
+    fn locate(&self, time: f64, cursor: &mut Cursor) -> usize {
+        let t = &self.times;
+        let last = t.len() - 2;
+        let k = cursor.0.min(last);
+        let k = if t[k] <= time {
+            if time < t[k + 1] {
+                k
+            } else if k < last && time < t[k + 2] {
+                k + 1
+            } else {
+                search(t, time)
+            }
+        } else {
+            search(t, time)
+        };
+        cursor.0 = k;
+        k
+    }
+
+    /// The basis for `time` (any f64), advancing `cursor`.
+    #[inline]
+    pub fn frame(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
+        let n = self.times.len();
+        let (t0, tn) = (self.times[0], self.times[n - 1]);
+        match map_time(time, t0, tn, self.pre, self.post) {
+            Mapped::Inside {
+                time,
+                direction,
+                cycles,
+            } => {
+                let mut f = if time >= tn {
+                    FrameBasis::fixed(n, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], 1.0)
+                } else {
+                    let k = self.locate(time, cursor);
+                    let d = self.times[k + 1] - self.times[k];
+                    let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
+                    let (s, ds_du) = self.eases[k].apply(u);
+                    let s32 = s as f32;
+                    FrameBasis {
+                        segment: k + 1,
+                        s: s32,
+                        h: hermite_basis(s32),
+                        dh: hermite_basis_derivative(s32),
+                        rate: (ds_du / d) as f32,
+                        cycles: 0.0,
+                        reset: false,
+                    }
+                };
+                f.rate *= direction as f32;
+                f.cycles = cycles as f32;
+                f
+            }
+            Mapped::Hold { last } => FrameBasis::fixed(
+                if last { n } else { 0 },
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0; 4],
+                0.0,
+            ),
+            Mapped::Reset => FrameBasis {
+                reset: true,
+                ..FrameBasis::fixed(0, [0.0; 4], [0.0; 4], 0.0)
+            },
+            Mapped::Line { last, dt } => FrameBasis::fixed(
+                if last { n } else { 0 },
+                [1.0, 0.0, dt as f32, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+                1.0,
+            ),
+        }
+    }
+}
+
+fn search(t: &[f64], time: f64) -> usize {
+    t.partition_point(|&x| x <= time)
+        .saturating_sub(1)
+        .min(t.len() - 2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(pre: Extrapolation, post: Extrapolation) -> TimeGrid {
+        TimeGrid {
+            times: vec![0.0, 1.0, 3.0, 4.0],
+            eases: vec![SegmentEase::default(); 3],
+            pre,
+            post,
+        }
+    }
+
+    #[test]
+    fn cursor_moves_forward_and_seeks() {
+        let g = grid(Extrapolation::Constant, Extrapolation::Constant);
+        let mut c = Cursor::default();
+        assert_eq!(g.frame(0.5, &mut c).segment, 1);
+        assert_eq!(g.frame(1.5, &mut c).segment, 2);
+        assert_eq!(c, Cursor(1));
+        assert_eq!(g.frame(3.5, &mut c).segment, 3);
+        assert_eq!(g.frame(0.2, &mut c).segment, 1);
+        assert_eq!(g.frame(3.9, &mut c).segment, 3);
+        assert_eq!(g.frame(1.0, &mut c).segment, 2);
+    }
+
+    #[test]
+    fn sentinels() {
+        let g = grid(Extrapolation::Linear, Extrapolation::Constant);
+        let mut c = Cursor::default();
+        let f = g.frame(4.0, &mut c);
+        assert_eq!(
+            (f.segment, f.h, f.dh, f.rate),
+            (4, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], 1.0)
+        );
+        let f = g.frame(9.0, &mut c);
+        assert_eq!((f.segment, f.rate), (4, 0.0));
+        let f = g.frame(-2.0, &mut c);
+        assert_eq!(
+            (f.segment, f.h, f.dh),
+            (0, [1.0, 0.0, -2.0, 0.0], [0.0, 0.0, 1.0, 0.0])
+        );
+        let g = grid(Extrapolation::Reset, Extrapolation::Oscillate);
+        let f = g.frame(-1.0, &mut c);
+        assert!(f.reset && f.h == [0.0; 4]);
+        let f = g.frame(4.5, &mut c);
+        assert_eq!((f.segment, f.rate), (3, -1.0));
+    }
+}

@@ -1,0 +1,126 @@
+//! Per-instance playback: cursors and a pose, sampled without allocating.
+
+use crate::clip::{Clip, TrackId};
+use crate::grid::Cursor;
+use crate::kernel;
+use crate::pose::Pose;
+use std::sync::Arc;
+use tcb_core::TrackData;
+use wide::f32x8;
+
+/// One playing copy of a clip: a cursor per group and the output pose.
+/// Allocates when created, never when sampling.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    clip: Arc<Clip>,
+    cursors: Vec<Cursor>,
+    pose: Pose,
+}
+
+impl Instance {
+    /// A new instance of `clip`; `velocities` adds d/dt to its pose.
+    pub fn new(clip: Arc<Clip>, velocities: bool) -> Self {
+        Instance {
+            cursors: vec![Cursor::default(); clip.groups.len()],
+            pose: Pose::new(&clip, velocities),
+            clip,
+        }
+    }
+
+    /// The clip.
+    pub fn clip(&self) -> &Arc<Clip> {
+        &self.clip
+    }
+
+    /// The last sampled pose.
+    pub fn pose(&self) -> &Pose {
+        &self.pose
+    }
+
+    /// Sample every track at `time` (seconds; any f64) into the pose.
+    pub fn sample(&mut self, time: f64) -> &Pose {
+        sample_into(&self.clip, time, &mut self.cursors, &mut self.pose);
+        &self.pose
+    }
+}
+
+/// Sample `clip` at `time` into `pose`, with one cursor per group.
+pub(crate) fn sample_into(clip: &Clip, time: f64, cursors: &mut [Cursor], pose: &mut Pose) {
+    let Pose {
+        values, velocities, ..
+    } = pose;
+    for (g, cursor) in clip.groups.iter().zip(cursors.iter_mut()) {
+        let f = g.grid.frame(time, cursor);
+        let h = kernel::splat4(f.h);
+        let dh = kernel::splat4(f.dh);
+        let rate = f32x8::splat(f.rate);
+        let seg = f.segment;
+        if g.vec_blocks > 0 {
+            let n = g.vec_blocks * kernel::VEC_STRIDE;
+            let coeffs = &g.vec[seg * n..(seg + 1) * n];
+            let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
+            kernel::vectors(coeffs, &h, out);
+            if f.cycles != 0.0 && !g.delta.is_empty() {
+                kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
+            }
+            if let Some(v) = velocities.as_deref_mut() {
+                kernel::vector_velocities(
+                    coeffs,
+                    &dh,
+                    rate,
+                    &mut v[g.vec_out..g.vec_out + g.vec_blocks],
+                );
+            }
+        }
+        if g.hq_blocks > 0 {
+            let n = g.hq_blocks * kernel::HQ_STRIDE;
+            let range = g.hq_out..g.hq_out + 4 * g.hq_blocks;
+            if f.reset {
+                kernel::identity(&mut values[range.clone()]);
+                if let Some(v) = velocities.as_deref_mut() {
+                    v[range].fill(f32x8::ZERO);
+                }
+            } else {
+                kernel::hermite_quats(
+                    &g.hq[seg * n..(seg + 1) * n],
+                    &h,
+                    Some((&dh, rate)),
+                    &mut values[range.clone()],
+                    velocities.as_deref_mut().map(|v| &mut v[range]),
+                );
+            }
+        }
+        if g.sq_blocks > 0 {
+            let n = g.sq_blocks * kernel::SQ_STRIDE;
+            let out = &mut values[g.sq_out..g.sq_out + 4 * g.sq_blocks];
+            if f.reset {
+                kernel::identity(out);
+            } else {
+                kernel::squad_quats(&g.sq[seg * n..(seg + 1) * n], f32x8::splat(f.s), out);
+            }
+        }
+    }
+    let want_velocity = pose.velocities.is_some();
+    for &id in &clip.reference {
+        let (q, d) = rotation(clip, id).sample_with_velocity(time);
+        pose.set(id, q.to_array(), Some(d.to_array()));
+    }
+    if want_velocity {
+        for &id in &clip.squad_velocity {
+            let (_, d) = rotation(clip, id).sample_with_velocity(time);
+            let value = pose_value(pose, id);
+            pose.set(id, value, Some(d.to_array()));
+        }
+    }
+}
+
+fn rotation(clip: &Clip, id: TrackId) -> &tcb_core::RotationTrack {
+    match &clip.source.tracks[id.0].data {
+        TrackData::Quat(r) => r,
+        _ => unreachable!("only rotation tracks are sampled by the reference"),
+    }
+}
+
+fn pose_value(pose: &Pose, id: TrackId) -> [f32; 4] {
+    pose.quat(id).to_array()
+}

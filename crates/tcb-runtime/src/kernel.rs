@@ -1,0 +1,130 @@
+//! The SIMD kernels: one stored segment, eight channels per `f32x8`, the
+//! frame's rows broadcast. No branch depends on a channel.
+
+use tcb_core::basis::hermite;
+use wide::f32x8;
+
+/// `[P0, P1, M0, M1]` of 8 channels.
+pub(crate) const VEC_STRIDE: usize = 4;
+/// `[P0, P1, M0, M1]` x `[x, y, z, w]` of 8 quaternions.
+pub(crate) const HQ_STRIDE: usize = 16;
+/// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`:
+/// the two outer slerps of squad as start point, log axis and log angle.
+pub(crate) const SQ_STRIDE: usize = 16;
+
+#[inline(always)]
+pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
+    r.map(f32x8::splat)
+}
+
+/// Values of vector channels: `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula
+/// of [`tcb_core::basis::hermite`] itself.
+#[inline]
+pub(crate) fn vectors(coeffs: &[f32x8], h: &[f32x8; 4], out: &mut [f32x8]) {
+    for (c, o) in coeffs.chunks_exact(VEC_STRIDE).zip(out) {
+        *o = hermite(h, c[0], c[1], c[2], c[3]);
+    }
+}
+
+/// Velocities of vector channels: `rate (dh . controls)`.
+#[inline]
+pub(crate) fn vector_velocities(coeffs: &[f32x8], dh: &[f32x8; 4], rate: f32x8, out: &mut [f32x8]) {
+    for (c, o) in coeffs.chunks_exact(VEC_STRIDE).zip(out) {
+        *o = hermite(dh, c[0], c[1], c[2], c[3]) * rate;
+    }
+}
+
+/// `value += cycles * delta` (offset-repeat).
+#[inline]
+pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
+    for (d, o) in delta.iter().zip(out) {
+        *o += *d * cycles;
+    }
+}
+
+/// Hermite rotations: four components, then normalized; `vel` gets
+/// `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
+#[inline]
+pub(crate) fn hermite_quats(
+    coeffs: &[f32x8],
+    h: &[f32x8; 4],
+    dh: Option<(&[f32x8; 4], f32x8)>,
+    out: &mut [f32x8],
+    mut vel: Option<&mut [f32x8]>,
+) {
+    for (b, c) in coeffs.chunks_exact(HQ_STRIDE).enumerate() {
+        let p: [f32x8; 4] =
+            std::array::from_fn(|i| hermite(h, c[i], c[4 + i], c[8 + i], c[12 + i]));
+        let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
+        let inv = f32x8::ONE / len;
+        let q = p.map(|x| x * inv);
+        out[4 * b..4 * b + 4].copy_from_slice(&q);
+        if let (Some((dh, rate)), Some(vel)) = (dh, vel.as_deref_mut()) {
+            let dp: [f32x8; 4] =
+                std::array::from_fn(|i| hermite(dh, c[i], c[4 + i], c[8 + i], c[12 + i]) * rate);
+            let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
+            for i in 0..4 {
+                vel[4 * b + i] = (dp[i] - q[i] * qd) * inv;
+            }
+        }
+    }
+}
+
+/// Hamilton product of two quaternions in planes `[x, y, z, w]`.
+#[inline(always)]
+fn quat_mul(a: &[f32x8; 4], b: &[f32x8; 4]) -> [f32x8; 4] {
+    [
+        a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+        a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+        a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
+    ]
+}
+
+/// `p exp(s alpha n)`: slerp from `p` along unit axis `n` (log-space angle
+/// `alpha`). No division by `sin`, so well conditioned for any angle.
+#[inline(always)]
+fn slerp_power(p: &[f32x8; 4], n: &[f32x8], alpha: f32x8, s: f32x8) -> [f32x8; 4] {
+    let (sin, cos) = (s * alpha).sin_cos();
+    quat_mul(p, &[n[0] * sin, n[1] * sin, n[2] * sin, cos])
+}
+
+/// Squad rotations: `slerp(slerp(q0, q1, s), slerp(a, b, s), 2s(1-s))`,
+/// normalized. Each slerp is written `p exp(s log(p^-1 q))`; the logs of the
+/// two outer ones are stored with the segment (axis and angle, from f64), the
+/// inner one is taken per frame.
+#[inline]
+pub(crate) fn squad_quats(coeffs: &[f32x8], s: f32x8, out: &mut [f32x8]) {
+    let one = f32x8::ONE;
+    let g = (s + s) * (one - s);
+    for (b, c) in coeffs.chunks_exact(SQ_STRIDE).enumerate() {
+        let q0 = [c[0], c[1], c[2], c[3]];
+        let a = [c[8], c[9], c[10], c[11]];
+        let p = slerp_power(&q0, &c[4..7], c[7], s);
+        let q = slerp_power(&a, &c[12..15], c[15], s);
+        // log(p^-1 q) = n alpha, alpha = atan2(|v|, w)
+        let r = quat_mul(&[-p[0], -p[1], -p[2], p[3]], &q);
+        let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+        let alpha = len.atan2(r[3]);
+        let none = len.simd_eq(f32x8::ZERO);
+        let inv = none.select(f32x8::ZERO, one / len);
+        let n = [r[0] * inv, r[1] * inv, r[2] * inv];
+        let v = slerp_power(&p, &n, alpha, g);
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
+        let il = one / l;
+        for i in 0..4 {
+            out[4 * b + i] = v[i] * il;
+        }
+    }
+}
+
+/// Write the identity rotation into quaternion blocks (`reset`).
+#[inline]
+pub(crate) fn identity(out: &mut [f32x8]) {
+    for q in out.chunks_exact_mut(4) {
+        q[0] = f32x8::ZERO;
+        q[1] = f32x8::ZERO;
+        q[2] = f32x8::ZERO;
+        q[3] = f32x8::ONE;
+    }
+}

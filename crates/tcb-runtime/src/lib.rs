@@ -1,0 +1,48 @@
+//! # tcb-runtime
+//!
+//! Sampling Kochanek–Bartels animation in a game loop.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use tcb_runtime::{Clip, Instance, blend};
+//!
+//! // Load once: validate, compile to structure-of-arrays, share by Arc.
+//! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/clips/bounce.json")).unwrap();
+//! let clip = Arc::new(Clip::compile(&tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()));
+//! let ball = clip.track("ball.position").unwrap();
+//!
+//! // Instances: a cursor per time grid and a pose each; no allocation after this.
+//! let mut walk = Instance::new(clip.clone(), false);
+//! let mut run = Instance::new(clip.clone(), false);
+//! let mut out = walk.pose().clone();
+//!
+//! // Fixed-step loop: sample both, cross-fade.
+//! let dt = 1.0 / 60.0;
+//! for frame in 0..120 {
+//!     let t = frame as f64 * dt;
+//!     walk.sample(t);
+//!     run.sample(t + 0.5);
+//!     let fade = (frame as f32 / 120.0).min(1.0);
+//!     blend(&mut out, &[(walk.pose(), 1.0 - fade), (run.pose(), fade)], None);
+//!     let p = out.vec3(ball);
+//!     assert!(p.is_finite());
+//! }
+//! ```
+//!
+//! How it works: see [`clip`] (the layout), [`grid`] (the per-frame basis
+//! and the sentinels that keep the kernels free of per-channel branches).
+
+pub mod blend;
+pub mod clip;
+pub mod grid;
+mod instance;
+mod kernel;
+pub mod pose;
+
+#[cfg(feature = "rayon")]
+pub mod batch;
+
+pub use blend::{BlendMask, blend};
+pub use clip::{Clip, TrackId, TrackSlot};
+pub use instance::Instance;
+pub use pose::Pose;

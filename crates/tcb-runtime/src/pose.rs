@@ -1,0 +1,133 @@
+//! Sampled values in structure-of-arrays form, with typed accessors.
+
+use crate::clip::{Clip, TrackId, TrackSlot};
+
+/// Where every track lives in a pose; shared by a clip and its poses. Poses
+/// can be blended when their layouts are equal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseLayout {
+    /// Each track's flat component indices.
+    pub slots: Vec<TrackSlot>,
+    /// Total f32x8 blocks.
+    pub blocks: usize,
+    /// First block of each group of 4 blocks holding x, y, z, w planes of 8 rotations.
+    pub quat_blocks: Vec<usize>,
+    /// Flat index of each rotation stored as 4 consecutive floats.
+    pub loose_quats: Vec<usize>,
+}
+use glam::{Quat, Vec2, Vec3, Vec4};
+use std::sync::Arc;
+use wide::f32x8;
+
+/// The output of sampling a [`Clip`]: blocks of 8 channels as `f32x8`, laid
+/// out by the clip's groups (vectors component-interleaved in track order,
+/// rotations as x/y/z/w planes of 8). Read it through the typed accessors,
+/// or [`Pose::write_row`] for the clip's column order.
+#[derive(Clone, Debug)]
+pub struct Pose {
+    pub(crate) layout: Arc<PoseLayout>,
+    pub(crate) values: Vec<f32x8>,
+    pub(crate) velocities: Option<Vec<f32x8>>,
+}
+
+macro_rules! accessors {
+    ($($value:ident, $velocity:ident, $t:ty, $n:literal, $make:expr;)+) => {$(
+        #[doc = concat!("The value of a `", stringify!($value), "` track.")]
+        pub fn $value(&self, track: TrackId) -> $t {
+            let a = self.components(&self.values, track);
+            ($make)(a)
+        }
+
+        #[doc = concat!("The d/dt of a `", stringify!($value), "` track (zero without velocities).")]
+        pub fn $velocity(&self, track: TrackId) -> $t {
+            match &self.velocities {
+                Some(v) => ($make)(self.components(v, track)),
+                None => ($make)([0.0; 4]),
+            }
+        }
+    )+};
+}
+
+impl Pose {
+    /// A pose for `clip`, with room for velocities if asked.
+    pub fn new(clip: &Clip, velocities: bool) -> Self {
+        let blocks = clip.layout.blocks;
+        Pose {
+            layout: clip.layout.clone(),
+            values: vec![f32x8::ZERO; blocks],
+            velocities: velocities.then(|| vec![f32x8::ZERO; blocks]),
+        }
+    }
+
+    /// The layout (shared with its clip).
+    pub fn layout(&self) -> &Arc<PoseLayout> {
+        &self.layout
+    }
+
+    /// Whether this pose carries velocities.
+    pub fn has_velocities(&self) -> bool {
+        self.velocities.is_some()
+    }
+
+    /// All channels as flat `f32` (layout order, padding lanes included).
+    pub fn as_slice(&self) -> &[f32] {
+        bytemuck::cast_slice(&self.values)
+    }
+
+    fn components(&self, data: &[f32x8], track: TrackId) -> [f32; 4] {
+        let flat: &[f32] = bytemuck::cast_slice(data);
+        let slot = &self.layout.slots[track.0];
+        let mut out = [0.0; 4];
+        for (o, &i) in out.iter_mut().zip(&slot.index).take(slot.kind.dim()) {
+            *o = flat[i];
+        }
+        out
+    }
+
+    accessors! {
+        scalar, scalar_velocity, f32, 1, |a: [f32; 4]| a[0];
+        vec2, vec2_velocity, Vec2, 2, |a: [f32; 4]| Vec2::new(a[0], a[1]);
+        vec3, vec3_velocity, Vec3, 3, |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        vec4, vec4_velocity, Vec4, 4, Vec4::from_array;
+        quat, quat_velocity, Quat, 4, Quat::from_array;
+    }
+
+    /// Every track's components in file order (the CSV columns of
+    /// `tcb sample`), and velocities after them if `velocities` is given.
+    pub fn write_row(&self, values: &mut [f32], velocities: Option<&mut [f32]>) {
+        let flat: &[f32] = bytemuck::cast_slice(&self.values);
+        let mut at = 0;
+        for s in self.layout.slots.iter() {
+            for &i in &s.index[..s.kind.dim()] {
+                values[at] = flat[i];
+                at += 1;
+            }
+        }
+        if let (Some(out), Some(v)) = (velocities, &self.velocities) {
+            let flat: &[f32] = bytemuck::cast_slice(v);
+            let mut at = 0;
+            for s in self.layout.slots.iter() {
+                for &i in &s.index[..s.kind.dim()] {
+                    out[at] = flat[i];
+                    at += 1;
+                }
+            }
+        }
+    }
+
+    pub(crate) fn set(&mut self, track: TrackId, value: [f32; 4], velocity: Option<[f32; 4]>) {
+        let slot = &self.layout.slots[track.0];
+        let dim = slot.kind.dim();
+        let idx = slot.index;
+        let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut self.values);
+        for c in 0..dim {
+            flat[idx[c]] = value[c];
+        }
+        if let (Some(vel), Some(v)) = (velocity, self.velocities.as_mut()) {
+            let flat: &mut [f32] = bytemuck::cast_slice_mut(v);
+            for c in 0..dim {
+                flat[idx[c]] = vel[c];
+            }
+        }
+    }
+}

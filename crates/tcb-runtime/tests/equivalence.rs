@@ -1,0 +1,450 @@
+//! The runtime against the tcb-core reference, over random clips.
+
+use glam::{Quat, Vec2, Vec3, Vec4};
+use proptest::prelude::*;
+use std::sync::Arc;
+use tcb_core::{
+    Ease, Ends, Extrapolation, Interp, KeyParams, NamedTrack, RotationMode, RotationTrack,
+    TangentRule, Tcb, Track, TrackData, TrackSettings, Value,
+};
+use tcb_runtime::{Clip, Instance};
+
+/// A small deterministic generator (xorshift64*), so failures replay from a seed.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    fn f(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        self.f(0.0, 1.0) < p
+    }
+}
+
+fn settings(rng: &mut Rng, rotation: bool) -> TrackSettings {
+    let rules = [
+        TangentRule::Uniform,
+        TangentRule::Adjusted,
+        TangentRule::Secant,
+        TangentRule::Parabolic,
+    ];
+    let mut ends = [Ends::Copy, Ends::Zero, Ends::Natural, Ends::Cyclic][rng.below(4)];
+    let modes = if rotation { 4 } else { 6 };
+    let mode = |rng: &mut Rng| Extrapolation::ALL[rng.below(modes)];
+    let rot = if rng.chance(0.5) {
+        RotationMode::Squad
+    } else {
+        RotationMode::Hermite
+    };
+    if rotation && rot == RotationMode::Squad && ends == Ends::Natural {
+        ends = Ends::Copy;
+    }
+    TrackSettings {
+        tangent_rule: rules[rng.below(4)],
+        ends,
+        match_speed: rng.chance(0.3),
+        continuity_fade: rng.chance(0.3),
+        pre: mode(rng),
+        post: mode(rng),
+        rotation: rot,
+    }
+}
+
+fn key_params<V: Copy>(
+    rng: &mut Rng,
+    n: usize,
+    tangent: impl Fn(&mut Rng) -> V,
+    explicit: bool,
+) -> Vec<KeyParams<V>> {
+    (0..n)
+        .map(|_| KeyParams {
+            tcb: Tcb::new(rng.f(-1.0, 1.0), rng.f(-1.0, 1.0), rng.f(-1.0, 1.0)),
+            ease: if rng.chance(0.3) {
+                Ease {
+                    to: rng.f(0.0, 1.0),
+                    from: rng.f(0.0, 1.0),
+                }
+            } else {
+                Ease::NONE
+            },
+            interp: [
+                Interp::Curve,
+                Interp::Curve,
+                Interp::Curve,
+                Interp::Linear,
+                Interp::Step,
+            ][rng.below(5)],
+            tangent_in: (explicit && rng.chance(0.2)).then(|| tangent(rng)),
+            tangent_out: (explicit && rng.chance(0.2)).then(|| tangent(rng)),
+        })
+        .collect()
+}
+
+fn times(rng: &mut Rng, n: usize) -> Vec<f64> {
+    let mut t = vec![rng.f(-2.0, 2.0)];
+    for _ in 1..n {
+        let next = t[t.len() - 1] + rng.f(0.05, 1.5);
+        t.push(next);
+    }
+    t
+}
+
+fn vector_track<V: Value>(rng: &mut Rng, t: &[f64], s: &TrackSettings) -> Track<V> {
+    let n = t.len();
+    let rnd = |rng: &mut Rng| {
+        let a: [f32; 4] = std::array::from_fn(|_| rng.f(-10.0, 10.0) as f32);
+        V::from_array(a)
+    };
+    let mut values: Vec<V> = (0..n).map(|_| rnd(rng)).collect();
+    if s.ends == Ends::Cyclic {
+        values[n - 1] = values[0];
+    }
+    let keys = key_params(rng, n, rnd, true);
+    Track::new(t.to_vec(), values, keys, s).expect("valid random track")
+}
+
+/// Random rotations: a random walk with up to `max_turn` radians between
+/// consecutive keys, each key given at a random scale and sign (the track
+/// normalizes and aligns hemispheres).
+fn rotation_track(rng: &mut Rng, t: &[f64], s: &TrackSettings) -> RotationTrack {
+    rotation_track_with(rng, t, s, 1.5)
+}
+
+fn rotation_track_with(
+    rng: &mut Rng,
+    t: &[f64],
+    s: &TrackSettings,
+    max_turn: f64,
+) -> RotationTrack {
+    let n = t.len();
+    let base = Quat::from_xyzw(
+        rng.f(-1.0, 1.0) as f32,
+        rng.f(-1.0, 1.0) as f32,
+        rng.f(-1.0, 1.0) as f32,
+        1.0,
+    )
+    .normalize();
+    let mut walk = base;
+    let mut q: Vec<Quat> = (0..n)
+        .map(|_| {
+            let axis = Vec3::new(
+                rng.f(-1.0, 1.0) as f32,
+                rng.f(-1.0, 1.0) as f32,
+                rng.f(-1.0, 1.0) as f32,
+            );
+            let axis = axis.try_normalize().unwrap_or(Vec3::Z);
+            walk = if s.ends == Ends::Cyclic {
+                // Keys around a base, so that the closing chord is no longer than the others.
+                (base * Quat::from_axis_angle(axis, rng.f(0.0, max_turn / 2.0) as f32)).normalize()
+            } else {
+                (walk * Quat::from_axis_angle(axis, rng.f(0.0, max_turn) as f32)).normalize()
+            };
+            let scale = rng.f(0.5, 2.0) as f32 * if rng.chance(0.3) { -1.0 } else { 1.0 };
+            walk * scale
+        })
+        .collect();
+    if s.ends == Ends::Cyclic {
+        q[n - 1] = if rng.chance(0.5) { q[0] } else { -q[0] };
+    }
+    let explicit = s.rotation == RotationMode::Hermite;
+    let rnd = |rng: &mut Rng| {
+        Quat::from_xyzw(
+            rng.f(-1.0, 1.0) as f32,
+            rng.f(-1.0, 1.0) as f32,
+            rng.f(-1.0, 1.0) as f32,
+            rng.f(-1.0, 1.0) as f32,
+        )
+    };
+    let keys = key_params(rng, n, rnd, explicit);
+    RotationTrack::new(t.to_vec(), q, keys, s).expect("valid random rotation")
+}
+
+/// A clip with `channels` scalar channels on one grid (in tracks of mixed
+/// kinds) plus rotations and a few tracks on grids of their own.
+fn random_clip(seed: u64, channels: usize) -> tcb_core::Clip {
+    let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let n = 3 + rng.below(6);
+    let shared = times(&mut rng, n);
+    let s = {
+        let mut s = settings(&mut rng, false);
+        if s.ends == Ends::Cyclic && n < 3 {
+            s.ends = Ends::Copy;
+        }
+        s
+    };
+    let mut tracks = Vec::new();
+    let mut left = channels;
+    while left > 0 {
+        let data = match (left.min(4), rng.below(4)) {
+            (1, _) | (_, 0) => TrackData::Scalar(vector_track(&mut rng, &shared, &s)),
+            (2, _) | (_, 1) => TrackData::Vec2(vector_track::<Vec2>(&mut rng, &shared, &s)),
+            (3, _) | (_, 2) => TrackData::Vec3(vector_track::<Vec3>(&mut rng, &shared, &s)),
+            _ => TrackData::Vec4(vector_track::<Vec4>(&mut rng, &shared, &s)),
+        };
+        left -= data.kind().dim();
+        tracks.push(data);
+    }
+    // Rotations on the shared grid (one settings each: squad or hermite).
+    for _ in 0..rng.below(12) {
+        let mut rs = settings(&mut rng, true);
+        rs.pre = s.pre.min_rotation();
+        rs.post = s.post.min_rotation();
+        tracks.push(TrackData::Quat(rotation_track(&mut rng, &shared, &rs)));
+    }
+    // Tracks on grids of their own.
+    for _ in 0..rng.below(4) {
+        let m = 2 + rng.below(5);
+        let own = times(&mut rng, m);
+        let mut os = settings(&mut rng, false);
+        if m < 3 {
+            os.ends = Ends::Copy;
+        }
+        tracks.push(TrackData::Vec3(vector_track::<Vec3>(&mut rng, &own, &os)));
+        let mut rs = settings(&mut rng, true);
+        if m < 3 {
+            rs.ends = Ends::Zero;
+        }
+        tracks.push(TrackData::Quat(rotation_track(&mut rng, &own, &rs)));
+    }
+    tcb_core::Clip {
+        name: format!("random-{seed}"),
+        tracks: tracks
+            .into_iter()
+            .enumerate()
+            .map(|(i, data)| NamedTrack {
+                name: format!("t{i}"),
+                data,
+            })
+            .collect(),
+    }
+}
+
+trait RotationSafe {
+    fn min_rotation(self) -> Self;
+}
+
+impl RotationSafe for Extrapolation {
+    /// The same mode where rotations allow it, else `constant`.
+    fn min_rotation(self) -> Self {
+        match self {
+            Extrapolation::Linear | Extrapolation::OffsetRepeat => Extrapolation::Constant,
+            m => m,
+        }
+    }
+}
+
+fn sample_times(rng: &mut Rng, clip: &tcb_core::Clip) -> Vec<f64> {
+    let (a, b) = clip.time_range().unwrap();
+    let mut t: Vec<f64> = clip.key_times();
+    for _ in 0..40 {
+        t.push(rng.f(a - 3.0, b + 3.0));
+    }
+    t.extend([
+        a - 100.0,
+        b + 1e6 + 0.3,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ]);
+    t
+}
+
+/// Compare rows: vectors to 1e-6 relative (absolute below 1), rotations up
+/// to sign; velocities to 1e-4 (squad velocities come from the reference).
+fn assert_rows_match(
+    clip: &tcb_core::Clip,
+    time: f64,
+    got: (&[f32], &[f32]),
+    want: (&[f32], &[f32]),
+) {
+    let mut at = 0;
+    for t in &clip.tracks {
+        let dim = t.data.kind().dim();
+        let (g, w) = (&got.0[at..at + dim], &want.0[at..at + dim]);
+        let (gv, wv) = (&got.1[at..at + dim], &want.1[at..at + dim]);
+        let sign = if matches!(t.data, TrackData::Quat(_))
+            && g.iter().zip(w).map(|(a, b)| a * b).sum::<f32>() < 0.0
+        {
+            -1.0
+        } else {
+            1.0
+        };
+        for c in 0..dim {
+            let tol = 1e-6 * w[c].abs().max(1.0);
+            assert!(
+                (g[c] - sign * w[c]).abs() <= tol,
+                "{} t={time} component {c}: runtime {} reference {} ({})",
+                t.name,
+                g[c],
+                sign * w[c],
+                describe(&t.data, time)
+            );
+            let vtol = 1e-4 * wv[c].abs().max(1.0);
+            assert!(
+                (gv[c] - sign * wv[c]).abs() <= vtol,
+                "{} t={time} velocity {c}: runtime {} reference {}",
+                t.name,
+                gv[c],
+                sign * wv[c]
+            );
+        }
+        at += dim;
+    }
+}
+
+fn describe(data: &TrackData, time: f64) -> String {
+    match data {
+        TrackData::Quat(r) => {
+            let (k, u) = tcb_core::track::locate(r.times(), time);
+            format!(
+                "{:?} {:?} segment {k} u {u} interp {:?} ease {:?}",
+                r.settings().rotation,
+                r.settings().ends,
+                r.interps()[k],
+                r.eases()[k]
+            )
+        }
+        other => format!("{:?}", other.kind()),
+    }
+}
+
+fn check_clip(clip: &tcb_core::Clip, seed: u64) {
+    let compiled = Arc::new(Clip::compile(clip));
+    let mut inst = Instance::new(compiled, true);
+    let n = clip.channel_count();
+    let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
+    let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
+    let mut rng = Rng(seed | 1);
+    for time in sample_times(&mut rng, clip) {
+        inst.sample(time).write_row(&mut got, Some(&mut got_v));
+        clip.sample_into(time, &mut want, Some(&mut want_v));
+        assert_rows_match(clip, time, (&got, &got_v), (&want, &want_v));
+    }
+}
+
+#[test]
+fn edge_channel_counts() {
+    for channels in [0, 1, 7, 8, 9, 63, 64, 65] {
+        for seed in 0..12 {
+            let clip = random_clip(seed * 1000 + channels as u64, channels);
+            if clip.tracks.is_empty() {
+                continue;
+            }
+            check_clip(&clip, seed);
+        }
+    }
+}
+
+/// Keys up to 180 degrees apart with extreme TCB: squad's inner slerp can
+/// join nearly opposite quaternions, where slerp is ill-conditioned and f32
+/// inputs limit the runtime to about 1e-4 of the f64 reference. Bounded here
+/// so that it cannot get worse unnoticed.
+#[test]
+fn wild_rotations_stay_within_1e_4() {
+    let mut worst = 0.0f32;
+    for seed in 0..300u64 {
+        let mut rng = Rng(seed * 7919 + 1);
+        let t = times(&mut rng, 6);
+        let s = TrackSettings {
+            rotation: RotationMode::Squad,
+            ..settings(&mut rng, true)
+        };
+        let s = TrackSettings {
+            ends: if s.ends == Ends::Natural {
+                Ends::Zero
+            } else {
+                s.ends
+            },
+            pre: s.pre.min_rotation(),
+            post: s.post.min_rotation(),
+            ..s
+        };
+        let track = rotation_track_with(&mut rng, &t, &s, std::f64::consts::PI);
+        let clip = tcb_core::Clip {
+            name: "wild".into(),
+            tracks: vec![NamedTrack {
+                name: "q".into(),
+                data: TrackData::Quat(track),
+            }],
+        };
+        let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+        let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
+        for i in 0..200 {
+            let time = t[0] - 1.0 + (t[5] - t[0] + 2.0) * i as f64 / 200.0;
+            inst.sample(time).write_row(&mut got, None);
+            clip.sample_into(time, &mut want, None);
+            let d = (0..4).map(|c| (got[c] - want[c]).abs()).fold(0.0, f32::max);
+            let e = (0..4).map(|c| (got[c] + want[c]).abs()).fold(0.0, f32::max);
+            worst = worst.max(d.min(e));
+        }
+    }
+    assert!(worst < 1e-4, "worst difference {worst}");
+}
+
+#[test]
+fn bundled_clips() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    for dir in ["examples/clips", "tools/check/clips"] {
+        for entry in std::fs::read_dir(format!("{root}/{dir}")).unwrap() {
+            let path = entry.unwrap().path();
+            let clip = tcb_io::load_clip(&path).unwrap();
+            check_clip(&clip, 7);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn runtime_equals_reference(seed in any::<u64>(), channels in 0..80usize) {
+        let clip = random_clip(seed, channels);
+        prop_assume!(!clip.tracks.is_empty());
+        check_clip(&clip, seed);
+    }
+
+    #[test]
+    fn forward_playback_equals_random_access(seed in any::<u64>(), channels in 1..40usize, fps in 10.0..240.0f64) {
+        let clip = random_clip(seed, channels);
+        let compiled = Arc::new(Clip::compile(&clip));
+        let (a, b) = clip.time_range().unwrap();
+        let mut playing = Instance::new(compiled.clone(), true);
+        let frames = ((b - a + 2.0) * fps) as usize;
+        for f in 0..frames.min(2000) {
+            let t = a - 1.0 + f as f64 / fps;
+            let mut fresh = Instance::new(compiled.clone(), true);
+            let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
+            prop_assert_eq!(p.as_slice(), q.as_slice());
+        }
+    }
+}
+
+#[cfg(feature = "rayon")]
+#[test]
+fn batch_equals_sequential() {
+    let clip = Arc::new(Clip::compile(&random_clip(42, 65)));
+    let make = || {
+        (0..257)
+            .map(|_| Instance::new(clip.clone(), true))
+            .collect::<Vec<_>>()
+    };
+    let (mut par, mut seq) = (make(), make());
+    let mut rng = Rng(99);
+    for _ in 0..5 {
+        let times: Vec<f64> = (0..257).map(|_| rng.f(-5.0, 20.0)).collect();
+        tcb_runtime::batch::sample_all(&mut par, &times);
+        tcb_runtime::batch::sample_all_sequential(&mut seq, &times);
+        for (p, s) in par.iter().zip(&seq) {
+            assert_eq!(p.pose().as_slice(), s.pose().as_slice());
+        }
+    }
+}
