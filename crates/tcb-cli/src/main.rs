@@ -9,6 +9,8 @@
 //! CSV goes to stdout; errors go to stderr as one line, with a non-zero exit
 //! status and nothing on stdout.
 
+#![forbid(unsafe_code)]
+
 use clap::{Args, Parser, Subcommand};
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -56,7 +58,7 @@ struct SampleArgs {
     /// Every key time of the clip and N evenly spaced times inside each interval.
     #[arg(long, value_name = "N")]
     inbetweens: Option<u32>,
-    /// Use the scalar reference implementation.
+    /// Use the scalar reference implementation (tcb-core) instead of the SIMD runtime.
     #[arg(long)]
     scalar: bool,
     /// Add d/dt columns named `<column>.d` after the value columns.
@@ -92,7 +94,17 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
     // Everything that can fail has been checked: from here on only writing can.
     let stdout = io::stdout().lock();
     let mut out = io::BufWriter::with_capacity(1 << 16, stdout);
-    write_csv(&mut out, &clip, &times, args.velocity)?;
+    if args.scalar {
+        write_csv(&mut out, &clip, &times, args.velocity, |t, v, d| {
+            clip.sample_into(t, v, d)
+        })?;
+    } else {
+        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile(&clip));
+        let mut instance = tcb_runtime::Instance::new(runtime, args.velocity);
+        write_csv(&mut out, &clip, &times, args.velocity, |t, v, d| {
+            instance.sample(t).write_row(v, d)
+        })?;
+    }
     out.flush()?;
     Ok(())
 }
@@ -140,7 +152,14 @@ fn sample_times(args: &SampleArgs, clip: &Clip) -> Result<Vec<f64>, BoxError> {
     Ok(inbetweens(&keys, n as usize))
 }
 
-fn write_csv(out: &mut impl Write, clip: &Clip, times: &[f64], velocity: bool) -> io::Result<()> {
+/// Write the CSV, sampling each time with `sample(time, values, velocities)`.
+fn write_csv(
+    out: &mut impl Write,
+    clip: &Clip,
+    times: &[f64],
+    velocity: bool,
+    mut sample: impl FnMut(f64, &mut [f32], Option<&mut [f32]>),
+) -> io::Result<()> {
     let names = clip.column_names();
     let mut header = String::from("time");
     for n in &names {
@@ -159,7 +178,7 @@ fn write_csv(out: &mut impl Write, clip: &Clip, times: &[f64], velocity: bool) -
     let mut values = vec![0.0f32; channels];
     let mut velocities = vec![0.0f32; channels];
     for &t in times {
-        clip.sample_into(t, &mut values, velocity.then_some(&mut velocities[..]));
+        sample(t, &mut values, velocity.then_some(&mut velocities[..]));
         write!(out, "{t}")?;
         for v in &values {
             write!(out, ",{v}")?;

@@ -152,9 +152,33 @@ fn negative_huge_and_non_finite_times_work_as_written() {
 
 #[test]
 fn scalar_flag_gives_the_same_numbers() {
-    let a = tcb(&["sample", &example("careen.json"), "--fps", "30"]);
-    let b = tcb(&["sample", &example("careen.json"), "--fps", "30", "--scalar"]);
+    // Vector channels are bit-identical between the runtime and the reference.
+    let a = tcb(&[
+        "sample",
+        &example("careen.json"),
+        "--fps",
+        "30",
+        "--velocity",
+    ]);
+    let b = tcb(&[
+        "sample",
+        &example("careen.json"),
+        "--fps",
+        "30",
+        "--velocity",
+        "--scalar",
+    ]);
+    assert!(a.status.success() && b.status.success());
     assert_eq!(stdout(&a), stdout(&b));
+    // Rotations agree to ~1e-6.
+    let a = tcb(&["sample", &example("spin.json"), "--fps", "30"]);
+    let b = tcb(&["sample", &example("spin.json"), "--fps", "30", "--scalar"]);
+    for (la, lb) in stdout(&a).lines().zip(stdout(&b).lines()).skip(1) {
+        for (x, y) in la.split(',').zip(lb.split(',')) {
+            let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+            assert!((x - y).abs() <= 1e-6, "{la}\n{lb}");
+        }
+    }
 }
 
 #[test]

@@ -44,6 +44,8 @@
 //! }
 //! ```
 
+#![forbid(unsafe_code)]
+
 pub mod basis;
 pub mod clip;
 pub mod ease;

@@ -22,6 +22,8 @@
 //! # Ok::<(), tcb_io::Error>(())
 //! ```
 
+#![forbid(unsafe_code)]
+
 pub mod clip;
 pub mod error;
 

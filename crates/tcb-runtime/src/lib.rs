@@ -32,6 +32,8 @@
 //! How it works: see [`clip`] (the layout), [`grid`] (the per-frame basis
 //! and the sentinels that keep the kernels free of per-channel branches).
 
+#![forbid(unsafe_code)]
+
 pub mod blend;
 pub mod clip;
 pub mod grid;

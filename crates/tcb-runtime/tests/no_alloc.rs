@@ -1,0 +1,77 @@
+#![allow(unsafe_code)] // a counting global allocator is unsafe by nature; test-only
+//! Steady playback allocates nothing: sampling, velocities, the reference
+//! fallbacks and blending, counted by a global allocator.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steady_playback_and_blending_allocate_nothing() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    // Every layout: vectors, hermite and squad rotations, a mixed hermite
+    // rotation sampled by the reference, offset-repeat, several groups.
+    let mut clips = Vec::new();
+    for name in [
+        "examples/clips/bounce.json",
+        "tools/check/clips/rotations.json",
+        "tools/check/clips/extrapolation.json",
+        "examples/clips/spin.json",
+    ] {
+        let clip = tcb_io::load_clip(format!("{root}/{name}").as_ref()).unwrap();
+        clips.push(Arc::new(tcb_runtime::Clip::compile(&clip)));
+    }
+    for clip in clips {
+        let mut a = tcb_runtime::Instance::new(clip.clone(), true);
+        let mut b = tcb_runtime::Instance::new(clip.clone(), true);
+        let mut out = a.pose().clone();
+        let mask = tcb_runtime::BlendMask::new(&clip, |t| if t.0 % 2 == 0 { 1.0 } else { 0.25 });
+        // Warm up once.
+        a.sample(0.0);
+        b.sample(0.0);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for frame in 0..2000 {
+            let t = -3.0 + frame as f64 / 120.0;
+            a.sample(t);
+            b.sample(t * 0.5 + 1e6);
+            tcb_runtime::blend(&mut out, &[(a.pose(), 0.7), (b.pose(), 0.3)], None);
+            tcb_runtime::blend(
+                &mut out,
+                &[(a.pose(), 1.0), (b.pose(), 1.0)],
+                Some(&[&mask, &mask]),
+            );
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert_eq!(
+            after - before,
+            0,
+            "{} allocations in 2000 frames of {}",
+            after - before,
+            clip.name()
+        );
+    }
+}
