@@ -1,0 +1,131 @@
+//! The sampling kernel on synthetic clips, against the tcb-core reference
+//! in the same process. The full comparison on real data is tcb-bench's.
+//!
+//! `cargo bench -p tcb-runtime --bench kernel` (add
+//! `RUSTFLAGS="-C target-cpu=native"` for AVX2/FMA builds of `wide`).
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::{Quat, Vec3};
+use std::hint::black_box;
+use std::sync::Arc;
+use tcb_core::{NamedTrack, RotationMode, RotationTrack, Track, TrackData, TrackSettings};
+use tcb_runtime::{Clip, Instance};
+
+fn times(n: usize, seed: u64) -> Vec<f64> {
+    let mut x = seed;
+    let mut t = vec![0.0];
+    for _ in 1..n {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let gap = 0.05 + (x >> 40) as f64 / (1u64 << 24) as f64 * 0.2;
+        t.push(t[t.len() - 1] + gap);
+    }
+    t
+}
+
+fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::Clip {
+    let s = TrackSettings::default();
+    let tracks = (0..count)
+        .map(|i| {
+            let t = times(keys, if shared { 1 } else { i as u64 + 1 });
+            let v = (0..keys).map(|k| ((k * 7 + i) % 13) as f32 * 0.1).collect();
+            NamedTrack {
+                name: format!("c{i}"),
+                data: TrackData::Scalar(Track::new(t, v, vec![], &s).unwrap()),
+            }
+        })
+        .collect();
+    tcb_core::Clip {
+        name: "synthetic".into(),
+        tracks,
+    }
+}
+
+fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
+    let s = TrackSettings {
+        rotation: mode,
+        ..Default::default()
+    };
+    let t = times(keys, 1);
+    let mut tracks = vec![NamedTrack {
+        name: "root.translation".into(),
+        data: TrackData::Vec3(
+            Track::new(
+                t.clone(),
+                (0..keys)
+                    .map(|k| Vec3::new(k as f32 * 0.1, 1.0, 0.0))
+                    .collect(),
+                vec![],
+                &s,
+            )
+            .unwrap(),
+        ),
+    }];
+    for j in 0..joints {
+        let q = (0..keys)
+            .map(|k| {
+                Quat::from_euler(
+                    glam::EulerRot::ZXY,
+                    (k + j) as f32 * 0.05,
+                    k as f32 * 0.03,
+                    0.2,
+                )
+            })
+            .collect();
+        tracks.push(NamedTrack {
+            name: format!("j{j}.rotation"),
+            data: TrackData::Quat(RotationTrack::new(t.clone(), q, vec![], &s).unwrap()),
+        });
+    }
+    tcb_core::Clip {
+        name: "skeleton".into(),
+        tracks,
+    }
+}
+
+fn play(c: &mut Criterion, group: &str, clip: &tcb_core::Clip, channels: u64) {
+    let compiled = Arc::new(Clip::compile(clip));
+    let (a, b) = clip.time_range().unwrap();
+    let mut g = c.benchmark_group(group);
+    g.throughput(Throughput::Elements(channels));
+    let mut inst = Instance::new(compiled, false);
+    let mut frame = 0u64;
+    g.bench_function(BenchmarkId::new("runtime", channels), |bench| {
+        bench.iter(|| {
+            frame += 1;
+            let t = a + (frame as f64 / 60.0) % (b - a);
+            black_box(inst.sample(black_box(t)));
+        })
+    });
+    let mut row = vec![0.0f32; clip.channel_count()];
+    g.bench_function(BenchmarkId::new("reference", channels), |bench| {
+        bench.iter(|| {
+            frame += 1;
+            let t = a + (frame as f64 / 60.0) % (b - a);
+            clip.sample_into(black_box(t), &mut row, None);
+            black_box(&row);
+        })
+    });
+    g.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    play(c, "wide", &scalar_tracks(10_000, 64, true), 10_000);
+    play(c, "sparse", &scalar_tracks(500, 64, false), 500);
+    play(
+        c,
+        "skeleton_hermite",
+        &skeleton(31, 200, RotationMode::Hermite),
+        31,
+    );
+    play(
+        c,
+        "skeleton_squad",
+        &skeleton(31, 200, RotationMode::Squad),
+        31,
+    );
+}
+
+criterion_group!(kernel, benches);
+criterion_main!(kernel);
