@@ -23,13 +23,8 @@ struct Golden {
 
 fn read_golden(path: &Path) -> Golden {
     let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let clip = lines
-        .next()
-        .unwrap()
-        .strip_prefix("# clip: ")
-        .unwrap()
-        .to_owned();
+    let first = text.lines().next().unwrap();
+    let clip = first.strip_prefix("# clip: ").unwrap().to_owned();
     let quats = text
         .lines()
         .find_map(|l| l.strip_prefix("# quat columns:"))
@@ -37,16 +32,7 @@ fn read_golden(path: &Path) -> Golden {
         .split_whitespace()
         .map(|x| x.parse().unwrap())
         .collect();
-    let mut lines = lines.filter(|l| !l.starts_with('#'));
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
+    let (header, rows) = parse_csv(&text);
     Golden {
         clip,
         quats,
@@ -70,8 +56,12 @@ fn sample(clip: &str, times: &[f64], scalar: bool) -> (Vec<String>, Vec<Vec<f64>
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8(out.stdout).unwrap();
-    let mut lines = text.lines();
+    parse_csv(&String::from_utf8(out.stdout).unwrap())
+}
+
+/// Header and numeric rows of a CSV, skipping `#` comment lines.
+fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header = lines
         .next()
         .unwrap()

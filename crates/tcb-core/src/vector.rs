@@ -113,43 +113,32 @@ glam_vector!(Vec2, 2, [0, 1]);
 glam_vector!(Vec3, 3, [0, 1, 2]);
 glam_vector!(Vec4, 4, [0, 1, 2, 3]);
 
-impl Vector for f64 {
-    const ZERO: Self = 0.0;
-    fn add(self, o: Self) -> Self {
-        self + o
-    }
-    fn sub(self, o: Self) -> Self {
-        self - o
-    }
-    fn scale(self, f: f64) -> Self {
-        self * f
-    }
-    fn norm(self) -> f64 {
-        self.abs()
-    }
-    fn is_finite(self) -> bool {
-        f64::is_finite(self)
-    }
+/// f64 vectors (rotation log-space chords, and scalars in tests): no rounding.
+macro_rules! f64_vector {
+    ($t:ty, $zero:expr, $norm:expr, $finite:expr) => {
+        impl Vector for $t {
+            const ZERO: Self = $zero;
+            fn add(self, o: Self) -> Self {
+                self + o
+            }
+            fn sub(self, o: Self) -> Self {
+                self - o
+            }
+            fn scale(self, f: f64) -> Self {
+                self * f
+            }
+            fn norm(self) -> f64 {
+                ($norm)(self)
+            }
+            fn is_finite(self) -> bool {
+                ($finite)(self)
+            }
+        }
+    };
 }
 
-impl Vector for DVec3 {
-    const ZERO: Self = DVec3::ZERO;
-    fn add(self, o: Self) -> Self {
-        self + o
-    }
-    fn sub(self, o: Self) -> Self {
-        self - o
-    }
-    fn scale(self, f: f64) -> Self {
-        self * f
-    }
-    fn norm(self) -> f64 {
-        self.length()
-    }
-    fn is_finite(self) -> bool {
-        DVec3::is_finite(self)
-    }
-}
+f64_vector!(f64, 0.0, f64::abs, f64::is_finite);
+f64_vector!(DVec3, DVec3::ZERO, DVec3::length, DVec3::is_finite);
 
 #[cfg(test)]
 mod tests {

@@ -95,23 +95,22 @@ impl Pose {
     /// Every track's components in file order (the CSV columns of
     /// `tcb sample`), and velocities after them if `velocities` is given.
     pub fn write_row(&self, values: &mut [f32], velocities: Option<&mut [f32]>) {
-        let flat: &[f32] = bytemuck::cast_slice(&self.values);
-        let mut at = 0;
-        for s in self.layout.slots.iter() {
-            for &i in &s.index[..s.kind.dim()] {
-                values[at] = flat[i];
-                at += 1;
-            }
-        }
+        self.gather(&self.values, values);
         if let (Some(out), Some(v)) = (velocities, &self.velocities) {
-            let flat: &[f32] = bytemuck::cast_slice(v);
-            let mut at = 0;
-            for s in self.layout.slots.iter() {
-                for &i in &s.index[..s.kind.dim()] {
-                    out[at] = flat[i];
-                    at += 1;
-                }
-            }
+            self.gather(v, out);
+        }
+    }
+
+    /// Every track's components of `data`, in file order, into `out`.
+    fn gather(&self, data: &[f32x8], out: &mut [f32]) {
+        let flat: &[f32] = bytemuck::cast_slice(data);
+        let indices = self
+            .layout
+            .slots
+            .iter()
+            .flat_map(|s| &s.index[..s.kind.dim()]);
+        for (o, &i) in out.iter_mut().zip(indices) {
+            *o = flat[i];
         }
     }
 
