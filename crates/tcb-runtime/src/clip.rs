@@ -20,6 +20,7 @@
 
 use crate::grid::TimeGrid;
 use crate::kernel::{HQ_STRIDE, SQ_STRIDE, VEC_STRIDE};
+use crate::loose::{Loose, LooseLane};
 use crate::pose::PoseLayout;
 use glam::DQuat;
 use std::collections::HashMap;
@@ -75,6 +76,8 @@ pub struct Clip {
     pub(crate) name: String,
     pub(crate) groups: Vec<Group>,
     pub(crate) layout: Arc<PoseLayout>,
+    /// Vector tracks of small groups, one lane each.
+    pub(crate) loose: Loose,
     /// Tracks the scalar reference samples (value and velocity).
     pub(crate) reference: Vec<TrackId>,
     /// Squad tracks, whose velocity the scalar reference gives.
@@ -308,6 +311,37 @@ impl Clip {
             }
         }
 
+        // Small groups of vector channels only: one lane per track (see loose.rs).
+        let mut loose_lanes: Vec<(usize, LooseLane)> = Vec::new();
+        let mut keep = vec![true; grids.len()];
+        for g in 0..grids.len() {
+            if hq_rows[g].is_empty() && sq_rows[g].is_empty() && vec_rows[g].len() < 8 {
+                keep[g] = false;
+                let mut by_track: Vec<(usize, Vec<&Controls>)> = Vec::new();
+                for (track, _, rows) in &vec_rows[g] {
+                    match by_track.last_mut() {
+                        Some((t, comps)) if t == track => comps.push(rows),
+                        _ => by_track.push((*track, vec![rows])),
+                    }
+                }
+                for (track, comps) in by_track {
+                    let controls = (0..comps[0].len())
+                        .map(|seg| {
+                            std::array::from_fn(|c| comps.get(c).map_or([0.0; 4], |r| r[seg]))
+                        })
+                        .collect();
+                    loose_lanes.push((
+                        track,
+                        LooseLane {
+                            grid: grids[g].clone(),
+                            dim: comps.len(),
+                            controls,
+                        },
+                    ));
+                }
+            }
+        }
+
         let mut slots: Vec<TrackSlot> = source
             .tracks
             .iter()
@@ -321,6 +355,9 @@ impl Clip {
         let mut quat_blocks = Vec::new();
         let mut at = 0usize; // pose block
         for (g, grid) in grids.into_iter().enumerate() {
+            if !keep[g] {
+                continue;
+            }
             let segments = grid.times.len() + 1;
             let vrows: Vec<Controls> = vec_rows[g].iter().map(|r| r.2.clone()).collect();
             let vec_blocks = vrows.len().div_ceil(8);
@@ -374,6 +411,13 @@ impl Clip {
                 grid,
             });
         }
+        // Loose tracks: planes of 8 lanes, like rotations.
+        for (lane, (track, _)) in loose_lanes.iter().enumerate() {
+            let base = (at + 4 * (lane / 8)) * 8 + lane % 8;
+            slots[*track].index = [base, base + 8, base + 16, base + 24];
+        }
+        let loose = Loose::new(loose_lanes.into_iter().map(|(_, l)| l).collect(), at);
+        at += 4 * loose.blocks;
         // Reference-sampled rotations: four consecutive floats each.
         let mut loose_quats = Vec::new();
         if !reference.is_empty() {
@@ -393,6 +437,7 @@ impl Clip {
                 quat_blocks,
                 loose_quats,
             }),
+            loose,
             reference,
             squad_velocity,
             source: source.clone(),
@@ -423,9 +468,15 @@ impl Clip {
         &self.layout
     }
 
-    /// Number of time grids (groups of channels sharing a basis per frame).
+    /// Number of time grids whose channels share one basis per frame.
     pub fn group_count(&self) -> usize {
         self.groups.len()
+    }
+
+    /// Number of tracks sampled as loose lanes (their own time grid, mapped
+    /// eight tracks at a time).
+    pub fn loose_track_count(&self) -> usize {
+        self.loose.lanes.len()
     }
 
     /// The validated clip this was compiled from.

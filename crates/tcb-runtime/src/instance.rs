@@ -3,6 +3,7 @@
 use crate::clip::{Clip, TrackId};
 use crate::grid::Cursor;
 use crate::kernel;
+use crate::loose::LooseState;
 use crate::pose::Pose;
 use std::sync::Arc;
 use tcb_core::TrackData;
@@ -14,6 +15,7 @@ use wide::f32x8;
 pub struct Instance {
     clip: Arc<Clip>,
     cursors: Vec<Cursor>,
+    loose: LooseState,
     pose: Pose,
 }
 
@@ -22,6 +24,7 @@ impl Instance {
     pub fn new(clip: Arc<Clip>, velocities: bool) -> Self {
         Instance {
             cursors: vec![Cursor::default(); clip.groups.len()],
+            loose: LooseState::new(&clip.loose),
             pose: Pose::new(&clip, velocities),
             clip,
         }
@@ -39,13 +42,25 @@ impl Instance {
 
     /// Sample every track at `time` (seconds; any f64) into the pose.
     pub fn sample(&mut self, time: f64) -> &Pose {
-        sample_into(&self.clip, time, &mut self.cursors, &mut self.pose);
+        sample_into(
+            &self.clip,
+            time,
+            &mut self.cursors,
+            &mut self.loose,
+            &mut self.pose,
+        );
         &self.pose
     }
 }
 
 /// Sample `clip` at `time` into `pose`, with one cursor per group.
-pub(crate) fn sample_into(clip: &Clip, time: f64, cursors: &mut [Cursor], pose: &mut Pose) {
+pub(crate) fn sample_into(
+    clip: &Clip,
+    time: f64,
+    cursors: &mut [Cursor],
+    loose: &mut LooseState,
+    pose: &mut Pose,
+) {
     let Pose {
         values, velocities, ..
     } = pose;
@@ -99,6 +114,9 @@ pub(crate) fn sample_into(clip: &Clip, time: f64, cursors: &mut [Cursor], pose: 
                 kernel::squad_quats(&g.sq[seg * n..(seg + 1) * n], f32x8::splat(f.s), out);
             }
         }
+    }
+    if clip.loose.blocks > 0 {
+        crate::loose::sample(&clip.loose, loose, time, values, velocities.as_deref_mut());
     }
     let want_velocity = pose.velocities.is_some();
     for &id in &clip.reference {

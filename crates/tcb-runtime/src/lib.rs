@@ -39,6 +39,7 @@ pub mod clip;
 pub mod grid;
 mod instance;
 mod kernel;
+mod loose;
 pub mod pose;
 
 #[cfg(feature = "rayon")]

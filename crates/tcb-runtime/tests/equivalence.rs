@@ -390,6 +390,42 @@ fn wild_rotations_stay_within_1e_4() {
     assert!(worst < 1e-4, "worst difference {worst}");
 }
 
+/// Tracks that each have their own key times (as DCC tools export them) are
+/// sampled as loose lanes, eight at a time; every mode, ease and shape.
+#[test]
+fn tracks_on_their_own_grids() {
+    for seed in 0..40u64 {
+        let mut rng = Rng(seed * 31 + 5);
+        let mut tracks = Vec::new();
+        for i in 0..(1 + rng.below(30)) {
+            let n = 2 + rng.below(8);
+            let t = times(&mut rng, n);
+            let mut s = settings(&mut rng, false);
+            if n < 3 && s.ends == Ends::Cyclic {
+                s.ends = Ends::Copy;
+            }
+            let data = match i % 4 {
+                0 => TrackData::Scalar(vector_track(&mut rng, &t, &s)),
+                1 => TrackData::Vec2(vector_track::<Vec2>(&mut rng, &t, &s)),
+                2 => TrackData::Vec3(vector_track::<Vec3>(&mut rng, &t, &s)),
+                _ => TrackData::Vec4(vector_track::<Vec4>(&mut rng, &t, &s)),
+            };
+            tracks.push(NamedTrack {
+                name: format!("own{i}"),
+                data,
+            });
+        }
+        let clip = tcb_core::Clip {
+            name: "own".into(),
+            tracks,
+        };
+        let compiled = Clip::compile(&clip);
+        assert_eq!(compiled.loose_track_count(), clip.tracks.len());
+        assert_eq!(compiled.group_count(), 0);
+        check_clip(&clip, seed);
+    }
+}
+
 #[test]
 fn bundled_clips() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");

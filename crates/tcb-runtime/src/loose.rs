@@ -1,0 +1,470 @@
+//! Tracks on key grids of their own ("loose" tracks), eight at a time.
+//!
+//! A group of a few channels cannot share its per-frame basis with anyone,
+//! and computing a [`FrameBasis`](crate::grid::FrameBasis) per group costs
+//! more than evaluating its channels. So vector tracks of small groups are
+//! packed one track per lane, eight per block, components as x/y/z/w planes,
+//! and everything per frame is done across lanes:
+//!
+//! 1. `map_time` for eight grids at once in `f64x4` (pre/post per lane,
+//!    wrap in f64, selects instead of branches);
+//! 2. each lane keeps a window `[ws, we)` of the stored segment it last
+//!    used and that segment's controls (in the [`crate::Instance`], so they
+//!    stay contiguous and cached, as ozz-animation does); a lane whose mapped
+//!    time left its window is refreshed, scalar, only when it crosses a key;
+//! 3. `u`, ease, and the Hermite rows per lane, then the same
+//!    [`tcb_core::basis::hermite`] on `f32x8` as every other kernel.
+//!
+//! The stored segments and sentinel rows are those of [`crate::grid`].
+//! Non-finite times take the scalar [`TimeGrid::frame`] per lane.
+
+use crate::grid::{Cursor, FrameBasis, TimeGrid};
+use tcb_core::Extrapolation;
+use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
+use wide::{f32x8, f64x4};
+
+/// Controls per block: 4 component planes x `[P0, P1, M0, M1]`.
+const CTL: usize = 16;
+
+/// Padding lanes: keys at -PAD_SPAN and +PAD_SPAN (finite, so u stays finite),
+/// zero controls.
+const PAD_SPAN: f64 = 1e300;
+
+fn mode_code(m: Extrapolation) -> f64 {
+    match m {
+        Extrapolation::Reset => 1.0,
+        Extrapolation::Repeat => 2.0,
+        Extrapolation::Oscillate => 3.0,
+        Extrapolation::OffsetRepeat => 4.0,
+        Extrapolation::Linear => 5.0,
+        _ => 0.0,
+    }
+}
+
+/// One loose track.
+#[derive(Clone, Debug)]
+pub(crate) struct LooseLane {
+    pub grid: TimeGrid,
+    /// Components used (1 to 4).
+    pub dim: usize,
+    /// Per stored segment `0..=n`, per component: `[P0, P1, M0, M1]`.
+    pub controls: Vec<[[f32; 4]; 4]>,
+}
+
+/// The loose tracks of a clip and their per-lane constants.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Loose {
+    pub lanes: Vec<LooseLane>,
+    pub blocks: usize,
+    /// First pose block (4 planes per block).
+    pub out: usize,
+    /// Per half block (4 lanes): first key, last key, span, pre and post codes.
+    t0: Vec<f64x4>,
+    tn: Vec<f64x4>,
+    len: Vec<f64x4>,
+    pre: Vec<f64x4>,
+    post: Vec<f64x4>,
+    /// `P_{n-1} - P_0` per block and component plane (offset-repeat).
+    delta: Vec<f32x8>,
+    /// Whether any lane of a block has an eased segment.
+    eased: Vec<bool>,
+    /// Component planes in use per block (the widest track's dimension).
+    dims: Vec<usize>,
+}
+
+impl Loose {
+    pub fn new(lanes: Vec<LooseLane>, out: usize) -> Self {
+        let blocks = lanes.len().div_ceil(8);
+        let lane = |i: usize| lanes.get(i);
+        let half = |f: &dyn Fn(&LooseLane) -> f64, pad: f64| -> Vec<f64x4> {
+            (0..2 * blocks)
+                .map(|h| f64x4::new(std::array::from_fn(|l| lane(4 * h + l).map_or(pad, f))))
+                .collect()
+        };
+        let t0 = half(&|l| l.grid.times[0], 0.0);
+        let tn = half(&|l| l.grid.times[l.grid.times.len() - 1], 1.0);
+        let len = half(
+            &|l| l.grid.times[l.grid.times.len() - 1] - l.grid.times[0],
+            1.0,
+        );
+        let pre = half(&|l| mode_code(l.grid.pre), 0.0);
+        let post = half(&|l| mode_code(l.grid.post), 0.0);
+        let mut delta = vec![f32x8::ZERO; 4 * blocks];
+        for b in 0..blocks {
+            for c in 0..4 {
+                delta[4 * b + c] = f32x8::new(std::array::from_fn(|l| {
+                    lane(8 * b + l).map_or(0.0, |x| {
+                        let n = x.controls.len();
+                        x.controls[n - 1][c][0] - x.controls[0][c][0]
+                    })
+                }));
+            }
+        }
+        let eased = (0..blocks)
+            .map(|b| {
+                (8 * b..8 * b + 8)
+                    .filter_map(lane)
+                    .any(|l| l.grid.eases.iter().any(|e| !e.is_none()))
+            })
+            .collect();
+        let dims = (0..blocks)
+            .map(|b| {
+                (8 * b..8 * b + 8)
+                    .filter_map(lane)
+                    .map(|l| l.dim)
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        Loose {
+            dims,
+            eased,
+            lanes,
+            blocks,
+            out,
+            t0,
+            tn,
+            len,
+            pre,
+            post,
+            delta,
+        }
+    }
+}
+
+/// Per-instance state of the loose tracks: each lane's window, ease and
+/// controls, written lane by lane only when a lane crosses a key and read
+/// four lanes at a time.
+#[derive(Clone, Debug)]
+pub(crate) struct LooseState {
+    ws: Vec<f64>,
+    we: Vec<f64>,
+    ease_from: Vec<f64>,
+    ease_to: Vec<f64>,
+    seg: Vec<usize>,
+    cursors: Vec<Cursor>,
+    ctl: Vec<f32x8>,
+}
+
+/// Lanes `4i .. 4i+4` of `v` as one vector.
+#[inline(always)]
+fn quad(v: &[f64], i: usize) -> f64x4 {
+    let q: [f64; 4] = v[4 * i..4 * i + 4].try_into().expect("4 lanes");
+    f64x4::new(q)
+}
+
+impl LooseState {
+    pub fn new(loose: &Loose) -> Self {
+        let lanes = loose.blocks * 8;
+        // Real lanes start with an empty window (refreshed on first use);
+        // padding lanes with one spanning all time and zero controls.
+        let real = loose.lanes.len();
+        let fill = |inside: f64, pad: f64| -> Vec<f64> {
+            (0..lanes)
+                .map(|l| if l < real { inside } else { pad })
+                .collect()
+        };
+        LooseState {
+            ws: fill(f64::INFINITY, -PAD_SPAN),
+            we: fill(f64::NEG_INFINITY, PAD_SPAN),
+            ease_from: vec![0.0; lanes],
+            ease_to: vec![0.0; lanes],
+            seg: vec![usize::MAX; lanes],
+            cursors: vec![Cursor::default(); lanes],
+            ctl: vec![f32x8::ZERO; loose.blocks * CTL],
+        }
+    }
+
+    /// Load stored segment `seg` of lane `l` into its window, ease and controls.
+    fn load(&mut self, loose: &Loose, l: usize, seg: usize) {
+        let lane = &loose.lanes[l];
+        let t = &lane.grid.times;
+        let n = t.len();
+        let (ws, we) = match seg {
+            0 => (f64::NEG_INFINITY, t[0]),
+            s if s == n => (t[n - 1], f64::INFINITY),
+            s => (t[s - 1], t[s]),
+        };
+        let ease = if (1..n).contains(&seg) {
+            lane.grid.eases[seg - 1]
+        } else {
+            Default::default()
+        };
+        self.ws[l] = ws;
+        self.we[l] = we;
+        self.ease_from[l] = ease.from;
+        self.ease_to[l] = ease.to;
+        self.seg[l] = seg;
+        let (b, i) = (l / 8, l % 8);
+        let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl[b * CTL..(b + 1) * CTL]);
+        let src = &lane.controls[seg];
+        for c in 0..4 {
+            for j in 0..4 {
+                ctl[(4 * c + j) * 8 + i] = src[c][j];
+            }
+        }
+    }
+
+    /// The stored segment for mapped time `tm` (within the keys, or the
+    /// sentinels beyond them); the one after `current` first, as forward
+    /// playback wants.
+    fn segment_for(lane: &LooseLane, current: usize, tm: f64) -> usize {
+        let t = &lane.grid.times;
+        let n = t.len();
+        let next = current.wrapping_add(1);
+        if (1..n - 1).contains(&next) && t[next - 1] <= tm && tm < t[next] {
+            return next;
+        }
+        if tm < t[0] {
+            0
+        } else if tm >= t[n - 1] {
+            n
+        } else {
+            t.partition_point(|&x| x <= tm).clamp(1, n - 1)
+        }
+    }
+}
+
+/// Rows of one block, per lane.
+struct Rows {
+    h: [f32x8; 4],
+    dh: [f32x8; 4],
+    rate: f32x8,
+    cycles: f32x8,
+    any_cycles: bool,
+}
+
+fn f32x8_of(a: f64x4, b: f64x4) -> f32x8 {
+    let (a, b) = (a.to_array(), b.to_array());
+    f32x8::new(std::array::from_fn(|i| {
+        if i < 4 { a[i] as f32 } else { b[i - 4] as f32 }
+    }))
+}
+
+fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
+    let bits = a.to_bitmask() | (b.to_bitmask() << 4);
+    f32x8::new(std::array::from_fn(|i| {
+        f32::from_bits(if bits >> i & 1 == 1 { u32::MAX } else { 0 })
+    }))
+}
+
+/// Refresh the lanes of half block `i` whose window does not hold `tm`
+/// (forward playback: a lane at a time, when it crosses a key).
+#[inline]
+fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
+    let ok = quad(&st.ws, i).simd_le(tm) & tm.simd_lt(quad(&st.we, i));
+    let mut stale = !ok.to_bitmask() & 0xf;
+    while stale != 0 {
+        let k = stale.trailing_zeros() as usize;
+        stale &= stale - 1;
+        let l = 4 * i + k;
+        if l < loose.lanes.len() {
+            let seg = LooseState::segment_for(&loose.lanes[l], st.seg[l], tm.to_array()[k]);
+            st.load(loose, l, seg);
+        }
+    }
+}
+
+/// Rows for block `b` when every lane is inside its keys, `t_0 <= time < t_{n-1}`:
+/// no extrapolation and no sentinel, just `u`, ease and the basis.
+#[inline]
+fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4) -> Rows {
+    let one = f64x4::ONE;
+    let mut s = [f64x4::ZERO; 2];
+    let mut rate = [f64x4::ZERO; 2];
+    for h in 0..2 {
+        let i = 2 * b + h;
+        refresh(loose, st, i, t);
+        let (ws, we) = (quad(&st.ws, i), quad(&st.we, i));
+        let d = we - ws;
+        let u = ((t - ws) / d).max(f64x4::ZERO).min(one);
+        let (ss, dsdu) = if loose.eased[b] {
+            ease(u, quad(&st.ease_from, i), quad(&st.ease_to, i))
+        } else {
+            (u, one)
+        };
+        s[h] = ss;
+        rate[h] = dsdu / d;
+    }
+    let s32 = f32x8_of(s[0], s[1]);
+    Rows {
+        h: hermite_basis(s32),
+        dh: hermite_basis_derivative(s32),
+        rate: f32x8_of(rate[0], rate[1]),
+        cycles: f32x8::ZERO,
+        any_cycles: false,
+    }
+}
+
+/// Rows for block `b` at a finite `time`, refreshing lanes that left their window.
+fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
+    let t = f64x4::splat(time);
+    let inside = |i: usize| (t.simd_ge(loose.t0[i]) & t.simd_lt(loose.tn[i])).all();
+    if inside(2 * b) && inside(2 * b + 1) {
+        return rows_inside(loose, st, b, t);
+    }
+    let zero = f64x4::ZERO;
+    let one = f64x4::ONE;
+    let mut out_tm = [zero; 2];
+    let (mut line, mut reset, mut hold) = ([zero; 2], [zero; 2], [zero; 2]);
+    let mut dir = [one; 2];
+    let mut cycles = [zero; 2];
+    let mut dt = [zero; 2];
+    for h in 0..2 {
+        let i = 2 * b + h;
+        let (t0, tn, len) = (loose.t0[i], loose.tn[i], loose.len[i]);
+        let before = t.simd_lt(t0);
+        let after = t.simd_gt(tn);
+        let outside = before | after;
+        let mode = before.select(loose.pre[i], loose.post[i]);
+        let rel = t - t0;
+        let m = (rel / len).floor();
+        let r = (rel - m * len).max(zero).min(len);
+        let odd = (m - (m * f64x4::splat(0.5)).floor() * f64x4::splat(2.0)).simd_eq(one);
+        let is = |c: f64| mode.simd_eq(f64x4::splat(c));
+        let wraps = is(2.0) | is(3.0) | is(4.0);
+        let back = outside & is(3.0) & odd;
+        let wrapped = back.select(tn - r, t0 + r);
+        let beyond = before.select(f64x4::splat(-f64::MAX), f64x4::splat(f64::MAX));
+        out_tm[h] = outside.select(wraps.select(wrapped, beyond), t);
+        dir[h] = back.select(-one, one);
+        cycles[h] = (outside & is(4.0)).select(m, zero);
+        dt[h] = before.select(t - t0, t - tn);
+        line[h] = outside & is(5.0);
+        reset[h] = outside & is(1.0);
+        hold[h] = outside & is(0.0);
+    }
+    for (h, &tm) in out_tm.iter().enumerate() {
+        refresh(loose, st, 2 * b + h, tm);
+    }
+    // u, ease, rates per lane (f64), for lanes in real segments.
+    let mut s = [zero; 2];
+    let mut rate = [zero; 2];
+    let mut real = [zero; 2];
+    for h in 0..2 {
+        let i = 2 * b + h;
+        let (ws, we) = (quad(&st.ws, i), quad(&st.we, i));
+        let is_real =
+            ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
+        let d = is_real.select(we - ws, one);
+        let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
+        let (a, e) = (quad(&st.ease_from, i), quad(&st.ease_to, i));
+        let (ss, dsdu) = if loose.eased[b] {
+            ease(u, a, e)
+        } else {
+            (u, one)
+        };
+        s[h] = ss;
+        rate[h] = dsdu / d * dir[h];
+        real[h] = is_real;
+    }
+    let realm = mask_of(real[0], real[1]);
+    let line = mask_of(line[0], line[1]);
+    let reset = mask_of(reset[0], reset[1]);
+    let hold = mask_of(hold[0], hold[1]);
+    let at_end = !(realm | line | reset | hold);
+    let s32 = f32x8_of(s[0], s[1]);
+    let hb = hermite_basis(s32);
+    let db = hermite_basis_derivative(s32);
+    let (z, o) = (f32x8::ZERO, f32x8::ONE);
+    let dt = f32x8_of(dt[0], dt[1]);
+    let dirs = f32x8_of(dir[0], dir[1]);
+    let cyc = f32x8_of(cycles[0], cycles[1]);
+    Rows {
+        h: [
+            realm.select(hb[0], reset.select(z, o)),
+            realm.select(hb[1], z),
+            realm.select(hb[2], line.select(dt, z)),
+            realm.select(hb[3], z),
+        ],
+        dh: [
+            realm.select(db[0], z),
+            realm.select(db[1], z),
+            realm.select(db[2], line.select(o, z)),
+            realm.select(db[3], at_end.select(o, z)),
+        ],
+        rate: realm.select(
+            f32x8_of(rate[0], rate[1]),
+            line.select(o, at_end.select(dirs, z)),
+        ),
+        any_cycles: cyc.simd_ne(z).any(),
+        cycles: cyc,
+    }
+}
+
+/// [`tcb_core::ease::SegmentEase::apply`] across lanes (`a + e <= 1`).
+fn ease(u: f64x4, a: f64x4, e: f64x4) -> (f64x4, f64x4) {
+    let (zero, one, two) = (f64x4::ZERO, f64x4::ONE, f64x4::splat(2.0));
+    let none = a.simd_eq(zero) & e.simd_eq(zero);
+    let k = one / (two - a - e);
+    let w = one - u;
+    let first = u.simd_lt(a);
+    let last = e.simd_gt(zero) & u.simd_ge(one - e);
+    let s = first.select(
+        k * u * u / a,
+        last.select(one - k * w * w / e, k * (two * u - a)),
+    );
+    let d = first.select(two * k * u / a, last.select(two * k * w / e, two * k));
+    (none.select(u, s), none.select(one, d))
+}
+
+/// Rows for block `b` from the scalar [`TimeGrid::frame`] of each lane.
+fn rows_scalar(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
+    let mut h = [[0.0f32; 8]; 4];
+    let mut dh = [[0.0f32; 8]; 4];
+    let mut rate = [0.0f32; 8];
+    let mut cycles = [0.0f32; 8];
+    for i in 0..8 {
+        let l = 8 * b + i;
+        let Some(lane) = loose.lanes.get(l) else {
+            continue;
+        };
+        let f: FrameBasis = lane.grid.frame(time, &mut st.cursors[l]);
+        if st.seg[l] != f.segment {
+            st.load(loose, l, f.segment);
+        }
+        for j in 0..4 {
+            h[j][i] = f.h[j];
+            dh[j][i] = f.dh[j];
+        }
+        rate[i] = f.rate;
+        cycles[i] = f.cycles;
+    }
+    Rows {
+        h: h.map(f32x8::new),
+        dh: dh.map(f32x8::new),
+        rate: f32x8::new(rate),
+        any_cycles: cycles.iter().any(|&c| c != 0.0),
+        cycles: f32x8::new(cycles),
+    }
+}
+
+/// Sample every loose track at `time` into its pose planes.
+pub(crate) fn sample(
+    loose: &Loose,
+    st: &mut LooseState,
+    time: f64,
+    values: &mut [f32x8],
+    mut velocities: Option<&mut [f32x8]>,
+) {
+    for b in 0..loose.blocks {
+        let rows = if time.is_finite() {
+            rows_simd(loose, st, b, time)
+        } else {
+            rows_scalar(loose, st, b, time)
+        };
+        let ctl = &st.ctl[b * CTL..(b + 1) * CTL];
+        let out = loose.out + 4 * b;
+        for c in 0..loose.dims[b] {
+            let k = &ctl[4 * c..4 * c + 4];
+            let mut v = hermite(&rows.h, k[0], k[1], k[2], k[3]);
+            if rows.any_cycles {
+                v += loose.delta[4 * b + c] * rows.cycles;
+            }
+            values[out + c] = v;
+            if let Some(vel) = velocities.as_deref_mut() {
+                vel[out + c] = hermite(&rows.dh, k[0], k[1], k[2], k[3]) * rows.rate;
+            }
+        }
+    }
+}
