@@ -1,0 +1,112 @@
+//! Blending poses: vectors lerp, rotations nlerp with hemisphere correction,
+//! per-track masks, lanes with no weight.
+
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use tcb_runtime::{BlendMask, Clip, Instance, blend};
+
+fn clip() -> Arc<Clip> {
+    // Rotations on a shared grid (squad and hermite) and a vector track; the
+    // loose scalar track has its own grid.
+    let text = r#"{"format": "tcb-clip/1", "tracks": [
+      {"name": "pos", "kind": "vec3", "times": [0, 1, 2], "values": [[0, 0, 0], [2, 4, 6], [4, 0, 2]]},
+      {"name": "rot", "kind": "quat", "times": [0, 1, 2], "values": [[0, 0, 0, 1], [0, 0, 0.7071068, 0.7071068], [0, 0, 1, 0]]},
+      {"name": "rot_h", "kind": "quat", "rotation": "hermite", "times": [0, 1, 2], "values": [[0, 0, 0, 1], [0.7071068, 0, 0, 0.7071068], [1, 0, 0, 0]]},
+      {"name": "x", "kind": "scalar", "times": [0, 3], "values": [10, 40]}
+    ]}"#;
+    Arc::new(Clip::compile(
+        &tcb_io::ClipDoc::parse(text).unwrap().build().unwrap(),
+    ))
+}
+
+fn close(a: Quat, b: Quat) -> bool {
+    (a - b).length().min((a + b).length()) < 1e-5
+}
+
+#[test]
+fn weighted_blend_by_hand() {
+    let clip = clip();
+    let (pos, rot, rot_h, x) = ["pos", "rot", "rot_h", "x"]
+        .map(|n| clip.track(n).unwrap())
+        .into();
+    let mut a = Instance::new(clip.clone(), false);
+    let mut b = Instance::new(clip.clone(), false);
+    a.sample(0.0);
+    b.sample(2.0);
+    let mut out = a.pose().clone();
+    blend(&mut out, &[(a.pose(), 3.0), (b.pose(), 1.0)], None);
+    // Vectors: (3 a + 1 b) / 4.
+    assert!(
+        (out.vec3(pos) - Vec3::new(1.0, 0.0, 0.5))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    let xb = b.pose().scalar(x);
+    assert!((out.scalar(x) - (3.0 * 10.0 + xb) / 4.0).abs() < 1e-5);
+    // Rotations: identity and a half turn about z (given as [0,0,1,0]):
+    // nlerp(3 * I + 1 * q) normalized.
+    let want = (Quat::IDENTITY * 3.0 + Quat::from_xyzw(0.0, 0.0, 1.0, 0.0)).normalize();
+    assert!(close(out.quat(rot), want), "{} {}", out.quat(rot), want);
+    let want = (Quat::IDENTITY * 3.0 + Quat::from_xyzw(1.0, 0.0, 0.0, 0.0)).normalize();
+    assert!(close(out.quat(rot_h), want));
+}
+
+#[test]
+fn hemisphere_correction() {
+    let clip = clip();
+    let (rot, rot_h) = (clip.track("rot").unwrap(), clip.track("rot_h").unwrap());
+    let mut a = Instance::new(clip.clone(), false);
+    let mut b = Instance::new(clip.clone(), false);
+    a.sample(1.0);
+    b.sample(0.4);
+    // b with every rotation negated (same rotations): a single layer of weight -1.
+    let mut flipped = b.pose().clone();
+    blend(&mut flipped, &[(b.pose(), -1.0)], None);
+    assert!(flipped.quat(rot).dot(b.pose().quat(rot)) < -0.99);
+    let (mut plain, mut corrected) = (a.pose().clone(), a.pose().clone());
+    blend(&mut plain, &[(a.pose(), 0.6), (b.pose(), 0.4)], None);
+    blend(&mut corrected, &[(a.pose(), 0.6), (&flipped, 0.4)], None);
+    for t in [rot, rot_h] {
+        assert!(
+            close(plain.quat(t), corrected.quat(t)),
+            "{} {}",
+            plain.quat(t),
+            corrected.quat(t)
+        );
+    }
+}
+
+#[test]
+fn masks_weigh_tracks_separately() {
+    let clip = clip();
+    let (pos, x) = (clip.track("pos").unwrap(), clip.track("x").unwrap());
+    let mut a = Instance::new(clip.clone(), false);
+    let mut b = Instance::new(clip.clone(), false);
+    a.sample(0.0);
+    b.sample(1.0);
+    // Layer b affects only "pos"; "x" keeps layer a's value.
+    let only_pos = BlendMask::new(&clip, |t| if t == pos { 1.0 } else { 0.0 });
+    let all = BlendMask::new(&clip, |_| 1.0);
+    let mut out = a.pose().clone();
+    blend(
+        &mut out,
+        &[(a.pose(), 1.0), (b.pose(), 1.0)],
+        Some(&[&all, &only_pos]),
+    );
+    assert!(
+        (out.vec3(pos) - Vec3::new(1.0, 2.0, 3.0))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert_eq!(out.scalar(x), a.pose().scalar(x));
+    // No weight at all: the first layer's values.
+    let none = BlendMask::new(&clip, |_| 0.0);
+    blend(
+        &mut out,
+        &[(b.pose(), 1.0), (a.pose(), 1.0)],
+        Some(&[&none, &none]),
+    );
+    assert_eq!(out.vec3(pos), b.pose().vec3(pos));
+}
