@@ -59,8 +59,28 @@ fn quat_close(a: Quat, b: Quat, tol: f32) -> bool {
     (a - b).length().min((a + b).length()) <= tol
 }
 
+/// Cases and seed: deterministic by default so that CI cannot flake;
+/// `PROPTEST_CASES` and `PROPTEST_RNG_SEED` override them for deeper runs.
+fn config(cases: u32) -> ProptestConfig {
+    let env = ProptestConfig::default();
+    let set = |name: &str| std::env::var_os(name).is_some();
+    ProptestConfig {
+        cases: if set("PROPTEST_CASES") {
+            env.cases
+        } else {
+            cases
+        },
+        rng_seed: if set("PROPTEST_RNG_SEED") {
+            env.rng_seed
+        } else {
+            proptest::test_runner::RngSeed::Fixed(0x7cb_1984)
+        },
+        ..env
+    }
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    #![proptest_config(config(200))]
 
     #[test]
     fn passes_through_every_key((t, v, c) in track3(8), rule in 0..4usize, ends in 0..3usize) {
@@ -225,7 +245,7 @@ fn quats(n: usize) -> impl Strategy<Value = Vec<Quat>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(100))]
+    #![proptest_config(config(100))]
 
     #[test]
     fn rotations_are_unit_and_pass_through_keys(
