@@ -135,7 +135,7 @@ pub(crate) fn nearly_equal<V: Vector>(a: V, b: V) -> bool {
 ///
 /// ```
 /// use glam::Vec3;
-/// use tcb_core::{KeyParams, Tcb, Track, TrackSettings};
+/// use tcb_core::{Track, TrackSettings};
 ///
 /// let track = Track::new(
 ///     vec![0.0, 0.5, 1.25, 2.0],
@@ -147,9 +147,6 @@ pub(crate) fn nearly_equal<V: Vector>(a: V, b: V) -> bool {
 /// assert_eq!(track.sample(0.5), Vec3::new(1.0, 2.0, 0.0)); // passes through its keys
 /// let (_, velocity) = track.sample_with_velocity(1.0);
 /// assert!(velocity.x > 0.0);
-/// // A key with continuity -1 makes a corner:
-/// let corner = KeyParams::<f32>::with_tcb(Tcb::LINEAR);
-/// # let _ = corner;
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track<V> {

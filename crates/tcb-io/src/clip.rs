@@ -279,13 +279,17 @@ impl TrackDoc {
     /// Build the track with `defaults` under this track's overrides.
     pub fn build(&self, defaults: &SettingsDoc) -> Result<TrackData, tcb_core::TrackError> {
         let (settings, tcb) = self.settings.or(defaults).resolve();
-        let dim = self.kind.dim();
+        /// Per-key parameters; without `keys`, every key takes the track's default tcb.
         fn params<V: Copy>(
-            keys: &[KeyDoc],
+            t: &TrackDoc,
             tcb: Tcb,
             conv: impl Fn([f32; 4]) -> V,
         ) -> Vec<KeyParams<V>> {
-            keys.iter()
+            if t.keys.is_empty() {
+                return vec![KeyParams::with_tcb(tcb); t.times.len()];
+            }
+            t.keys
+                .iter()
                 .map(|k| KeyParams {
                     tcb: k.tcb.map_or(tcb, Tcb::from_array),
                     ease: k.ease.map_or(Ease::NONE, Ease::from_array),
@@ -301,17 +305,13 @@ impl TrackDoc {
             settings: &TrackSettings,
         ) -> Result<Track<V>, tcb_core::TrackError> {
             let values = t.values.iter().map(|&a| V::from_array(a)).collect();
-            let mut keys = params(&t.keys, tcb, V::from_array);
-            if keys.is_empty() && tcb != Tcb::DEFAULT {
-                keys = vec![KeyParams::with_tcb(tcb); t.times.len()];
-            }
-            Track::new(t.times.clone(), values, keys, settings)
+            Track::new(
+                t.times.clone(),
+                values,
+                params(t, tcb, V::from_array),
+                settings,
+            )
         }
-        debug_assert!(
-            self.values
-                .iter()
-                .all(|v| v[dim..].iter().all(|&x| x == 0.0))
-        );
         Ok(match self.kind {
             TrackKind::Scalar => TrackData::Scalar(vector(self, tcb, &settings)?),
             TrackKind::Vec2 => TrackData::Vec2(vector::<Vec2>(self, tcb, &settings)?),
@@ -319,10 +319,7 @@ impl TrackDoc {
             TrackKind::Vec4 => TrackData::Vec4(vector::<Vec4>(self, tcb, &settings)?),
             TrackKind::Quat => {
                 let values = self.values.iter().map(|&a| Quat::from_array(a)).collect();
-                let mut keys = params(&self.keys, tcb, Quat::from_array);
-                if keys.is_empty() && tcb != Tcb::DEFAULT {
-                    keys = vec![KeyParams::with_tcb(tcb); self.times.len()];
-                }
+                let keys = params(self, tcb, Quat::from_array);
                 TrackData::Quat(RotationTrack::new(
                     self.times.clone(),
                     values,

@@ -48,7 +48,17 @@ impl BlendMask {
 /// the same tracks and time grids); layers that do not are skipped.
 pub fn blend(out: &mut Pose, layers: &[(&Pose, f32)], masks: Option<&[&BlendMask]>) {
     let layout = out.layout.clone();
-    let usable = |i: usize| layers[i].0.layout == layout || *layers[i].0.layout == *layout;
+    // Which layers share `out`'s layout, decided once per call: poses of one
+    // clip share the Arc; poses of another clip need a deep comparison, which
+    // must not run per block. Layers past the 128th compare each time.
+    let same = |i: usize| {
+        let l = &layers[i].0.layout;
+        std::sync::Arc::ptr_eq(l, &layout) || **l == *layout
+    };
+    let mask: u128 = (0..layers.len().min(128))
+        .filter(|&i| same(i))
+        .fold(0, |m, i| m | 1 << i);
+    let usable = |i: usize| if i < 128 { mask >> i & 1 == 1 } else { same(i) };
     let Some(first) = (0..layers.len()).find(|&i| usable(i)) else {
         return;
     };

@@ -99,7 +99,8 @@ pub(crate) fn sample_into(
                 kernel::hermite_quats(
                     &g.hq[seg * n..(seg + 1) * n],
                     &h,
-                    Some((&dh, rate)),
+                    &dh,
+                    rate,
                     &mut values[range.clone()],
                     velocities.as_deref_mut().map(|v| &mut v[range]),
                 );
@@ -121,13 +122,12 @@ pub(crate) fn sample_into(
     let want_velocity = pose.velocities.is_some();
     for &id in &clip.reference {
         let (q, d) = rotation(clip, id).sample_with_velocity(time);
-        pose.set(id, q.to_array(), Some(d.to_array()));
+        pose.set(id, Some(q.to_array()), Some(d.to_array()));
     }
     if want_velocity {
         for &id in &clip.squad_velocity {
             let (_, d) = rotation(clip, id).sample_with_velocity(time);
-            let value = pose_value(pose, id);
-            pose.set(id, value, Some(d.to_array()));
+            pose.set(id, None, Some(d.to_array()));
         }
     }
 }
@@ -137,8 +137,4 @@ fn rotation(clip: &Clip, id: TrackId) -> &tcb_core::RotationTrack {
         TrackData::Quat(r) => r,
         _ => unreachable!("only rotation tracks are sampled by the reference"),
     }
-}
-
-fn pose_value(pose: &Pose, id: TrackId) -> [f32; 4] {
-    pose.quat(id).to_array()
 }

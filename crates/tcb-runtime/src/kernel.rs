@@ -48,7 +48,8 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
 pub(crate) fn hermite_quats(
     coeffs: &[f32x8],
     h: &[f32x8; 4],
-    dh: Option<(&[f32x8; 4], f32x8)>,
+    dh: &[f32x8; 4],
+    rate: f32x8,
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
@@ -59,7 +60,7 @@ pub(crate) fn hermite_quats(
         let inv = f32x8::ONE / len;
         let q = p.map(|x| x * inv);
         out[4 * b..4 * b + 4].copy_from_slice(&q);
-        if let (Some((dh, rate)), Some(vel)) = (dh, vel.as_deref_mut()) {
+        if let Some(vel) = vel.as_deref_mut() {
             let dp: [f32x8; 4] =
                 std::array::from_fn(|i| hermite(dh, c[i], c[4 + i], c[8 + i], c[12 + i]) * rate);
             let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];

@@ -114,19 +114,26 @@ impl Pose {
         }
     }
 
-    pub(crate) fn set(&mut self, track: TrackId, value: [f32; 4], velocity: Option<[f32; 4]>) {
+    /// Write a track's value and/or velocity (the scalar reference fallbacks).
+    pub(crate) fn set(
+        &mut self,
+        track: TrackId,
+        value: Option<[f32; 4]>,
+        velocity: Option<[f32; 4]>,
+    ) {
         let slot = &self.layout.slots[track.0];
-        let dim = slot.kind.dim();
-        let idx = slot.index;
-        let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut self.values);
-        for c in 0..dim {
-            flat[idx[c]] = value[c];
-        }
-        if let (Some(vel), Some(v)) = (velocity, self.velocities.as_mut()) {
-            let flat: &mut [f32] = bytemuck::cast_slice_mut(v);
-            for c in 0..dim {
-                flat[idx[c]] = vel[c];
+        let idx = &slot.index[..slot.kind.dim()];
+        let write = |data: &mut [f32x8], v: [f32; 4]| {
+            let flat: &mut [f32] = bytemuck::cast_slice_mut(data);
+            for (c, &i) in idx.iter().enumerate() {
+                flat[i] = v[c];
             }
+        };
+        if let Some(v) = value {
+            write(&mut self.values, v);
+        }
+        if let (Some(v), Some(data)) = (velocity, self.velocities.as_mut()) {
+            write(data, v);
         }
     }
 }

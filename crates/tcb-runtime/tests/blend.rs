@@ -110,3 +110,32 @@ fn masks_weigh_tracks_separately() {
     );
     assert_eq!(out.vec3(pos), b.pose().vec3(pos));
 }
+
+#[test]
+fn layers_of_another_clip_with_the_same_layout_blend_others_are_skipped() {
+    let (one, two) = (clip(), clip()); // compiled twice: equal layouts, different Arcs
+    let pos = one.track("pos").unwrap();
+    let mut a = Instance::new(one.clone(), false);
+    let mut b = Instance::new(two, false);
+    a.sample(0.0);
+    b.sample(1.0);
+    let mut out = a.pose().clone();
+    blend(&mut out, &[(a.pose(), 1.0), (b.pose(), 1.0)], None);
+    assert!(
+        (out.vec3(pos) - Vec3::new(1.0, 2.0, 3.0))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    // A pose of a clip with other tracks does not take part.
+    let other = tcb_io::ClipDoc::parse(
+        r#"{"format": "tcb-clip/1", "tracks": [{"name": "pos", "kind": "vec3", "times": [0, 1], "values": [[9, 9, 9], [9, 9, 9]]}]}"#,
+    )
+    .unwrap()
+    .build()
+    .unwrap();
+    let mut c = Instance::new(Arc::new(Clip::compile(&other)), false);
+    c.sample(0.5);
+    blend(&mut out, &[(a.pose(), 1.0), (c.pose(), 1.0)], None);
+    assert_eq!(out.vec3(pos), a.pose().vec3(pos));
+}
