@@ -4,12 +4,12 @@
 //! modes; a group's channels share one [`FrameBasis`](crate::grid::FrameBasis)
 //! per frame. Per group, per stored segment (see [`crate::grid`]), per block
 //! of 8 channels, the Hermite controls are stored lane-contiguous as
-//! `wide::f32x8` (32-byte aligned, zero-padded):
+//! `wide::f32x8` (32-byte aligned, zero-padded; squad in `f64x4`):
 //!
 //! ```text
 //! vectors   [segment][block][P0 P1 M0 M1]                       4 x f32x8
 //! hermite   [segment][block][P0 P1 M0 M1][x y z w]             16 x f32x8
-//! squad     [segment][block][q0 n01 alpha01 a n_ab alpha_ab]            16 x f32x8
+//! squad     [segment][half block][q0 n01 alpha01 a n_ab alpha_ab]   16 x f64x4
 //! ```
 //!
 //! `linear` and `step` segments and explicit tangents are folded into the
@@ -28,7 +28,7 @@ use std::sync::Arc;
 use tcb_core::ease::SegmentEase;
 use tcb_core::rotation::RotationTrack;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value};
-use wide::f32x8;
+use wide::{f32x8, f64x4};
 
 /// Index of a track in its clip (file order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -66,7 +66,8 @@ pub(crate) struct Group {
     pub hq: Vec<f32x8>,
     pub hq_out: usize,
     pub sq_blocks: usize,
-    pub sq: Vec<f32x8>,
+    /// Two halves of 4 lanes per output block of 8.
+    pub sq: Vec<f64x4>,
     pub sq_out: usize,
 }
 
@@ -164,7 +165,7 @@ fn rot_layout(t: &RotationTrack) -> RotLayout {
 
 /// `p` followed by the unit axis and angle of `log(p^-1 q)`, so that
 /// `slerp(p, q, s) = p exp(s angle axis)` (plain slerp, no hemisphere flip).
-fn slerp_controls(p: DQuat, q: DQuat) -> [f32; 8] {
+fn slerp_controls(p: DQuat, q: DQuat) -> [f64; 8] {
     let v = tcb_core::rotation::quat_log(p.conjugate() * q);
     let alpha = v.length();
     let n = if alpha > 0.0 {
@@ -172,21 +173,11 @@ fn slerp_controls(p: DQuat, q: DQuat) -> [f32; 8] {
     } else {
         glam::DVec3::ZERO
     };
-    let p = p.as_quat();
-    [
-        p.x,
-        p.y,
-        p.z,
-        p.w,
-        n.x as f32,
-        n.y as f32,
-        n.z as f32,
-        alpha as f32,
-    ]
+    [p.x, p.y, p.z, p.w, n.x, n.y, n.z, alpha]
 }
 
 /// Squad controls over stored segments `0..=n` (see [`slerp_controls`]).
-fn squad_controls(t: &RotationTrack) -> Vec<[f32; SQ_STRIDE]> {
+fn squad_controls(t: &RotationTrack) -> Vec<[f64; SQ_STRIDE]> {
     let keys: Vec<DQuat> = t.values().iter().map(|q| q.as_dquat()).collect();
     let n = keys.len();
     let quads: Vec<[DQuat; 4]> = match t.squad_segments() {
@@ -200,7 +191,7 @@ fn squad_controls(t: &RotationTrack) -> Vec<[f32; SQ_STRIDE]> {
     };
     let mut out = Vec::with_capacity(n + 1);
     let mut push = |q: [DQuat; 4]| {
-        let mut c = [0.0f32; SQ_STRIDE];
+        let mut c = [0.0f64; SQ_STRIDE];
         c[..8].copy_from_slice(&slerp_controls(q[0], q[1]));
         c[8..].copy_from_slice(&slerp_controls(q[2], q[3]));
         out.push(c);
@@ -233,6 +224,24 @@ fn pack<const W: usize>(rows: &[Vec<[f32; W]>], segments: usize, pad: [f32; W]) 
     out
 }
 
+/// [`pack`] in f64, blocks of 4 lanes, padded to an even number of blocks.
+fn pack_f64<const W: usize>(rows: &[Vec<[f64; W]>], segments: usize, pad: [f64; W]) -> Vec<f64x4> {
+    let blocks = 2 * rows.len().div_ceil(8);
+    let mut out = vec![f64x4::ZERO; segments * blocks * W];
+    for seg in 0..segments {
+        for b in 0..blocks {
+            for j in 0..W {
+                let mut lanes = [0.0f64; 4];
+                for (l, lane) in lanes.iter_mut().enumerate() {
+                    *lane = rows.get(b * 4 + l).map_or(pad[j], |r| r[seg][j]);
+                }
+                out[(seg * blocks + b) * W + j] = f64x4::new(lanes);
+            }
+        }
+    }
+    out
+}
+
 /// Controls of an unused rotation lane: the identity, so that padding lanes
 /// normalize to a finite value, not 0/0. `w` sits at index 3 of the first and
 /// of the second quaternion of a row (P0 and P1 for hermite, q0 and a for squad).
@@ -259,7 +268,7 @@ impl Clip {
         // Per group: vector channel rows (track, component), hermite rows, squad rows.
         let mut vec_rows: Vec<Vec<(usize, usize, Controls)>> = Vec::new();
         let mut hq_rows: Vec<Vec<(usize, Vec<[f32; HQ_STRIDE]>)>> = Vec::new();
-        let mut sq_rows: Vec<Vec<(usize, Vec<[f32; SQ_STRIDE]>)>> = Vec::new();
+        let mut sq_rows: Vec<Vec<(usize, Vec<[f64; SQ_STRIDE]>)>> = Vec::new();
         let mut reference = Vec::new();
         let mut squad_velocity = Vec::new();
         for (i, t) in source.tracks.iter().enumerate() {
@@ -405,7 +414,7 @@ impl Clip {
                 hq: pack(&hrows, segments, identity_pad(7)),
                 hq_blocks,
                 hq_out,
-                sq: pack(&srows, segments, identity_pad(11)),
+                sq: pack_f64(&srows, segments, identity_pad(11).map(f64::from)),
                 sq_blocks,
                 sq_out,
                 grid,
@@ -495,7 +504,10 @@ impl Clip {
         self.groups
             .iter()
             .map(|g| {
-                (g.vec_blocks * VEC_STRIDE + g.hq_blocks * HQ_STRIDE + g.sq_blocks * SQ_STRIDE) * 32
+                (g.vec_blocks * VEC_STRIDE
+                    + g.hq_blocks * HQ_STRIDE
+                    + g.sq_blocks * 2 * SQ_STRIDE * 2)
+                    * 32
             })
             .sum()
     }

@@ -47,8 +47,8 @@ pub struct TimeGrid {
 pub struct FrameBasis {
     /// Stored segment (`0` pre sentinel, `1..n` real, `n` post sentinel).
     pub segment: usize,
-    /// Eased local parameter (for slerp-based rotations).
-    pub s: f32,
+    /// Eased local parameter, kept in f64 for slerp-based rotations.
+    pub s: f64,
     /// Value row `[h1 h2 h3 h4]`.
     pub h: [f32; 4],
     /// Derivative row before scaling by `rate`.
@@ -130,7 +130,7 @@ impl TimeGrid {
                     let s32 = s as f32;
                     FrameBasis {
                         segment: k + 1,
-                        s: s32,
+                        s,
                         h: hermite_basis(s32),
                         dh: hermite_basis_derivative(s32),
                         rate: (ds_du / d) as f32,

@@ -107,12 +107,12 @@ pub(crate) fn sample_into(
             }
         }
         if g.sq_blocks > 0 {
-            let n = g.sq_blocks * kernel::SQ_STRIDE;
+            let n = 2 * g.sq_blocks * kernel::SQ_STRIDE;
             let out = &mut values[g.sq_out..g.sq_out + 4 * g.sq_blocks];
             if f.reset {
                 kernel::identity(out);
             } else {
-                kernel::squad_quats(&g.sq[seg * n..(seg + 1) * n], f32x8::splat(f.s), out);
+                kernel::squad_quats(&g.sq[seg * n..(seg + 1) * n], f.s, out);
             }
         }
     }

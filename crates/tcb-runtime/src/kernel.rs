@@ -2,14 +2,15 @@
 //! frame's rows broadcast. No branch depends on a channel.
 
 use tcb_core::basis::hermite;
-use wide::f32x8;
+use wide::{f32x8, f64x4};
 
 /// `[P0, P1, M0, M1]` of 8 channels.
 pub(crate) const VEC_STRIDE: usize = 4;
 /// `[P0, P1, M0, M1]` x `[x, y, z, w]` of 8 quaternions.
 pub(crate) const HQ_STRIDE: usize = 16;
-/// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`:
-/// the two outer slerps of squad as start point, log axis and log angle.
+/// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
+/// of 4 quaternions in f64: the two outer slerps of squad as start point, log
+/// axis and log angle.
 pub(crate) const SQ_STRIDE: usize = 16;
 
 #[inline(always)]
@@ -73,7 +74,7 @@ pub(crate) fn hermite_quats(
 
 /// Hamilton product of two quaternions in planes `[x, y, z, w]`.
 #[inline(always)]
-fn quat_mul(a: &[f32x8; 4], b: &[f32x8; 4]) -> [f32x8; 4] {
+fn quat_mul(a: &[f64x4; 4], b: &[f64x4; 4]) -> [f64x4; 4] {
     [
         a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
         a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
@@ -85,36 +86,61 @@ fn quat_mul(a: &[f32x8; 4], b: &[f32x8; 4]) -> [f32x8; 4] {
 /// `p exp(s alpha n)`: slerp from `p` along unit axis `n` (log-space angle
 /// `alpha`). No division by `sin`, so well conditioned for any angle.
 #[inline(always)]
-fn slerp_power(p: &[f32x8; 4], n: &[f32x8], alpha: f32x8, s: f32x8) -> [f32x8; 4] {
+fn slerp_power(p: &[f64x4; 4], n: &[f64x4], alpha: f64x4, s: f64x4) -> [f64x4; 4] {
     let (sin, cos) = (s * alpha).sin_cos();
     quat_mul(p, &[n[0] * sin, n[1] * sin, n[2] * sin, cos])
 }
 
-/// Squad rotations: `slerp(slerp(q0, q1, s), slerp(a, b, s), 2s(1-s))`,
-/// normalized. Each slerp is written `p exp(s log(p^-1 q))`; the logs of the
-/// two outer ones are stored with the segment (axis and angle, from f64), the
-/// inner one is taken per frame.
+/// Squad of four lanes, in f64: `slerp(slerp(q0, q1, s), slerp(a, b, s),
+/// 2s(1-s))`, normalized.
+#[inline(always)]
+fn squad4(c: &[f64x4], s: f64x4, g: f64x4) -> [f64x4; 4] {
+    let q0 = [c[0], c[1], c[2], c[3]];
+    let a = [c[8], c[9], c[10], c[11]];
+    let p = slerp_power(&q0, &c[4..7], c[7], s);
+    let q = slerp_power(&a, &c[12..15], c[15], s);
+    // log(p^-1 q) = n alpha, alpha = atan2(|v|, w)
+    let r = quat_mul(&[-p[0], -p[1], -p[2], p[3]], &q);
+    let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let alpha = len.atan2(r[3]);
+    let none = len.simd_eq(f64x4::ZERO);
+    let inv = none.select(f64x4::ZERO, f64x4::ONE / len);
+    let n = [r[0] * inv, r[1] * inv, r[2] * inv];
+    let v = slerp_power(&p, &n, alpha, g);
+    let il = f64x4::ONE / (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
+    v.map(|x| x * il)
+}
+
+/// Squad rotations. Each slerp is written `p exp(s log(p^-1 q))`; the logs of
+/// the two outer ones are stored with the segment (axis and angle), the inner
+/// one is taken per frame.
+///
+/// This runs in f64 (four lanes per [`f64x4`], two halves per output block):
+/// the inner slerp between nearly opposite quaternions amplifies its inputs'
+/// errors by about `1 / sin(angle)`, and f32 controls and arithmetic put the
+/// result up to 6e-6 from the reference on such segments.
 #[inline]
-pub(crate) fn squad_quats(coeffs: &[f32x8], s: f32x8, out: &mut [f32x8]) {
-    let one = f32x8::ONE;
-    let g = (s + s) * (one - s);
-    for (b, c) in coeffs.chunks_exact(SQ_STRIDE).enumerate() {
-        let q0 = [c[0], c[1], c[2], c[3]];
-        let a = [c[8], c[9], c[10], c[11]];
-        let p = slerp_power(&q0, &c[4..7], c[7], s);
-        let q = slerp_power(&a, &c[12..15], c[15], s);
-        // log(p^-1 q) = n alpha, alpha = atan2(|v|, w)
-        let r = quat_mul(&[-p[0], -p[1], -p[2], p[3]], &q);
-        let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-        let alpha = len.atan2(r[3]);
-        let none = len.simd_eq(f32x8::ZERO);
-        let inv = none.select(f32x8::ZERO, one / len);
-        let n = [r[0] * inv, r[1] * inv, r[2] * inv];
-        let v = slerp_power(&p, &n, alpha, g);
-        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
-        let il = one / l;
+pub(crate) fn squad_quats(coeffs: &[f64x4], s: f64, out: &mut [f32x8]) {
+    let g = f64x4::splat(2.0 * s * (1.0 - s));
+    let s = f64x4::splat(s);
+    for (c, o) in coeffs
+        .chunks_exact(2 * SQ_STRIDE)
+        .zip(out.chunks_exact_mut(4))
+    {
+        let lo = squad4(&c[..SQ_STRIDE], s, g);
+        let hi = squad4(&c[SQ_STRIDE..], s, g);
         for i in 0..4 {
-            out[4 * b + i] = v[i] * il;
+            let (l, h) = (lo[i].to_array(), hi[i].to_array());
+            o[i] = f32x8::new([
+                l[0] as f32,
+                l[1] as f32,
+                l[2] as f32,
+                l[3] as f32,
+                h[0] as f32,
+                h[1] as f32,
+                h[2] as f32,
+                h[3] as f32,
+            ]);
         }
     }
 }
