@@ -4,7 +4,11 @@
 //! tcb sample CLIP.json --at 0,0.25,1.5
 //! tcb sample CLIP.json --fps 60 [--from A] [--to B]
 //! tcb sample CLIP.json --inbetweens N [--scalar] [--velocity]
+//! tcb import FILE.bvh -o CLIP.json [--rotation squad|hermite]
+//! tcb import FILE.gltf|FILE.glb -o CLIP.json [--animation NAME_OR_INDEX]
 //! ```
+//!
+//! `sample` also reads BVH and glTF files directly (imported on the fly).
 //!
 //! CSV goes to stdout; errors go to stderr as one line, with a non-zero exit
 //! status and nothing on stdout.
@@ -36,12 +40,29 @@ struct Cli {
 enum Command {
     /// Sample a clip and print CSV: a `time` column, then one column per channel.
     Sample(SampleArgs),
+    /// Import a BVH or glTF file as a clip (tcb-clip/1 JSON).
+    Import(ImportArgs),
+}
+
+#[derive(Args)]
+struct ImportArgs {
+    /// The file to import (.bvh, .gltf, .glb).
+    file: PathBuf,
+    /// The clip to write (replaced only once it is complete).
+    #[arg(short, long, value_name = "CLIP.json")]
+    output: PathBuf,
+    /// BVH: rotation mode of the rotation tracks.
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF: the animation to import, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
 }
 
 #[derive(Args)]
 #[command(group = clap::ArgGroup::new("times").required(true).args(["at", "fps", "inbetweens"]))]
 struct SampleArgs {
-    /// The clip file (tcb-clip/1 JSON).
+    /// The clip file (tcb-clip/1 JSON; .bvh, .gltf and .glb are imported first).
     clip: PathBuf,
     /// Sample at these times (seconds, comma separated; may be negative or huge).
     #[arg(long, value_name = "T,T,...", allow_hyphen_values = true)]
@@ -70,6 +91,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Sample(args) => sample(&args),
+        Command::Import(args) => import(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -88,8 +110,55 @@ fn main() -> ExitCode {
 
 type BoxError = Box<dyn std::error::Error>;
 
+fn warn(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("tcb: warning: {w}");
+    }
+}
+
+fn import(args: &ImportArgs) -> Result<(), BoxError> {
+    let ext = args
+        .file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "bvh" if args.animation.is_some() => return Err("--animation is for glTF files".into()),
+        "gltf" | "glb" if args.rotation.is_some() => {
+            return Err(
+                "--rotation is for BVH files (glTF rotations keep their own interpolation)".into(),
+            );
+        }
+        "bvh" | "gltf" | "glb" => {}
+        _ => {
+            return Err(format!(
+                "{}: can import .bvh, .gltf and .glb files",
+                args.file.display()
+            )
+            .into());
+        }
+    }
+    let options = tcb_io::ImportOptions {
+        rotation: args.rotation.unwrap_or_default(),
+        animation: args.animation.clone(),
+    };
+    let loaded = tcb_io::load_with(&args.file, &options)?;
+    warn(&loaded.warnings);
+    tcb_io::write_clip_doc(&loaded.doc, &args.output)?;
+    let keys: usize = loaded.doc.tracks.iter().map(|t| t.times.len()).sum();
+    let (a, b) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
+    eprintln!(
+        "tcb: wrote {}: {} tracks, {keys} keys, {a} to {b} s",
+        args.output.display(),
+        loaded.doc.tracks.len()
+    );
+    Ok(())
+}
+
 fn sample(args: &SampleArgs) -> Result<(), BoxError> {
-    let clip = tcb_io::load_clip(&args.clip)?;
+    let loaded = tcb_io::load(&args.clip)?;
+    warn(&loaded.warnings);
+    let clip = loaded.clip;
     let times = sample_times(args, &clip)?;
     // Everything that can fail has been checked: from here on only writing can.
     let stdout = io::stdout().lock();

@@ -54,6 +54,7 @@ pub mod extrapolate;
 pub mod params;
 pub mod rotation;
 pub mod sample_times;
+pub mod skeleton;
 pub mod tangent;
 pub mod track;
 pub mod vector;

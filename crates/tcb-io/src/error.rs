@@ -50,6 +50,15 @@ pub enum ErrorKind {
     Invalid(String),
     /// Data a track cannot be built from.
     Track(TrackError),
+    /// A text format (BVH) that cannot be read at a line.
+    Syntax {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong there.
+        message: String,
+    },
+    /// A file that cannot be imported as a whole (glTF structure, sizes).
+    Import(String),
 }
 
 /// A clip file problem, with its location.
@@ -66,6 +75,23 @@ impl Error {
         Error {
             location,
             kind: ErrorKind::Invalid(message.into()),
+        }
+    }
+
+    pub(crate) fn syntax(line: usize, message: impl Into<String>) -> Self {
+        Error {
+            location: Location::default(),
+            kind: ErrorKind::Syntax {
+                line,
+                message: message.into(),
+            },
+        }
+    }
+
+    pub(crate) fn import(message: impl Into<String>) -> Self {
+        Error {
+            location: Location::default(),
+            kind: ErrorKind::Import(message.into()),
         }
     }
 
@@ -108,6 +134,8 @@ impl fmt::Display for Error {
             } => write!(f, "line {line}, column {column}: {message}"),
             ErrorKind::Invalid(m) => f.write_str(m),
             ErrorKind::Track(e) => write!(f, "{e}"),
+            ErrorKind::Syntax { line, message } => write!(f, "line {line}: {message}"),
+            ErrorKind::Import(m) => f.write_str(m),
         }
     }
 }

@@ -24,14 +24,97 @@
 
 #![forbid(unsafe_code)]
 
+pub mod bvh;
 pub mod clip;
 pub mod error;
+pub mod gltf_import;
 
 pub use clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc, write_clip_doc};
 pub use error::{Error, ErrorKind, Location};
 
 use std::io::Write;
 use std::path::Path;
+use tcb_core::RotationMode;
+use tcb_core::skeleton::Skeleton;
+
+/// Choices for importing other formats (see [`load_with`]).
+#[derive(Clone, Debug, Default)]
+pub struct ImportOptions {
+    /// Rotation mode of BVH rotation tracks (default `squad`).
+    pub rotation: RotationMode,
+    /// glTF animation to import, by name or index (default: the first).
+    pub animation: Option<String>,
+}
+
+/// A clip file, BVH or glTF file, read and validated.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The clip as a document (what `tcb import` writes).
+    pub doc: ClipDoc,
+    /// The clip, built and validated.
+    pub clip: tcb_core::Clip,
+    /// The joint hierarchy (BVH and glTF files).
+    pub skeleton: Option<Skeleton>,
+    /// Things that were read but look wrong, for the user to see.
+    pub warnings: Vec<String>,
+}
+
+/// Load a clip (`.json`), a BVH file (`.bvh`) or a glTF file (`.gltf`,
+/// `.glb`), by extension, with default [`ImportOptions`].
+///
+/// ```
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// let loaded = tcb_io::load(path.as_ref())?;
+/// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31);
+/// assert_eq!(loaded.clip.tracks[0].name, "Hips.translation");
+/// # Ok::<(), tcb_io::Error>(())
+/// ```
+pub fn load(path: &Path) -> Result<Loaded, Error> {
+    load_with(path, &ImportOptions::default())
+}
+
+/// [`load`] with options.
+pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (doc, skeleton, warnings) = match ext.as_str() {
+        "json" => (read_clip_doc(path)?, None, Vec::new()),
+        "bvh" => {
+            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            let bvh = bvh::Bvh::parse(&text).map_err(|e| e.in_file(path))?;
+            let doc = bvh
+                .to_clip_doc(&stem, options.rotation)
+                .map_err(|e| e.in_file(path))?;
+            (doc, Some(bvh.skeleton), bvh.warnings)
+        }
+        "gltf" | "glb" => {
+            let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+            let base = path.parent().unwrap_or(Path::new("."));
+            let g = gltf_import::import(&bytes, Some(base), options.animation.as_deref(), &stem)
+                .map_err(|e| e.in_file(path))?;
+            (g.doc, Some(g.skeleton), g.warnings)
+        }
+        _ => {
+            return Err(Error::import(format!(
+                "unknown file type '.{ext}' (expected .json, .bvh, .gltf or .glb)"
+            ))
+            .in_file(path));
+        }
+    };
+    let clip = doc.build().map_err(|e| e.in_file(path))?;
+    Ok(Loaded {
+        doc,
+        clip,
+        skeleton,
+        warnings,
+    })
+}
 
 /// Write `bytes` to `path` through a temporary file in the same directory,
 /// renamed over `path` only once everything is written and synced.

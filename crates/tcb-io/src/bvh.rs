@@ -1,0 +1,463 @@
+//! BVH motion capture: the hierarchy and the motion, as files in the wild
+//! write them (CRLF, tabs, trailing blank lines, `Frames:` counts that
+//! disagree with the rows).
+//!
+//! ```
+//! let text = "HIERARCHY\nROOT hip\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 2\nFrame Time: 0.5\n0 0 0 0 0 0\n1 2 3 90 0 0\n";
+//! let bvh = tcb_io::bvh::Bvh::parse(text)?;
+//! assert_eq!(bvh.frame_count(), 2);
+//! let doc = bvh.to_clip_doc("walk", tcb_core::RotationMode::Squad)?;
+//! assert_eq!(doc.tracks[0].name, "hip.translation");
+//! assert_eq!(doc.tracks[1].name, "hip.rotation");
+//! assert_eq!(doc.tracks[1].times, [0.0, 0.5]);
+//! # Ok::<(), tcb_io::Error>(())
+//! ```
+
+use crate::{ClipDoc, Error, SettingsDoc, TrackDoc};
+use glam::{DQuat, DVec3, Vec3};
+use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::{RotationMode, TrackKind};
+
+/// One BVH channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    /// `Xposition`, `Yposition`, `Zposition` (axis 0, 1, 2).
+    Position(usize),
+    /// `Xrotation`, `Yrotation`, `Zrotation`, in degrees (axis 0, 1, 2).
+    Rotation(usize),
+}
+
+impl Channel {
+    fn parse(name: &str) -> Option<Channel> {
+        let lower = name.to_ascii_lowercase();
+        let axis = match lower.as_bytes().first()? {
+            b'x' => 0,
+            b'y' => 1,
+            b'z' => 2,
+            _ => return None,
+        };
+        match &lower[1..] {
+            "position" => Some(Channel::Position(axis)),
+            "rotation" => Some(Channel::Rotation(axis)),
+            _ => None,
+        }
+    }
+}
+
+/// A parsed BVH file.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation = `OFFSET`.
+    pub skeleton: Skeleton,
+    /// Channels of each joint, in the order listed.
+    pub channels: Vec<Vec<Channel>>,
+    /// `End Site`s: the parent joint and the offset.
+    pub end_sites: Vec<(usize, Vec3)>,
+    /// `Frame Time`, seconds.
+    pub frame_time: f64,
+    /// Channel values, one row per frame, channels in hierarchy order.
+    pub values: Vec<f32>,
+    /// Things that were read but look wrong (a `Frames:` count that
+    /// disagrees with the rows).
+    pub warnings: Vec<String>,
+}
+
+/// Tokens of the hierarchy with their 1-based lines.
+struct Tokens<'a> {
+    tokens: Vec<(usize, &'a str)>,
+    at: usize,
+    last_line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    fn next(&mut self) -> Option<(usize, &'a str)> {
+        let t = self.tokens.get(self.at).copied();
+        self.at += 1;
+        t
+    }
+
+    fn expect(&mut self, what: &str) -> Result<(usize, &'a str), Error> {
+        self.next().ok_or_else(|| {
+            Error::syntax(
+                self.last_line,
+                format!("the hierarchy ends where {what} was expected"),
+            )
+        })
+    }
+
+    fn number(&mut self, what: &str) -> Result<f32, Error> {
+        let (line, tok) = self.expect(what)?;
+        match tok.parse::<f32>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(Error::syntax(
+                line,
+                format!("'{tok}' is not a finite number ({what})"),
+            )),
+        }
+    }
+
+    fn offset(&mut self) -> Result<Vec3, Error> {
+        Ok(Vec3::new(
+            self.number("OFFSET x")?,
+            self.number("OFFSET y")?,
+            self.number("OFFSET z")?,
+        ))
+    }
+}
+
+impl Bvh {
+    /// Parse BVH text.
+    pub fn parse(text: &str) -> Result<Bvh, Error> {
+        let lines: Vec<&str> = text.lines().collect();
+        let motion = lines
+            .iter()
+            .position(|l| l.split_whitespace().next() == Some("MOTION"))
+            .ok_or_else(|| Error::syntax(lines.len().max(1), "no MOTION section"))?;
+        let mut tokens = Tokens {
+            tokens: lines[..motion]
+                .iter()
+                .enumerate()
+                .flat_map(|(i, l)| l.split_whitespace().map(move |t| (i + 1, t)))
+                .collect(),
+            at: 0,
+            last_line: motion + 1,
+        };
+        let mut bvh = Bvh {
+            skeleton: Skeleton::default(),
+            channels: Vec::new(),
+            end_sites: Vec::new(),
+            frame_time: 0.0,
+            values: Vec::new(),
+            warnings: Vec::new(),
+        };
+        bvh.parse_hierarchy(&mut tokens)?;
+        bvh.parse_motion(&lines, motion)?;
+        Ok(bvh)
+    }
+
+    fn parse_hierarchy(&mut self, t: &mut Tokens) -> Result<(), Error> {
+        match t.next() {
+            Some((_, "HIERARCHY")) => {}
+            Some((line, tok)) => {
+                return Err(Error::syntax(
+                    line,
+                    format!("expected HIERARCHY, found '{tok}'"),
+                ));
+            }
+            None => return Err(Error::syntax(1, "expected HIERARCHY")),
+        }
+        // Joints open and not yet closed.
+        let mut stack: Vec<usize> = Vec::new();
+        while let Some((line, tok)) = t.next() {
+            match tok {
+                "ROOT" | "JOINT" => {
+                    if (tok == "ROOT") != stack.is_empty() {
+                        let msg = if tok == "ROOT" {
+                            "ROOT inside a joint (use JOINT)"
+                        } else {
+                            "JOINT outside any ROOT"
+                        };
+                        return Err(Error::syntax(line, msg));
+                    }
+                    let mut name = Vec::new();
+                    while let Some(&(l, w)) = t.tokens.get(t.at) {
+                        if l != line || w == "{" {
+                            break;
+                        }
+                        name.push(w);
+                        t.at += 1;
+                    }
+                    let name = name.join(" ");
+                    if name.is_empty() {
+                        return Err(Error::syntax(line, format!("{tok} without a name")));
+                    }
+                    if self.skeleton.joint(&name).is_some() {
+                        return Err(Error::syntax(
+                            line,
+                            format!("a second joint named '{name}'"),
+                        ));
+                    }
+                    match t.expect("'{'")? {
+                        (_, "{") => {}
+                        (l, w) => {
+                            return Err(Error::syntax(l, format!("expected '{{', found '{w}'")));
+                        }
+                    }
+                    self.skeleton.joints.push(Joint {
+                        name,
+                        parent: stack.last().copied(),
+                        rest: Transform::IDENTITY,
+                    });
+                    self.channels.push(Vec::new());
+                    stack.push(self.skeleton.joints.len() - 1);
+                }
+                "OFFSET" => {
+                    let j = *stack
+                        .last()
+                        .ok_or_else(|| Error::syntax(line, "OFFSET outside a joint"))?;
+                    self.skeleton.joints[j].rest.translation = t.offset()?;
+                }
+                "CHANNELS" => {
+                    let j = *stack
+                        .last()
+                        .ok_or_else(|| Error::syntax(line, "CHANNELS outside a joint"))?;
+                    let (l, n) = t.expect("the channel count")?;
+                    let n: usize = n
+                        .parse()
+                        .map_err(|_| Error::syntax(l, format!("'{n}' is not a channel count")))?;
+                    if n > 6 {
+                        return Err(Error::syntax(
+                            l,
+                            format!("CHANNELS {n}: at most 6 (X/Y/Z position and rotation)"),
+                        ));
+                    }
+                    let mut channels = Vec::with_capacity(n);
+                    for _ in 0..n {
+                        let (l, name) = t.expect("a channel name")?;
+                        let c = Channel::parse(name).ok_or_else(|| {
+                            Error::syntax(
+                                l,
+                                format!(
+                                    "unknown channel '{name}' (expected Xposition … Zrotation)"
+                                ),
+                            )
+                        })?;
+                        if channels.contains(&c) {
+                            return Err(Error::syntax(l, format!("channel '{name}' listed twice")));
+                        }
+                        channels.push(c);
+                    }
+                    self.channels[j] = channels;
+                }
+                "End" => {
+                    let j = *stack
+                        .last()
+                        .ok_or_else(|| Error::syntax(line, "End Site outside a joint"))?;
+                    for want in ["Site", "{", "OFFSET"] {
+                        let (l, w) = t.expect(want)?;
+                        if w != want {
+                            return Err(Error::syntax(
+                                l,
+                                format!("expected '{want}' in End Site, found '{w}'"),
+                            ));
+                        }
+                    }
+                    let offset = t.offset()?;
+                    match t.expect("'}'")? {
+                        (_, "}") => {}
+                        (l, w) => {
+                            return Err(Error::syntax(
+                                l,
+                                format!("expected '}}' closing End Site, found '{w}'"),
+                            ));
+                        }
+                    }
+                    self.end_sites.push((j, offset));
+                }
+                "}" => {
+                    if stack.pop().is_none() {
+                        return Err(Error::syntax(line, "'}' without a joint to close"));
+                    }
+                }
+                other => {
+                    return Err(Error::syntax(
+                        line,
+                        format!("unexpected '{other}' in the hierarchy"),
+                    ));
+                }
+            }
+        }
+        if !stack.is_empty() {
+            return Err(Error::syntax(
+                t.last_line,
+                "the hierarchy ends with joints not closed by '}'",
+            ));
+        }
+        if self.skeleton.joints.is_empty() {
+            return Err(Error::syntax(t.last_line, "no ROOT joint"));
+        }
+        if self.channel_count() == 0 {
+            return Err(Error::syntax(t.last_line, "no joint has CHANNELS"));
+        }
+        Ok(())
+    }
+
+    fn parse_motion(&mut self, lines: &[&str], motion: usize) -> Result<(), Error> {
+        // (1-based line, text) of the non-blank lines after MOTION.
+        let mut rest = lines
+            .iter()
+            .enumerate()
+            .skip(motion + 1)
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty());
+        let mut header = |key: &str| -> Result<(usize, String), Error> {
+            let (line, text) = rest.next().ok_or_else(|| {
+                Error::syntax(lines.len(), format!("'{key}' missing after MOTION"))
+            })?;
+            let value = text
+                .split_once(':')
+                .filter(|(k, _)| k.split_whitespace().collect::<Vec<_>>().join(" ") == key)
+                .map(|(_, v)| v.trim().to_string())
+                .ok_or_else(|| {
+                    Error::syntax(line, format!("expected '{key}: …', found '{text}'"))
+                })?;
+            Ok((line, value))
+        };
+        let (frames_line, frames) = header("Frames")?;
+        let claimed: u64 = frames
+            .parse()
+            .map_err(|_| Error::syntax(frames_line, format!("'{frames}' is not a frame count")))?;
+        let (line, dt) = header("Frame Time")?;
+        self.frame_time = match dt.parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => v,
+            _ => {
+                return Err(Error::syntax(
+                    line,
+                    format!("Frame Time '{dt}' is not a positive number of seconds"),
+                ));
+            }
+        };
+        let width = self.channel_count();
+        let mut rows = 0usize;
+        for (line, text) in rest {
+            let before = self.values.len();
+            for tok in text.split_whitespace() {
+                if self.values.len() - before == width {
+                    return Err(Error::syntax(
+                        line,
+                        format!("frame {rows} has more than {width} values (one per channel)"),
+                    ));
+                }
+                match tok.parse::<f32>() {
+                    Ok(v) if v.is_finite() => self.values.push(v),
+                    _ => {
+                        let c = self.values.len() - before;
+                        return Err(Error::syntax(
+                            line,
+                            format!(
+                                "frame {rows}, channel {c} ({}): '{tok}' is not a finite number",
+                                self.channel_name(c)
+                            ),
+                        ));
+                    }
+                }
+            }
+            let got = self.values.len() - before;
+            if got != width {
+                return Err(Error::syntax(
+                    line,
+                    format!(
+                        "frame {rows} has {got} values, expected {width} (truncated or malformed row)"
+                    ),
+                ));
+            }
+            rows += 1;
+        }
+        if claimed != rows as u64 {
+            self.warnings.push(format!(
+                "line {frames_line}: the header says Frames: {claimed} but {rows} rows follow; read the {rows} rows"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Number of channels (values per frame).
+    pub fn channel_count(&self) -> usize {
+        self.channels.iter().map(Vec::len).sum()
+    }
+
+    /// Number of frames read.
+    pub fn frame_count(&self) -> usize {
+        self.values.len() / self.channel_count().max(1)
+    }
+
+    fn channel_name(&self, mut c: usize) -> String {
+        for (j, ch) in self.channels.iter().enumerate() {
+            if c < ch.len() {
+                let (kind, axis) = match ch[c] {
+                    Channel::Position(a) => ("position", a),
+                    Channel::Rotation(a) => ("rotation", a),
+                };
+                return format!(
+                    "{} {}{kind}",
+                    self.skeleton.joints[j].name,
+                    ["X", "Y", "Z"][axis]
+                );
+            }
+            c -= ch.len();
+        }
+        String::new()
+    }
+
+    /// The local translation and rotation of `joint` in `frame`: position
+    /// channels as written (the `OFFSET` on axes without one), rotation
+    /// channels composed in the order listed (`Zrotation Xrotation
+    /// Yrotation` is `qz * qx * qy`), in f64.
+    pub fn local(&self, frame: usize, joint: usize) -> (DVec3, DQuat) {
+        let first: usize = self.channels[..joint].iter().map(Vec::len).sum();
+        let row = &self.values[frame * self.channel_count()..];
+        let mut t = self.skeleton.joints[joint].rest.translation.as_dvec3();
+        let mut q = DQuat::IDENTITY;
+        for (i, c) in self.channels[joint].iter().enumerate() {
+            let v = f64::from(row[first + i]);
+            match *c {
+                Channel::Position(a) => t[a] = v,
+                Channel::Rotation(a) => {
+                    let axis = [DVec3::X, DVec3::Y, DVec3::Z][a];
+                    q *= DQuat::from_axis_angle(axis, v.to_radians());
+                }
+            }
+        }
+        (t, q.normalize())
+    }
+
+    /// The clip: per joint, `<joint>.translation` (vec3) if it has position
+    /// channels and `<joint>.rotation` (quat, `rotation` mode) if it has
+    /// rotation channels, one key per frame at `frame * Frame Time`.
+    pub fn to_clip_doc(&self, name: &str, rotation: RotationMode) -> Result<ClipDoc, Error> {
+        let frames = self.frame_count();
+        if frames < 2 {
+            return Err(Error::import(format!(
+                "{frames} frame(s) of motion: a clip needs at least 2"
+            )));
+        }
+        let times: Vec<f64> = (0..frames).map(|f| f as f64 * self.frame_time).collect();
+        let mut tracks = Vec::new();
+        for (j, joint) in self.skeleton.joints.iter().enumerate() {
+            let ch = &self.channels[j];
+            let has_pos = ch.iter().any(|c| matches!(c, Channel::Position(_)));
+            let has_rot = ch.iter().any(|c| matches!(c, Channel::Rotation(_)));
+            let track = |suffix: &str, kind: TrackKind, values: Vec<[f32; 4]>| TrackDoc {
+                name: format!("{}.{suffix}", joint.name),
+                kind,
+                times: times.clone(),
+                values,
+                keys: Vec::new(),
+                settings: SettingsDoc::default(),
+            };
+            if has_pos {
+                let values = (0..frames)
+                    .map(|f| {
+                        let t = self.local(f, j).0.as_vec3();
+                        [t.x, t.y, t.z, 0.0]
+                    })
+                    .collect();
+                tracks.push(track("translation", TrackKind::Vec3, values));
+            }
+            if has_rot {
+                let values = (0..frames)
+                    .map(|f| self.local(f, j).1.as_quat().to_array())
+                    .collect();
+                tracks.push(track("rotation", TrackKind::Quat, values));
+            }
+        }
+        Ok(ClipDoc {
+            name: name.to_string(),
+            defaults: SettingsDoc {
+                rotation: Some(rotation),
+                ..SettingsDoc::default()
+            },
+            tracks,
+        })
+    }
+}

@@ -1,0 +1,491 @@
+//! glTF 2.0 animations (`.gltf` with external or data-URI buffers, `.glb`).
+//!
+//! Buffers are resolved here rather than by the `gltf` crate's `import`
+//! feature (which would pull in image decoding), and every accessor is
+//! checked against the bytes that exist before anything is read or
+//! allocated, so a file claiming more than it holds is an error, not a panic
+//! or a huge allocation.
+
+use crate::{ClipDoc, Error, KeyDoc, SettingsDoc, TrackDoc};
+use glam::{Quat, Vec3};
+use gltf::Document;
+use gltf::accessor::{DataType, Dimensions};
+use gltf::animation::{Interpolation, Property};
+use std::path::Path;
+use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::{Interp, RotationMode, TrackKind};
+
+/// A glTF file's hierarchy and one of its animations as a clip.
+#[derive(Clone, Debug)]
+pub struct GltfImport {
+    /// The animation as a clip document.
+    pub doc: ClipDoc,
+    /// Every node reachable from a root, parents first, with its rest
+    /// transform; joint names are the track name prefixes.
+    pub skeleton: Skeleton,
+    /// Things that were read but look odd.
+    pub warnings: Vec<String>,
+}
+
+/// Import animation `animation` (a name or an index; the first when `None`)
+/// from glTF or GLB bytes. `base` is the directory external buffers are
+/// relative to (`None`: external buffers are an error).
+pub fn import(
+    bytes: &[u8],
+    base: Option<&Path>,
+    animation: Option<&str>,
+    name: &str,
+) -> Result<GltfImport, Error> {
+    let gltf = gltf::Gltf::from_slice(bytes)
+        .map_err(|e| Error::import(format!("not a valid glTF 2.0 file: {e}")))?;
+    let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base)?;
+    let mut warnings = Vec::new();
+    let names = node_names(&gltf.document, &mut warnings);
+    let skeleton = skeleton(&gltf.document, &names);
+
+    let animations: Vec<_> = gltf.document.animations().collect();
+    if animations.is_empty() {
+        return Err(Error::import("the file has no animations"));
+    }
+    let anim = match animation {
+        None => {
+            if animations.len() > 1 {
+                warnings.push(format!(
+                    "{} animations; imported the first ({}); choose with --animation NAME_OR_INDEX",
+                    animations.len(),
+                    describe(&animations[0])
+                ));
+            }
+            animations[0].clone()
+        }
+        Some(want) => animations
+            .iter()
+            .find(|a| a.name() == Some(want))
+            .or_else(|| want.parse::<usize>().ok().and_then(|i| animations.get(i)))
+            .cloned()
+            .ok_or_else(|| {
+                let all: Vec<String> = animations.iter().map(describe).collect();
+                Error::import(format!(
+                    "no animation '{want}' (the file has: {})",
+                    all.join(", ")
+                ))
+            })?,
+    };
+
+    let mut tracks = Vec::new();
+    for (c, channel) in anim.channels().enumerate() {
+        let target = channel.target();
+        let node = &names[target.node().index()];
+        let sampler = channel.sampler();
+        let what = |m: String| {
+            Error::import(format!(
+                "animation {}, channel {c} ({node}): {m}",
+                describe(&anim)
+            ))
+        };
+        let times: Vec<f64> = read(&buffers, &sampler.input(), 1)
+            .map_err(|m| what(format!("input: {m}")))?
+            .into_iter()
+            .map(f64::from)
+            .collect();
+        let interp = sampler.interpolation();
+        let per_key = if interp == Interpolation::CubicSpline {
+            3
+        } else {
+            1
+        };
+        let (suffix, kind, dim) = match target.property() {
+            Property::Translation => ("translation", TrackKind::Vec3, 3),
+            Property::Rotation => ("rotation", TrackKind::Quat, 4),
+            Property::Scale => ("scale", TrackKind::Vec3, 3),
+            Property::MorphTargetWeights => ("weights", TrackKind::Scalar, 1),
+        };
+        let out =
+            read(&buffers, &sampler.output(), dim).map_err(|m| what(format!("output: {m}")))?;
+        let rows = out.len() / dim;
+        let elements = times.len() * per_key;
+        if elements == 0 || rows % elements != 0 || (dim > 1 && rows != elements) {
+            return Err(what(format!(
+                "{} input times but {rows} output elements (expected {} per key{})",
+                times.len(),
+                per_key,
+                if dim == 1 { " per morph target" } else { "" }
+            )));
+        }
+        let targets = rows / elements;
+        for target_index in 0..targets {
+            // Element e of key k, morph target i: row (k * per_key + e) * targets + i.
+            let value = |k: usize, e: usize| -> [f32; 4] {
+                let row = (k * per_key + e) * targets + target_index;
+                let mut v = [0.0; 4];
+                v[..dim].copy_from_slice(&out[row * dim..(row + 1) * dim]);
+                v
+            };
+            let value_e = if per_key == 3 { 1 } else { 0 };
+            let mut values: Vec<[f32; 4]> = (0..times.len()).map(|k| value(k, value_e)).collect();
+            let mut keys: Vec<KeyDoc> = (0..times.len())
+                .map(|k| match interp {
+                    Interpolation::Linear => KeyDoc {
+                        interp: Some(Interp::Linear),
+                        ..KeyDoc::default()
+                    },
+                    Interpolation::Step => KeyDoc {
+                        interp: Some(Interp::Step),
+                        ..KeyDoc::default()
+                    },
+                    Interpolation::CubicSpline => KeyDoc {
+                        tangent_in: Some(value(k, 0)),
+                        tangent_out: Some(value(k, 2)),
+                        ..KeyDoc::default()
+                    },
+                })
+                .collect();
+            let mut times = times.clone();
+            if times.len() == 1 {
+                // A constant: a clip track needs two keys.
+                times.push(times[0] + 1.0);
+                values.push(values[0]);
+                keys.push(keys[0].clone());
+                keys[0].interp = Some(Interp::Step);
+                warnings.push(format!(
+                    "{node}.{suffix}: one key; held as a constant (second key at {} s)",
+                    times[1]
+                ));
+            }
+            let name = if kind == TrackKind::Scalar {
+                format!("{node}.weights.{target_index}")
+            } else {
+                format!("{node}.{suffix}")
+            };
+            if tracks.iter().any(|t: &TrackDoc| t.name == name) {
+                return Err(what(format!("a second channel animates '{name}'")));
+            }
+            let mut settings = SettingsDoc::default();
+            if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
+                settings.rotation = Some(RotationMode::Hermite);
+            }
+            tracks.push(TrackDoc {
+                name,
+                kind,
+                times,
+                values,
+                keys,
+                settings,
+            });
+        }
+    }
+    Ok(GltfImport {
+        doc: ClipDoc {
+            name: anim.name().unwrap_or(name).to_string(),
+            defaults: SettingsDoc::default(),
+            tracks,
+        },
+        skeleton,
+        warnings,
+    })
+}
+
+fn describe(a: &gltf::Animation) -> String {
+    match a.name() {
+        Some(n) => format!("'{n}' ({})", a.index()),
+        None => format!("{}", a.index()),
+    }
+}
+
+/// `<node name>`, or `node<index>` for an unnamed node or a repeated name.
+fn node_names(doc: &Document, warnings: &mut Vec<String>) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for node in doc.nodes() {
+        let fallback = format!("node{}", node.index());
+        let name = match node.name() {
+            Some(n) if !n.is_empty() && !names.iter().any(|m| m == n) => n.to_string(),
+            Some(n) if !n.is_empty() => {
+                warnings.push(format!(
+                    "node {} repeats the name '{n}'; its tracks are named '{fallback}'",
+                    node.index()
+                ));
+                fallback
+            }
+            _ => fallback,
+        };
+        names.push(name);
+    }
+    names
+}
+
+fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
+    let n = doc.nodes().len();
+    let mut parent = vec![None; n];
+    for node in doc.nodes() {
+        for child in node.children() {
+            if parent[child.index()].is_none() && child.index() != node.index() {
+                parent[child.index()] = Some(node.index());
+            }
+        }
+    }
+    // Breadth first from the roots: parents before children; nodes on a
+    // cycle are never reached and left out.
+    let mut order: Vec<usize> = (0..n).filter(|&i| parent[i].is_none()).collect();
+    let mut seen = vec![false; n];
+    for &i in &order {
+        seen[i] = true;
+    }
+    let mut at = 0;
+    while at < order.len() {
+        let node = doc.nodes().nth(order[at]).expect("index from the document");
+        for child in node.children() {
+            if !seen[child.index()] && parent[child.index()] == Some(node.index()) {
+                seen[child.index()] = true;
+                order.push(child.index());
+            }
+        }
+        at += 1;
+    }
+    let mut slot = vec![usize::MAX; n];
+    for (j, &i) in order.iter().enumerate() {
+        slot[i] = j;
+    }
+    let joints = order
+        .iter()
+        .map(|&i| {
+            let node = doc.nodes().nth(i).expect("index from the document");
+            let (t, r, s) = node.transform().decomposed();
+            Joint {
+                name: names[i].clone(),
+                parent: parent[i].map(|p| slot[p]),
+                rest: Transform {
+                    translation: Vec3::from_array(t),
+                    rotation: Quat::from_array(r),
+                    scale: Vec3::from_array(s),
+                },
+            }
+        })
+        .collect();
+    Skeleton { joints }
+}
+
+fn load_buffers(
+    doc: &Document,
+    blob: Option<&[u8]>,
+    base: Option<&Path>,
+) -> Result<Vec<Vec<u8>>, Error> {
+    doc.buffers()
+        .map(|b| {
+            let i = b.index();
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => blob
+                    .ok_or_else(|| {
+                        Error::import(format!(
+                            "buffer {i}: refers to the GLB binary chunk, which is missing"
+                        ))
+                    })?
+                    .to_vec(),
+                gltf::buffer::Source::Uri(uri) => {
+                    if let Some(rest) = uri.strip_prefix("data:") {
+                        let (head, payload) = rest.split_once(',').ok_or_else(|| {
+                            Error::import(format!("buffer {i}: malformed data URI"))
+                        })?;
+                        if !head.ends_with(";base64") {
+                            return Err(Error::import(format!(
+                                "buffer {i}: only base64 data URIs are supported"
+                            )));
+                        }
+                        base64_decode(payload)
+                            .map_err(|m| Error::import(format!("buffer {i}: {m}")))?
+                    } else {
+                        let base = base.ok_or_else(|| {
+                            Error::import(format!(
+                                "buffer {i}: external file '{uri}' but no directory to find it in"
+                            ))
+                        })?;
+                        let path = base.join(percent_decode(uri));
+                        std::fs::read(&path).map_err(|e| Error::io(&path, e))?
+                    }
+                }
+            };
+            if data.len() < b.length() {
+                return Err(Error::import(format!(
+                    "buffer {i}: {} bytes, but the file says {}",
+                    data.len(),
+                    b.length()
+                )));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+/// Read accessor `a` as f32 rows of `dim` components (normalized integers
+/// converted as the glTF spec says), after checking that every byte it
+/// names exists.
+fn read(buffers: &[Vec<u8>], a: &gltf::Accessor, dim: usize) -> Result<Vec<f32>, String> {
+    let want = match dim {
+        1 => Dimensions::Scalar,
+        3 => Dimensions::Vec3,
+        _ => Dimensions::Vec4,
+    };
+    if a.dimensions() != want {
+        return Err(format!(
+            "accessor {} is {:?}, expected {want:?}",
+            a.index(),
+            a.dimensions()
+        ));
+    }
+    if a.sparse().is_some() {
+        return Err(format!(
+            "accessor {} is sparse (not supported for animation)",
+            a.index()
+        ));
+    }
+    let ty = a.data_type();
+    let float = ty == DataType::F32;
+    if !float && !a.normalized() {
+        return Err(format!(
+            "accessor {} is {ty:?} and not normalized (expected floats)",
+            a.index()
+        ));
+    }
+    let size = ty.size();
+    let count = a.count();
+    let Some(view) = a.view() else {
+        return Err(format!("accessor {} has no buffer view", a.index()));
+    };
+    let data = &buffers[view.buffer().index()];
+    let elem = size * dim;
+    let stride = view.stride().unwrap_or(elem);
+    let range = (|| {
+        let view_end = view.offset().checked_add(view.length())?;
+        let last = count.checked_sub(1)?.checked_mul(stride)?;
+        let end = a.offset().checked_add(last)?.checked_add(elem)?;
+        (stride >= elem && end <= view.length() && view_end <= data.len()).then_some(())
+    })();
+    if count == 0 {
+        return Err(format!("accessor {} has no elements", a.index()));
+    }
+    if range.is_none() {
+        return Err(format!(
+            "accessor {}: {count} elements of {elem} bytes (stride {stride}) from byte {} do not fit in buffer view {} ({} bytes) or its buffer",
+            a.index(),
+            a.offset(),
+            view.index(),
+            view.length()
+        ));
+    }
+    let bytes = &data[view.offset() + a.offset()..];
+    let mut out = Vec::with_capacity(count * dim);
+    for e in 0..count {
+        for c in 0..dim {
+            let at = e * stride + c * size;
+            let b = &bytes[at..at + size];
+            let v = match ty {
+                DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                DataType::I8 => (f32::from(b[0] as i8) / 127.0).max(-1.0),
+                DataType::U8 => f32::from(b[0]) / 255.0,
+                DataType::I16 => (f32::from(i16::from_le_bytes([b[0], b[1]])) / 32767.0).max(-1.0),
+                DataType::U16 => f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0,
+                DataType::U32 => {
+                    return Err(format!(
+                        "accessor {} is u32 (not allowed for animation)",
+                        a.index()
+                    ));
+                }
+            };
+            if !v.is_finite() {
+                return Err(format!("accessor {}: element {e} is not finite", a.index()));
+            }
+            out.push(v);
+        }
+    }
+    Ok(out)
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Standard base64 (RFC 4648), padding optional, whitespace ignored.
+pub(crate) fn base64_decode(s: &str) -> Result<Vec<u8>, String> {
+    let mut out = Vec::with_capacity(s.len() / 4 * 3);
+    let (mut acc, mut bits) = (0u32, 0u32);
+    for (i, c) in s.bytes().enumerate() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            b'=' => break,
+            b' ' | b'\n' | b'\r' | b'\t' => continue,
+            _ => return Err(format!("invalid base64 character at {i}")),
+        };
+        acc = (acc << 6) | u32::from(v);
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    Ok(out)
+}
+
+/// Standard base64 with padding.
+#[allow(dead_code)] // for the exporter
+pub(crate) fn base64_encode(data: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(data.len().div_ceil(3) * 4);
+    for chunk in data.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(A[(n >> (18 - 6 * k)) as usize & 63] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_round_trips() {
+        for n in 0..20u8 {
+            let data: Vec<u8> = (0..n).map(|i| i.wrapping_mul(37)).collect();
+            assert_eq!(base64_decode(&base64_encode(&data)).unwrap(), data);
+        }
+        assert_eq!(base64_encode(b"Man"), "TWFu");
+        assert_eq!(base64_decode("TWE=").unwrap(), b"Ma");
+        assert!(base64_decode("TW!u").is_err());
+    }
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("a%20b.bin"), "a b.bin");
+        assert_eq!(percent_decode("100%"), "100%");
+    }
+}

@@ -1,0 +1,268 @@
+//! BVH import against the real CMU file (bundled in `data/`) and against
+//! the damaged files motion capture arrives as.
+
+use glam::{DQuat, Quat};
+use std::path::{Path, PathBuf};
+use tcb_io::bvh::Bvh;
+use tcb_io::{ErrorKind, ImportOptions, load_with};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(name)
+}
+
+/// The channel layout and rows, read here independently of `tcb_io::bvh`:
+/// per joint with channels, its name and channel names; then the rows.
+/// Joint name and channel names.
+type Layout = Vec<(String, Vec<String>)>;
+
+fn raw(text: &str) -> (Layout, Vec<Vec<f64>>, f64) {
+    let mut joints = Vec::new();
+    let mut name = String::new();
+    let mut lines = text.lines();
+    for line in lines.by_ref() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.first() {
+            Some(&"ROOT") | Some(&"JOINT") => name = w[1].to_string(),
+            Some(&"CHANNELS") => {
+                joints.push((name.clone(), w[2..].iter().map(|s| s.to_string()).collect()))
+            }
+            Some(&"MOTION") => break,
+            _ => {}
+        }
+    }
+    lines.next();
+    let dt: f64 = lines
+        .next()
+        .unwrap()
+        .split(':')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (joints, rows, dt)
+}
+
+fn close_quat(a: Quat, b: DQuat) -> f64 {
+    let a = a.as_dquat();
+    let d = (a - b)
+        .to_array()
+        .iter()
+        .map(|x| x.abs())
+        .fold(0.0, f64::max);
+    let e = (a + b)
+        .to_array()
+        .iter()
+        .map(|x| x.abs())
+        .fold(0.0, f64::max);
+    d.min(e)
+}
+
+#[test]
+fn cmu_every_frame_reproduced() {
+    for mode in [
+        tcb_core::RotationMode::Squad,
+        tcb_core::RotationMode::Hermite,
+    ] {
+        let path = data("cmu-01_01.bvh");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (joints, rows, dt) = raw(&text);
+        assert_eq!(rows.len(), 2752);
+        let options = ImportOptions {
+            rotation: mode,
+            ..Default::default()
+        };
+        let loaded = load_with(&path, &options).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        let clip = &loaded.clip;
+        assert_eq!(loaded.skeleton.as_ref().unwrap().joints.len(), 31);
+        assert_eq!(clip.channel_count(), 3 + 31 * 4);
+        let mut row = vec![0.0f32; clip.channel_count()];
+        let (mut worst_t, mut worst_q) = (0.0f64, 0.0f64);
+        for (f, values) in rows.iter().enumerate() {
+            clip.sample_into(f as f64 * dt, &mut row, None);
+            let mut col = 0; // into `values`
+            let mut out = 0; // into `row`
+            for (_, channels) in &joints {
+                let mut q = DQuat::IDENTITY;
+                let mut has_pos = false;
+                let mut pos = [0.0f64; 3];
+                for c in channels {
+                    let v = values[col];
+                    col += 1;
+                    let axis = match &c[..1] {
+                        "X" => 0,
+                        "Y" => 1,
+                        _ => 2,
+                    };
+                    if c.ends_with("position") {
+                        has_pos = true;
+                        pos[axis] = v;
+                    } else {
+                        let r = v.to_radians();
+                        q *= [
+                            DQuat::from_rotation_x(r),
+                            DQuat::from_rotation_y(r),
+                            DQuat::from_rotation_z(r),
+                        ][axis];
+                    }
+                }
+                if has_pos {
+                    for (i, p) in pos.iter().enumerate() {
+                        worst_t =
+                            worst_t.max((f64::from(row[out + i]) - p).abs() / p.abs().max(1.0));
+                    }
+                    out += 3;
+                }
+                let got = Quat::from_slice(&row[out..out + 4]);
+                worst_q = worst_q.max(close_quat(got, q));
+                out += 4;
+            }
+        }
+        assert!(
+            worst_t <= 1e-5,
+            "{mode:?}: translation off by {worst_t} (relative)"
+        );
+        assert!(worst_q <= 1e-5, "{mode:?}: rotation off by {worst_q}");
+        println!("{mode:?}: worst translation {worst_t:e}, rotation {worst_q:e}");
+    }
+}
+
+const SMALL: &str = "HIERARCHY\nROOT hip\n{\n\tOFFSET 1 2 3\n\tCHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation\n\tJOINT knee\n\t{\n\t\tOFFSET 0 -1 0\n\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0 -1 0\n\t\t}\n\t}\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n0 0 0 0 0 0 0 0 0\n1 2 3 90 0 0 10 20 30\n2 4 6 0 90 0 -10 -20 -30\n";
+
+#[test]
+fn euler_order_as_listed() {
+    let bvh = Bvh::parse(SMALL).unwrap();
+    assert_eq!(bvh.frame_count(), 3);
+    assert_eq!(bvh.end_sites.len(), 1);
+    let (_, q) = bvh.local(1, 1);
+    let r = |d: f64| d.to_radians();
+    // Zrotation Xrotation Yrotation: qz * qx * qy, intrinsic.
+    let want = DQuat::from_rotation_z(r(10.0))
+        * DQuat::from_rotation_x(r(20.0))
+        * DQuat::from_rotation_y(r(30.0));
+    assert!(close_quat(q.as_quat(), want) < 1e-7);
+    // And the same as glam's intrinsic Euler convention.
+    let glam_q = DQuat::from_euler(glam::EulerRot::ZXY, r(10.0), r(20.0), r(30.0));
+    assert!(close_quat(q.as_quat(), glam_q) < 1e-7);
+    let (t, _) = bvh.local(2, 0);
+    assert_eq!(t.to_array(), [2.0, 4.0, 6.0]);
+}
+
+#[test]
+fn crlf_tabs_and_trailing_blank_lines_read_the_same() {
+    let crlf = SMALL.replace('\n', "\r\n").replace(' ', " \t") + "\r\n\r\n   \r\n";
+    let a = Bvh::parse(SMALL).unwrap();
+    let b = Bvh::parse(&crlf).unwrap();
+    assert_eq!(a.values, b.values);
+    assert_eq!(a.skeleton, b.skeleton);
+    assert!(b.warnings.is_empty());
+}
+
+fn error(text: &str) -> String {
+    match Bvh::parse(text) {
+        Ok(_) => panic!("parsed: {text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn frame_count_disagreeing_with_rows_is_a_warning() {
+    let more = SMALL.replace("Frames: 3", "Frames: 1000000000");
+    let bvh = Bvh::parse(&more).unwrap();
+    assert_eq!(bvh.frame_count(), 3);
+    assert_eq!(
+        bvh.warnings,
+        ["line 17: the header says Frames: 1000000000 but 3 rows follow; read the 3 rows"]
+    );
+    let fewer = SMALL.replace("Frames: 3", "Frames: 2");
+    assert_eq!(Bvh::parse(&fewer).unwrap().frame_count(), 3);
+}
+
+#[test]
+fn damaged_files_are_clear_errors_naming_the_line() {
+    // A row cut short (the file truncated mid-row).
+    let cut = &SMALL[..SMALL.len() - 8];
+    assert_eq!(
+        error(cut),
+        "line 21: frame 2 has 7 values, expected 9 (truncated or malformed row)"
+    );
+    // A row with too many values.
+    assert_eq!(
+        error(&SMALL.replace("0 0 0 0 0 0 0 0 0\n", "0 0 0 0 0 0 0 0 0 0\n")),
+        "line 19: frame 0 has more than 9 values (one per channel)"
+    );
+    // Not a number, with the channel it was for.
+    assert_eq!(
+        error(&SMALL.replace("1 2 3 90", "1 2 3 nan")),
+        "line 20: frame 1, channel 3 (hip Xrotation): 'nan' is not a finite number"
+    );
+    assert_eq!(
+        error(&SMALL.replace(
+            "Xrotation Yrotation Zrotation",
+            "Xrotation Yrotation Wrotation"
+        )),
+        "line 5: unknown channel 'Wrotation' (expected Xposition … Zrotation)"
+    );
+    assert_eq!(
+        error(&SMALL.replace("CHANNELS 3", "CHANNELS 1000000000")),
+        "line 9: CHANNELS 1000000000: at most 6 (X/Y/Z position and rotation)"
+    );
+    assert_eq!(
+        error(&SMALL.replace("MOTION", "MOTON")),
+        "line 21: no MOTION section"
+    );
+    assert_eq!(
+        error(&SMALL.replace("Frame Time: 0.1", "Frame Time: 0")),
+        "line 18: Frame Time '0' is not a positive number of seconds"
+    );
+    assert_eq!(
+        error(&SMALL.replace("\t}\n}\nMOTION", "\t}\nMOTION")),
+        "line 15: the hierarchy ends with joints not closed by '}'"
+    );
+    assert_eq!(
+        error(&SMALL.replace("JOINT knee", "JOINT hip")),
+        "line 6: a second joint named 'hip'"
+    );
+    assert_eq!(error(""), "line 1: no MOTION section");
+    assert_eq!(error("MOTION\n"), "line 1: expected HIERARCHY");
+    let header_only = &SMALL[..SMALL.find("Frames").unwrap()];
+    assert_eq!(error(header_only), "line 16: 'Frames' missing after MOTION");
+}
+
+#[test]
+fn errors_from_files_name_the_file_and_nothing_is_written() {
+    let dir = std::env::temp_dir().join(format!("tcb-bvh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("cut.bvh");
+    std::fs::write(&path, &SMALL[..SMALL.len() - 8]).unwrap();
+    let err = tcb_io::load(&path).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Syntax { line: 21, .. }));
+    assert!(
+        err.to_string().starts_with(&path.display().to_string()),
+        "{err}"
+    );
+    let one = dir.join("one.bvh");
+    std::fs::write(
+        &one,
+        SMALL
+            .replace("Frames: 3", "Frames: 1")
+            .lines()
+            .take(19)
+            .collect::<Vec<_>>()
+            .join("\n"),
+    )
+    .unwrap();
+    let err = tcb_io::load(&one).unwrap_err().to_string();
+    assert!(
+        err.ends_with("1 frame(s) of motion: a clip needs at least 2"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,204 @@
+//! glTF import: the real Khronos sample (bundled in `data/`), and files that
+//! claim more than they hold.
+
+use glam::Quat;
+use std::path::{Path, PathBuf};
+use tcb_io::gltf_import::import;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(name)
+}
+
+/// Decode base64 here, independently of the importer.
+fn b64(s: &str) -> Vec<u8> {
+    let v = |c: u8| {
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/"
+            .bytes()
+            .position(|a| a == c)
+            .unwrap() as u32
+    };
+    let s: Vec<u8> = s.bytes().filter(|&c| c != b'=').collect();
+    let mut out = Vec::new();
+    for chunk in s.chunks(4) {
+        let n = chunk
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (i, &c)| n | v(c) << (18 - 6 * i));
+        out.extend_from_slice(&n.to_be_bytes()[1..chunk.len()]);
+    }
+    out
+}
+
+#[test]
+fn simple_skin_samples_as_gltf_linear_slerp() {
+    let path = data("simple_skin.gltf");
+    let loaded = tcb_io::load(&path).unwrap();
+    let clip = &loaded.clip;
+    assert_eq!(clip.tracks.len(), 1);
+    assert_eq!(clip.tracks[0].name, "node2.rotation");
+    let skeleton = loaded.skeleton.unwrap();
+    assert_eq!(skeleton.joints.len(), 3);
+    assert_eq!(skeleton.joints[2].parent, Some(1));
+
+    // The keys, read with the gltf crate's own reader.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let g = gltf::Gltf::from_slice(text.as_bytes()).unwrap();
+    let buffers: Vec<Vec<u8>> = g
+        .buffers()
+        .map(|b| match b.source() {
+            gltf::buffer::Source::Uri(u) => b64(u.split_once(',').unwrap().1),
+            _ => unreachable!(),
+        })
+        .collect();
+    let channel = g.animations().next().unwrap().channels().next().unwrap();
+    let reader = channel.reader(|b| Some(&buffers[b.index()]));
+    let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+    let keys: Vec<Quat> = match reader.read_outputs().unwrap() {
+        gltf::animation::util::ReadOutputs::Rotations(r) => {
+            r.into_f32().map(Quat::from_array).collect()
+        }
+        _ => unreachable!(),
+    };
+    assert_eq!(times.len(), 12);
+
+    let mut row = [0.0f32; 4];
+    let mut worst = 0.0f32;
+    for k in 0..times.len() - 1 {
+        for i in 0..=10 {
+            let u = i as f32 / 10.0;
+            let t = times[k] + u * (times[k + 1] - times[k]);
+            clip.sample_into(f64::from(t), &mut row, None);
+            // glTF LINEAR rotation: shortest-path slerp, in f64, of the keys
+            // as rotations (the file's 0.707 is not quite unit length).
+            let (a, b) = (
+                keys[k].as_dquat().normalize(),
+                keys[k + 1].as_dquat().normalize(),
+            );
+            let want = a.slerp(b, f64::from(u)).as_quat();
+            let got = Quat::from_array(row);
+            let d = (got - want).length().min((got + want).length());
+            worst = worst.max(d);
+        }
+    }
+    assert!(worst < 1e-5, "worst {worst}");
+}
+
+fn gltf_with(accessors: &str, buffer: &[u8]) -> String {
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        // A tiny encoder, for the test's own buffers.
+        {
+            let a = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+            let mut s = String::new();
+            for c in buffer.chunks(3) {
+                let n = (u32::from(c[0]) << 16)
+                    | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+                    | u32::from(*c.get(2).unwrap_or(&0));
+                for k in 0..4 {
+                    s.push(if k <= c.len() {
+                        a[(n >> (18 - 6 * k)) as usize & 63] as char
+                    } else {
+                        '='
+                    });
+                }
+            }
+            s
+        }
+    );
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "nodes": [{{"name": "box"}}],
+        "buffers": [{{"byteLength": {}, "uri": "{uri}"}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": {}}}],
+        "accessors": [{accessors}],
+        "animations": [{{"channels": [{{"sampler": 0, "target": {{"node": 0, "path": "translation"}}}}],
+                        "samplers": [{{"input": 0, "output": 1, "interpolation": "LINEAR"}}]}}]}}"#,
+        buffer.len(),
+        buffer.len()
+    )
+}
+
+fn floats(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+#[test]
+fn a_valid_small_file_imports() {
+    let buf = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    let acc = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#;
+    let g = import(gltf_with(acc, &buf).as_bytes(), None, None, "t").unwrap();
+    assert_eq!(g.doc.tracks[0].name, "box.translation");
+    assert_eq!(g.doc.tracks[0].values[1], [4.0, 5.0, 6.0, 0.0]);
+    let clip = g.doc.build().unwrap();
+    let mut row = [0.0f32; 3];
+    clip.sample_into(0.5, &mut row, None);
+    assert_eq!(row, [2.5, 3.5, 4.5]);
+}
+
+#[test]
+fn absurd_files_are_errors_not_panics() {
+    let buf = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    let cases = [
+        // A billion keys in 32 bytes.
+        (
+            r#"{"bufferView": 0, "componentType": 5126, "count": 1000000000, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
+            "do not fit in buffer view 0",
+        ),
+        // An offset past the end.
+        (
+            r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 24, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
+            "do not fit in buffer view 0",
+        ),
+        // Outputs of the wrong shape.
+        (
+            r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC2"}"#,
+            "is Vec2, expected Vec3",
+        ),
+        // Fewer output rows than keys.
+        (
+            r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 1, "type": "VEC3"}"#,
+            "2 input times but 1 output elements",
+        ),
+        // Integer times.
+        (
+            r#"{"bufferView": 0, "componentType": 5125, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
+            "not normalized",
+        ),
+    ];
+    for (acc, want) in cases {
+        let err = import(gltf_with(acc, &buf).as_bytes(), None, None, "t")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(want), "{err}");
+    }
+    // A buffer shorter than it says.
+    let text = gltf_with(
+        r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+           {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
+        &buf,
+    )
+    .replace(r#""byteLength": 32, "uri""#, r#""byteLength": 4000000000, "uri""#);
+    let err = import(text.as_bytes(), None, None, "t")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("32 bytes, but the file says 4000000000"),
+        "{err}"
+    );
+    // Not glTF at all; a GLB cut short.
+    assert!(import(b"{\"asset\": 1}", None, None, "t").is_err());
+    assert!(import(b"glTF\x02\x00\x00\x00\xff\xff\xff\xff", None, None, "t").is_err());
+    // An animation that is not there.
+    let ok = gltf_with(cases[0].0.replace("1000000000", "2").as_str(), &buf);
+    let err = import(ok.as_bytes(), None, Some("run"), "t")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(err, "no animation 'run' (the file has: 0)");
+}
