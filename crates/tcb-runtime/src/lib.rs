@@ -41,6 +41,7 @@ mod instance;
 mod kernel;
 mod loose;
 pub mod pose;
+pub mod skeleton;
 
 #[cfg(feature = "rayon")]
 pub mod batch;
@@ -49,3 +50,4 @@ pub use blend::{BlendMask, blend};
 pub use clip::{Clip, TrackId, TrackSlot};
 pub use instance::Instance;
 pub use pose::Pose;
+pub use skeleton::SkeletonBinding;
