@@ -504,9 +504,7 @@ impl Clip {
         self.groups
             .iter()
             .map(|g| {
-                (g.vec_blocks * VEC_STRIDE
-                    + g.hq_blocks * HQ_STRIDE
-                    + g.sq_blocks * 2 * SQ_STRIDE * 2)
+                (g.vec_blocks * VEC_STRIDE + g.hq_blocks * HQ_STRIDE + g.sq_blocks * 2 * SQ_STRIDE)
                     * 32
             })
             .sum()

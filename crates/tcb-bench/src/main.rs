@@ -1,0 +1,113 @@
+//! `cargo run --release -p tcb-bench`: the comparison report on the bundled
+//! real data; `--json PATH` writes it as JSON; `--check BASELINE.json`
+//! exits non-zero when a ratio regressed by more than `--max-regression`
+//! percent.
+
+#![forbid(unsafe_code)]
+
+use clap::Parser;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+use tcb_bench::{report, scenarios};
+
+#[derive(Parser)]
+#[command(
+    name = "tcb-bench",
+    about = "Runtime vs scalar baseline vs the splines crate, on real data"
+)]
+struct Args {
+    /// Write the report as JSON here too.
+    #[arg(long, value_name = "PATH")]
+    json: Option<PathBuf>,
+    /// Compare with a saved JSON report; exit 1 on a regression.
+    #[arg(long, value_name = "BASELINE.json")]
+    check: Option<PathBuf>,
+    /// Largest allowed fall of a ratio, percent.
+    #[arg(long, value_name = "PCT", default_value_t = 10.0)]
+    max_regression: f64,
+    /// The motion-capture file for character, crowd and seek.
+    #[arg(long, value_name = "FILE.bvh", default_value_os_t = scenarios::default_bvh())]
+    bvh: PathBuf,
+    /// Only these scenarios (comma separated).
+    #[arg(long, value_name = "NAMES")]
+    only: Option<String>,
+    /// Timing rounds per implementation (the median is reported).
+    #[arg(long, default_value_t = 11)]
+    rounds: usize,
+    /// Milliseconds per timing.
+    #[arg(long, default_value_t = 20)]
+    slice_ms: u64,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    match run(&args) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("tcb-bench: error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
+    if args.max_regression.is_nan() || args.max_regression < 0.0 || args.rounds == 0 {
+        return Err("--max-regression must be >= 0 and --rounds > 0".into());
+    }
+    // Read the baseline first: a bad file should fail before minutes of timing.
+    let saved = match &args.check {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Some(
+                serde_json::from_str::<serde_json::Value>(&text)
+                    .map_err(|e| format!("{}: {e}", p.display()))?,
+            )
+        }
+        None => None,
+    };
+    if cfg!(debug_assertions) {
+        eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
+    }
+    let mut all = scenarios::all(&args.bvh)?;
+    if let Some(only) = &args.only {
+        let names: Vec<&str> = only.split(',').map(str::trim).collect();
+        all.retain(|s| names.contains(&s.name));
+        if all.is_empty() {
+            return Err(format!("--only {only}: no such scenario").into());
+        }
+    }
+    let slice = Duration::from_millis(args.slice_ms.max(1));
+    let rows: Vec<_> = all
+        .iter()
+        .map(|s| report::measure(s, args.rounds, slice))
+        .collect();
+    let (flags, machine) = (report::flags(), report::machine());
+    print!("{}", report::table(&rows, &flags, &machine));
+    println!("\ntargets:");
+    for (line, met) in report::targets(&rows) {
+        println!("  {} {line}", if met { "met " } else { "MISS" });
+    }
+    if let Some(path) = &args.json {
+        let doc = report::to_json(&rows, &flags, &machine);
+        let text = serde_json::to_string_pretty(&doc)? + "\n";
+        tcb_io::write_atomically(path, text.as_bytes())?;
+    }
+    let mut ok = true;
+    if let Some(saved) = &saved {
+        let (lines, held) = report::check(&rows, saved, args.max_regression);
+        println!(
+            "\nregression check against {}:",
+            args.check
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default()
+        );
+        for l in lines {
+            println!("  {l}");
+        }
+        ok = held;
+    }
+    Ok(ok)
+}

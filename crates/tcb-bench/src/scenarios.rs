@@ -1,0 +1,303 @@
+//! The scenarios, shared by the report and the criterion benches.
+//!
+//! | name | what |
+//! |---|---|
+//! | `character-hermite`, `character-squad` | the CMU clip (31 joints, 120 fps), 60 fps forward over the whole clip |
+//! | `crowd` | 1,000 instances of it (hermite) at random phases, 60 frames |
+//! | `wide` | 10,000 scalar channels on one key grid (61 keys), 60 fps over 2 s |
+//! | `sparse` | 500 scalar tracks, each with its own random key times |
+//! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
+
+use crate::Rng;
+use crate::baseline::Baseline;
+use crate::peer::SplinesPeer;
+use rayon::prelude::*;
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use tcb_core::{KeyParams, NamedTrack, RotationMode, Track, TrackData, TrackSettings};
+use tcb_runtime::Instance;
+use wide::f32x8;
+
+/// The bundled CMU clip (`data/cmu-01_01.bvh`).
+pub fn default_bvh() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/cmu-01_01.bvh")
+}
+
+/// A clip, how it is played, and every implementation's view of it.
+pub struct Scenario {
+    /// Name in the report.
+    pub name: &'static str,
+    /// The validated clip (the tcb-core reference).
+    pub source: tcb_core::Clip,
+    /// The runtime's compiled clip.
+    pub clip: Arc<tcb_runtime::Clip>,
+    /// The scalar baseline.
+    pub baseline: Baseline,
+    /// The `splines` crate, where it computes the same curve (even keys, tcb 0).
+    pub peer: Option<SplinesPeer>,
+    /// Sample times of one pass.
+    pub times: Vec<f64>,
+    /// One phase per instance (`[0.0]` but for `crowd`).
+    pub phases: Vec<f64>,
+    /// Joints, for ns per joint.
+    pub joints: Option<usize>,
+    /// Whether to time the read limit (the same coefficient bytes summed).
+    pub read_limit: bool,
+    /// Whether to time instances in parallel with rayon.
+    pub parallel: bool,
+}
+
+impl Scenario {
+    fn new(name: &'static str, source: tcb_core::Clip, times: Vec<f64>) -> Self {
+        Scenario {
+            name,
+            clip: Arc::new(tcb_runtime::Clip::compile(&source)),
+            baseline: Baseline::new(&source),
+            source,
+            peer: None,
+            times,
+            phases: vec![0.0],
+            joints: None,
+            read_limit: false,
+            parallel: false,
+        }
+    }
+
+    /// Values per sample (a quaternion counts 4).
+    pub fn channels(&self) -> usize {
+        self.source.channel_count()
+    }
+
+    /// Channel-samples in one pass.
+    pub fn channel_samples(&self) -> f64 {
+        (self.times.len() * self.phases.len() * self.channels()) as f64
+    }
+
+    /// One pass of the baseline.
+    pub fn baseline_pass(&self) -> impl FnMut() + '_ {
+        let mut row = vec![0.0f32; self.baseline.channel_count()];
+        move || {
+            for &t in &self.times {
+                for &p in &self.phases {
+                    self.baseline.sample(t + p, &mut row);
+                    black_box(&row);
+                }
+            }
+        }
+    }
+
+    /// One pass of the runtime, one thread.
+    pub fn runtime_pass(&self) -> impl FnMut() + '_ {
+        let mut instances: Vec<Instance> = self
+            .phases
+            .iter()
+            .map(|_| Instance::new(self.clip.clone(), false))
+            .collect();
+        move || {
+            for &t in &self.times {
+                for (inst, &p) in instances.iter_mut().zip(&self.phases) {
+                    black_box(inst.sample(t + p));
+                }
+            }
+        }
+    }
+
+    /// One pass of the runtime, each frame's instances split into one
+    /// contiguous chunk per rayon thread (one job per core per frame, as a
+    /// game's job system would). The frame loop runs inside the pool, so
+    /// the calling thread works rather than sleeping on every frame.
+    pub fn parallel_pass(&self) -> impl FnMut() + '_ {
+        let mut instances: Vec<Instance> = self
+            .phases
+            .iter()
+            .map(|_| Instance::new(self.clip.clone(), false))
+            .collect();
+        let chunk = instances
+            .len()
+            .div_ceil(rayon::current_num_threads())
+            .max(1);
+        move || {
+            rayon::scope(|_| {
+                for &t in &self.times {
+                    instances
+                        .par_chunks_mut(chunk)
+                        .zip(self.phases.par_chunks(chunk))
+                        .for_each(|(insts, phases)| {
+                            for (inst, &p) in insts.iter_mut().zip(phases) {
+                                black_box(inst.sample(t + p));
+                            }
+                        });
+                }
+            })
+        }
+    }
+
+    /// One pass of the `splines` crate.
+    pub fn peer_pass(&self) -> Option<impl FnMut() + '_> {
+        let peer = self.peer.as_ref()?;
+        let mut row = vec![0.0f32; peer.channel_count()];
+        Some(move || {
+            for &t in &self.times {
+                peer.sample(t, &mut row);
+                black_box(&row);
+            }
+        })
+    }
+
+    /// One pass of the read limit: per frame, the runtime's number of
+    /// coefficient bytes, at the frame's segment of an array of the clip's
+    /// size, summed (no arithmetic beyond the adds).
+    pub fn read_pass(&self) -> impl FnMut() + '_ {
+        let per_frame = self.clip.bytes_per_frame() / 32;
+        let keys = self.source.key_times();
+        let segments = keys.len() + 1;
+        let data: Vec<f32x8> = (0..segments * per_frame)
+            .map(|i| f32x8::splat(i as f32 * 1e-9))
+            .collect();
+        move || {
+            for &t in &self.times {
+                let seg = keys.partition_point(|&k| k <= t).min(segments - 1);
+                let block = &data[seg * per_frame..(seg + 1) * per_frame];
+                let mut acc = [f32x8::ZERO; 4];
+                for c in block.chunks_exact(4) {
+                    for i in 0..4 {
+                        acc[i] += c[i];
+                    }
+                }
+                black_box(acc[0] + acc[1] + acc[2] + acc[3]);
+            }
+        }
+    }
+}
+
+/// Frame times `0, 1/fps, ...` up to `end`.
+fn frames(end: f64, fps: f64) -> Vec<f64> {
+    let n = (end * fps + 1e-9).floor() as usize;
+    (0..=n).map(|i| i as f64 / fps).collect()
+}
+
+fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::Clip, usize), tcb_io::Error> {
+    let options = tcb_io::ImportOptions {
+        rotation,
+        ..Default::default()
+    };
+    let loaded = tcb_io::load_with(bvh, &options)?;
+    let joints = loaded.skeleton.map_or(0, |s| s.joints.len());
+    Ok((loaded.clip, joints))
+}
+
+/// `character-hermite` or `character-squad`.
+pub fn character(bvh: &Path, rotation: RotationMode) -> Result<Scenario, tcb_io::Error> {
+    let (clip, joints) = cmu(bvh, rotation)?;
+    let end = clip.time_range().map_or(0.0, |r| r.1);
+    let name = match rotation {
+        RotationMode::Hermite => "character-hermite",
+        _ => "character-squad",
+    };
+    let mut s = Scenario::new(name, clip, frames(end, 60.0));
+    s.joints = Some(joints);
+    if rotation == RotationMode::Hermite {
+        // Catmull-Rom on the components is hermite with tcb 0 on even keys.
+        s.peer = Some(SplinesPeer::new(&s.source));
+    }
+    Ok(s)
+}
+
+/// `seek`: the hermite character at random times.
+pub fn seek(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
+    let (clip, joints) = cmu(bvh, RotationMode::Hermite)?;
+    let end = clip.time_range().map_or(0.0, |r| r.1);
+    let mut rng = Rng(0x5eec);
+    let times = (0..frames(end, 60.0).len())
+        .map(|_| rng.range(0.0, end))
+        .collect();
+    let mut s = Scenario::new("seek", clip, times);
+    s.joints = Some(joints);
+    s.peer = Some(SplinesPeer::new(&s.source));
+    Ok(s)
+}
+
+/// `crowd`: 1,000 instances at random phases.
+pub fn crowd(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
+    let (clip, joints) = cmu(bvh, RotationMode::Hermite)?;
+    let end = clip.time_range().map_or(0.0, |r| r.1);
+    let mut rng = Rng(0xc20d);
+    let mut s = Scenario::new("crowd", clip, frames(1.0, 60.0)[..60].to_vec());
+    s.phases = (0..1000).map(|_| rng.range(0.0, end - 1.0)).collect();
+    s.joints = Some(joints);
+    s.parallel = true;
+    Ok(s)
+}
+
+fn scalar_track(times: Vec<f64>, rng: &mut Rng) -> NamedTrack {
+    let n = times.len();
+    let values = (0..n).map(|_| rng.range(-1.0, 1.0) as f32).collect();
+    let track = Track::new(
+        times,
+        values,
+        vec![KeyParams::default(); n],
+        &TrackSettings::default(),
+    )
+    .expect("valid synthetic keys");
+    NamedTrack {
+        name: String::new(),
+        data: TrackData::Scalar(track),
+    }
+}
+
+/// `wide`: 10,000 scalar channels on one grid of 61 keys over 2 s.
+pub fn wide() -> Scenario {
+    let mut rng = Rng(0x1de);
+    let times: Vec<f64> = (0..61).map(|k| k as f64 / 30.0).collect();
+    let tracks = (0..10_000)
+        .map(|i| NamedTrack {
+            name: format!("w{i}"),
+            ..scalar_track(times.clone(), &mut rng)
+        })
+        .collect();
+    let clip = tcb_core::Clip {
+        name: "wide".into(),
+        tracks,
+    };
+    let mut s = Scenario::new("wide", clip, frames(2.0, 60.0));
+    s.peer = Some(SplinesPeer::new(&s.source));
+    s.read_limit = true;
+    s
+}
+
+/// `sparse`: 500 scalar tracks, each with 10 to 40 random key times in [0, 2] s.
+pub fn sparse() -> Scenario {
+    let mut rng = Rng(0x5ba5e);
+    let tracks = (0..500)
+        .map(|i| {
+            let n = 10 + (rng.next_f64() * 31.0) as usize;
+            let mut times: Vec<f64> = (0..n).map(|_| rng.range(0.0, 2.0)).collect();
+            times.sort_by(f64::total_cmp);
+            times.dedup();
+            times[0] = 0.0;
+            *times.last_mut().expect("10 or more") = 2.0;
+            NamedTrack {
+                name: format!("s{i}"),
+                ..scalar_track(times, &mut rng)
+            }
+        })
+        .collect();
+    let clip = tcb_core::Clip {
+        name: "sparse".into(),
+        tracks,
+    };
+    Scenario::new("sparse", clip, frames(2.0, 60.0))
+}
+
+/// Every scenario, in report order.
+pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
+    Ok(vec![
+        character(bvh, RotationMode::Hermite)?,
+        character(bvh, RotationMode::Squad)?,
+        crowd(bvh)?,
+        wide(),
+        sparse(),
+        seek(bvh)?,
+    ])
+}
