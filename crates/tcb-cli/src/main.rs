@@ -42,6 +42,20 @@ enum Command {
     Sample(SampleArgs),
     /// Import a BVH or glTF file as a clip (tcb-clip/1 JSON).
     Import(ImportArgs),
+    /// Export a clip to glTF 2.0 (.gltf with an embedded buffer, or .glb).
+    Export(ExportArgs),
+}
+
+#[derive(Args)]
+struct ExportArgs {
+    /// The clip (tcb-clip/1 JSON, or anything `sample` reads).
+    clip: PathBuf,
+    /// The file to write: .glb or .gltf.
+    #[arg(short, long, value_name = "OUT.glb|OUT.gltf")]
+    output: PathBuf,
+    /// Largest error allowed where the curve must be resampled (relative to max(1, |value|)).
+    #[arg(long, value_name = "E", default_value_t = 1e-5)]
+    max_error: f64,
 }
 
 #[derive(Args)]
@@ -92,6 +106,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Sample(args) => sample(&args),
         Command::Import(args) => import(&args),
+        Command::Export(args) => export(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -152,6 +167,56 @@ fn import(args: &ImportArgs) -> Result<(), BoxError> {
         args.output.display(),
         loaded.doc.tracks.len()
     );
+    Ok(())
+}
+
+fn export(args: &ExportArgs) -> Result<(), BoxError> {
+    if !(args.max_error > 0.0 && args.max_error.is_finite()) {
+        return Err(format!(
+            "--max-error must be a positive number, got {}",
+            args.max_error
+        )
+        .into());
+    }
+    let ext = args
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if ext != "glb" && ext != "gltf" {
+        return Err(format!(
+            "{}: the output must end in .glb or .gltf",
+            args.output.display()
+        )
+        .into());
+    }
+    let loaded = tcb_io::load(&args.clip)?;
+    warn(&loaded.warnings);
+    let report = tcb_io::gltf_export::export_file(&loaded.clip, &args.output, args.max_error)?;
+    warn(&report.notes);
+    let resampled: Vec<_> = report
+        .tracks
+        .iter()
+        .filter_map(|t| t.resampled_error.map(|e| (&t.name, e)))
+        .collect();
+    for (name, e) in &resampled {
+        eprintln!("tcb: resampled {name}: max error {e:e}");
+    }
+    eprintln!(
+        "tcb: wrote {}: {} tracks, {} exact, {} resampled, max error {:e}",
+        args.output.display(),
+        report.tracks.len(),
+        report.tracks.len() - resampled.len(),
+        resampled.len(),
+        report.max_error()
+    );
+    if report.max_error() > args.max_error {
+        eprintln!(
+            "tcb: warning: max error {:e} is above --max-error {:e} (a step inside a curve track cannot be followed by a cubic)",
+            report.max_error(),
+            args.max_error
+        );
+    }
     Ok(())
 }
 

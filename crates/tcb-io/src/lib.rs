@@ -27,6 +27,7 @@
 pub mod bvh;
 pub mod clip;
 pub mod error;
+pub mod gltf_export;
 pub mod gltf_import;
 
 pub use clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc, write_clip_doc};
