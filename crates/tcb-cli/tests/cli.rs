@@ -478,3 +478,118 @@ fn tcb_beyond_one_is_allowed() {
     let o = tcb(&["sample", path.to_str().unwrap(), "--at", "0.5,1.5"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+fn data(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn import_and_export_round_trip_through_the_command() {
+    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let clip = dir.join("skin.json");
+    let o = tcb(&[
+        "import",
+        &data("simple_skin.gltf"),
+        "-o",
+        clip.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 tracks, 12 keys"), "{}", stderr(&o));
+    let glb = dir.join("skin.glb");
+    let o = tcb(&[
+        "export",
+        clip.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // LINEAR slerp goes back as LINEAR, exactly.
+    assert!(
+        stderr(&o).contains("1 exact, 0 resampled"),
+        "{}",
+        stderr(&o)
+    );
+    let a = tcb(&["sample", clip.to_str().unwrap(), "--fps", "7"]);
+    let b = tcb(&["sample", glb.to_str().unwrap(), "--fps", "7"]);
+    for (x, y) in stdout(&a).lines().zip(stdout(&b).lines()).skip(1) {
+        for (u, v) in x.split(',').zip(y.split(',')).skip(1) {
+            let (u, v): (f32, f32) = (u.parse().unwrap(), v.parse().unwrap());
+            assert!((u - v).abs() < 2e-5, "{x} vs {y}");
+        }
+    }
+}
+
+#[test]
+fn import_and_export_errors_write_nothing() {
+    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let out = dir.join("never.json");
+    let bad = temp_clip(
+        "cut.bvh",
+        "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 Xrotation Yrotation Zrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n1 2 3\n4 5\n",
+    );
+    let o = tcb(&["import", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).ends_with(
+            "cut.bvh: line 11: frame 1 has 2 values, expected 3 (truncated or malformed row)\n"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = tcb(&[
+        "import",
+        &data("simple_skin.gltf"),
+        "-o",
+        out.to_str().unwrap(),
+        "--rotation",
+        "hermite",
+    ]);
+    assert!(
+        stderr(&o).contains("--rotation is for BVH files"),
+        "{}",
+        stderr(&o)
+    );
+    let o = tcb(&[
+        "import",
+        &data("simple_skin.gltf"),
+        "-o",
+        out.to_str().unwrap(),
+        "--animation",
+        "walk",
+    ]);
+    assert!(
+        stderr(&o).contains("no animation 'walk' (the file has: 0)"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let glb = dir.join("never.glb");
+    let o = tcb(&[
+        "export",
+        &example("bounce.json"),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&o).contains("track 'ball.position' (vec3) has no glTF target"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!glb.exists());
+    let o = tcb(&[
+        "export",
+        &example("bounce.json"),
+        "-o",
+        dir.join("x.fbx").to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&o).contains("must end in .glb or .gltf"),
+        "{}",
+        stderr(&o)
+    );
+}

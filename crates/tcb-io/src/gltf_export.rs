@@ -6,7 +6,9 @@
 //!
 //! - vector tracks and `hermite` rotations as `CUBICSPLINE`, with
 //!   `out_k = DD_k / D_k` and `in_k+1 = DS_k+1 / D_k` (time-unit tangents);
-//! - tracks whose every segment is `step` as `STEP`.
+//! - tracks whose every segment is `step` as `STEP`;
+//! - rotations whose every segment is `linear` (slerp), without ease, as
+//!   `LINEAR`.
 //!
 //! The rest (squad, ease, slerp segments of hermite rotations, `step`
 //! segments inside a curve) is resampled: each segment is split into 1, 2,
@@ -110,6 +112,7 @@ fn exact_shape<V: TcbValue>(t: &Track<V>) -> Shape {
 #[derive(Clone, Copy, PartialEq)]
 enum Shape {
     Step,
+    Linear,
     Cubic,
     Resample,
 }
@@ -376,21 +379,21 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
         TrackData::Vec2(t) => exact_shape(t),
         TrackData::Vec3(t) => exact_shape(t),
         TrackData::Vec4(t) => exact_shape(t),
-        TrackData::Quat(r) => match r.hermite_track() {
-            Some(h) if !r.interps()[..r.interps().len() - 1].contains(&Interp::Linear) => {
-                exact_shape(h)
+        TrackData::Quat(r) => {
+            let interps = &r.interps()[..r.interps().len() - 1];
+            let eased = r.eases().iter().any(|e| !e.is_none());
+            match r.hermite_track() {
+                Some(h) if !interps.contains(&Interp::Linear) => exact_shape(h),
+                _ if interps.iter().all(|i| *i == Interp::Step) => Shape::Step,
+                // glTF LINEAR is slerp (shortest path; the keys are already
+                // on one hemisphere, so the same path).
+                _ if !eased && interps.iter().all(|i| *i == Interp::Linear) => Shape::Linear,
+                _ => Shape::Resample,
             }
-            _ if r.interps()[..r.interps().len() - 1]
-                .iter()
-                .all(|i| *i == Interp::Step) =>
-            {
-                Shape::Step
-            }
-            _ => Shape::Resample,
-        },
+        }
     };
     match shape {
-        Shape::Step => {
+        Shape::Step | Shape::Linear => {
             let dim = data.kind().dim();
             let mut output = Vec::new();
             let mut v = vec![0.0f32; dim];
@@ -400,7 +403,11 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
             }
             let sampler = Sampler {
                 times: data.times().iter().map(|&t| t as f32).collect(),
-                interpolation: "STEP",
+                interpolation: if shape == Shape::Step {
+                    "STEP"
+                } else {
+                    "LINEAR"
+                },
                 width: dim,
                 output,
                 kind,
