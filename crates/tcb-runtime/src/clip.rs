@@ -204,42 +204,38 @@ fn squad_controls(t: &RotationTrack) -> Vec<[f64; SQ_STRIDE]> {
     out
 }
 
-/// Lay per-lane control rows into blocks of 8 lanes:
-/// `out[(seg * blocks + b) * width + j]` lane `l` = `rows[b * 8 + l][seg][j]`;
+/// Lay per-lane control rows into blocks of `N` lanes (`f32x8`: 8,
+/// `f64x4`: 4), `blocks` of them:
+/// `out[(seg * blocks + b) * width + j]` lane `l` = `rows[b * N + l][seg][j]`;
 /// lanes past the last row get `pad`.
-fn pack<const W: usize>(rows: &[Vec<[f32; W]>], segments: usize, pad: [f32; W]) -> Vec<f32x8> {
-    let blocks = rows.len().div_ceil(8);
-    let mut out = vec![f32x8::ZERO; segments * blocks * W];
+fn pack_lanes<T: Copy + Default, L: Clone, const N: usize, const W: usize>(
+    rows: &[Vec<[T; W]>],
+    segments: usize,
+    blocks: usize,
+    pad: [T; W],
+    make: fn([T; N]) -> L,
+) -> Vec<L> {
+    let mut out = Vec::with_capacity(segments * blocks * W);
     for seg in 0..segments {
         for b in 0..blocks {
             for j in 0..W {
-                let mut lanes = [0.0f32; 8];
-                for (l, lane) in lanes.iter_mut().enumerate() {
-                    *lane = rows.get(b * 8 + l).map_or(pad[j], |r| r[seg][j]);
-                }
-                out[(seg * blocks + b) * W + j] = f32x8::new(lanes);
+                let lanes: [T; N] =
+                    std::array::from_fn(|l| rows.get(b * N + l).map_or(pad[j], |r| r[seg][j]));
+                out.push(make(lanes));
             }
         }
     }
     out
 }
 
-/// [`pack`] in f64, blocks of 4 lanes, padded to an even number of blocks.
+/// [`pack_lanes`] into `f32x8` blocks.
+fn pack<const W: usize>(rows: &[Vec<[f32; W]>], segments: usize, pad: [f32; W]) -> Vec<f32x8> {
+    pack_lanes(rows, segments, rows.len().div_ceil(8), pad, f32x8::new)
+}
+
+/// [`pack_lanes`] into `f64x4` half blocks, two per block of 8 channels.
 fn pack_f64<const W: usize>(rows: &[Vec<[f64; W]>], segments: usize, pad: [f64; W]) -> Vec<f64x4> {
-    let blocks = 2 * rows.len().div_ceil(8);
-    let mut out = vec![f64x4::ZERO; segments * blocks * W];
-    for seg in 0..segments {
-        for b in 0..blocks {
-            for j in 0..W {
-                let mut lanes = [0.0f64; 4];
-                for (l, lane) in lanes.iter_mut().enumerate() {
-                    *lane = rows.get(b * 4 + l).map_or(pad[j], |r| r[seg][j]);
-                }
-                out[(seg * blocks + b) * W + j] = f64x4::new(lanes);
-            }
-        }
-    }
-    out
+    pack_lanes(rows, segments, 2 * rows.len().div_ceil(8), pad, f64x4::new)
 }
 
 /// Controls of an unused rotation lane: the identity, so that padding lanes
