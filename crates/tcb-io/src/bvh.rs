@@ -435,19 +435,23 @@ impl Bvh {
                 keys: Vec::new(),
                 settings: SettingsDoc::default(),
             };
+            if !has_pos && !has_rot {
+                continue;
+            }
+            // Each frame's local transform once, for both tracks.
+            let locals: Vec<(DVec3, DQuat)> = (0..frames).map(|f| self.local(f, j)).collect();
             if has_pos {
-                let values = (0..frames)
-                    .map(|f| {
-                        let t = self.local(f, j).0.as_vec3();
+                let values = locals
+                    .iter()
+                    .map(|(t, _)| {
+                        let t = t.as_vec3();
                         [t.x, t.y, t.z, 0.0]
                     })
                     .collect();
                 tracks.push(track("translation", TrackKind::Vec3, values));
             }
             if has_rot {
-                let values = (0..frames)
-                    .map(|f| self.local(f, j).1.as_quat().to_array())
-                    .collect();
+                let values = locals.iter().map(|(_, q)| q.as_quat().to_array()).collect();
                 tracks.push(track("rotation", TrackKind::Quat, values));
             }
         }

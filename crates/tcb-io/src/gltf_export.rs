@@ -136,11 +136,12 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
         data.sample_into(t, &mut v, Some(&mut d));
         (v, d)
     };
+    let (v0, d0) = sample(keys[0]);
     let mut out = Cubic {
         times: vec![keys[0]],
-        values: vec![sample(keys[0]).0],
-        tin: vec![sample(keys[0]).1],
-        tout: vec![sample(keys[0]).1],
+        values: vec![v0],
+        tin: vec![d0.clone()],
+        tout: vec![d0],
     };
     let mut worst = 0.0f64;
     for k in 0..keys.len() - 1 {
@@ -151,7 +152,10 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
             let knots: Vec<f64> = (0..=pieces)
                 .map(|j| a + (b - a) * j as f64 / pieces as f64)
                 .collect();
-            // (value, in tangent, out tangent) at each knot; the left derivative at b.
+            // (value, in tangent, out tangent) at each knot. The in tangent at
+            // b is the left derivative; its out tangent is replaced by the
+            // next segment's first knot (and at the last key the reference's
+            // velocity is already the left derivative).
             let at: Vec<_> = knots
                 .iter()
                 .enumerate()
@@ -163,17 +167,6 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
                         d.clone()
                     };
                     (v, din, d)
-                })
-                .collect();
-            let at: Vec<_> = at
-                .into_iter()
-                .enumerate()
-                .map(|(j, (v, din, dout))| {
-                    if j == pieces {
-                        (v, din.clone(), din)
-                    } else {
-                        (v, din, dout)
-                    }
                 })
                 .collect();
             let mut err = 0.0f64;
