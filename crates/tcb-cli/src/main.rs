@@ -44,6 +44,37 @@ enum Command {
     Import(ImportArgs),
     /// Export a clip to glTF 2.0 (.gltf with an embedded buffer, or .glb).
     Export(ExportArgs),
+    /// Fit dense animation with far fewer Hermite keys within a stated error.
+    Reduce(ReduceArgs),
+}
+
+#[derive(Args)]
+struct ReduceArgs {
+    /// The input: clip JSON, BVH, glTF or GLB.
+    input: PathBuf,
+    /// The clip to write (tcb-clip/1 JSON; written only once it is verified).
+    #[arg(short, long, value_name = "OUT.json")]
+    output: PathBuf,
+    /// Largest error allowed (shell: model-space distance, default 6e-5 x the
+    /// rest-pose height; value: per component, default 1e-4).
+    #[arg(long, value_name = "E", allow_hyphen_values = true)]
+    tolerance: Option<f64>,
+    /// Shell radius: distance of the virtual points from each joint (default 0.018 x height).
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
+    shell: Option<f64>,
+    /// Error metric (default: shell when the input has a skeleton, else value).
+    #[arg(long, value_name = "shell|value")]
+    metric: Option<tcb_fit::Metric>,
+    /// Value metric: largest rotation error in degrees (default 0.01).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    rotation_tolerance: Option<f64>,
+    /// Which tracks share key times.
+    #[arg(long, value_name = "track|joint|clip", default_value = "track")]
+    knots: tcb_fit::Knots,
+    /// Tangents: derived by the TCB rule from neighbouring keys (values only
+    /// stored), or explicit in/out tangents on every key.
+    #[arg(long, value_name = "derived|explicit", default_value = "derived")]
+    tangents: tcb_fit::Tangents,
 }
 
 #[derive(Args)]
@@ -107,6 +138,7 @@ fn main() -> ExitCode {
         Command::Sample(args) => sample(&args),
         Command::Import(args) => import(&args),
         Command::Export(args) => export(&args),
+        Command::Reduce(args) => reduce(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -217,6 +249,87 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
             args.max_error
         );
     }
+    Ok(())
+}
+
+fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
+    let ext = args
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if ext != "json" {
+        return Err(format!("{}: the output must end in .json", args.output.display()).into());
+    }
+    let started = std::time::Instant::now();
+    let loaded = tcb_io::load(&args.input)?;
+    warn(&loaded.warnings);
+    let skeleton = loaded
+        .skeleton
+        .as_ref()
+        .map(|s| tcb_fit::metric::with_end_sites(s, &loaded.end_sites));
+    let options = tcb_fit::ReduceOptions {
+        tolerance: args.tolerance,
+        shell: args.shell,
+        metric: args.metric,
+        rotation_tolerance: args.rotation_tolerance,
+        knots: args.knots,
+        tangents: args.tangents,
+    };
+    let input = tcb_fit::reduce::Input {
+        doc: &loaded.doc,
+        clip: &loaded.clip,
+        skeleton: skeleton.as_ref(),
+    };
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("tcb: fitting {bar:30} {pos}/{len} groups")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = tcb_fit::reduce(input, &options, &progress);
+    bar.finish_and_clear();
+    let reduced = result?;
+    let s = &reduced.settings;
+    match s.metric {
+        tcb_fit::Metric::Shell => eprintln!(
+            "tcb: metric shell, tolerance {:e}, shell {:e} (rest-pose height {}), knots {}, tangents {}",
+            s.tolerance,
+            s.shell,
+            s.height,
+            s.knots.name(),
+            s.tangents.name()
+        ),
+        tcb_fit::Metric::Value => eprintln!(
+            "tcb: metric value, tolerance {:e}, rotation tolerance {} degrees, knots {}, tangents {}",
+            s.tolerance,
+            s.rotation_tolerance,
+            s.knots.name(),
+            s.tangents.name()
+        ),
+    }
+    for a in &reduced.attempts {
+        eprintln!(
+            "tcb: budget scale {}: values {}, error {:.3} of the tolerance ({} at {} s)",
+            a.scale, a.values, a.ratio, a.worst.at, a.worst.time
+        );
+    }
+    if !reduced.kept.is_empty() {
+        eprintln!(
+            "tcb: {} tracks kept as they were: {}",
+            reduced.kept.len(),
+            reduced.kept.join(", ")
+        );
+    }
+    tcb_io::write_clip_doc(&reduced.doc, &args.output)?;
+    eprintln!(
+        "tcb: wrote {} in {:.2} s",
+        args.output.display(),
+        started.elapsed().as_secs_f64()
+    );
+    println!("{}", reduced.summary_line());
     Ok(())
 }
 

@@ -14,7 +14,8 @@
 
 use std::ops::{Add, Mul, Sub};
 
-/// A lane of arithmetic: `f32`, or a SIMD vector of `f32` (`wide::f32x8`).
+/// A lane of arithmetic: `f32`, `f64` (the key-reduction fitter), or a SIMD
+/// vector of `f32` (`wide::f32x8`).
 ///
 /// Only `+`, `-` and `*` are used (no fused multiply-add), so a formula run
 /// on `f32` and on `f32x8` gives the same bits in every lane.
@@ -27,6 +28,13 @@ impl Real for f32 {
     #[inline(always)]
     fn splat(x: f32) -> Self {
         x
+    }
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        f64::from(x)
     }
 }
 

@@ -194,6 +194,26 @@ impl Clip {
         }
     }
 
+    /// Heap bytes the clip owns: its tracks, their names and data.
+    pub fn heap_bytes(&self) -> usize {
+        self.name.len()
+            + self
+                .tracks
+                .iter()
+                .map(|t| {
+                    std::mem::size_of::<NamedTrack>()
+                        + t.name.len()
+                        + match &t.data {
+                            TrackData::Scalar(t) => t.heap_bytes(),
+                            TrackData::Vec2(t) => t.heap_bytes(),
+                            TrackData::Vec3(t) => t.heap_bytes(),
+                            TrackData::Vec4(t) => t.heap_bytes(),
+                            TrackData::Quat(t) => t.heap_bytes(),
+                        }
+                })
+                .sum::<usize>()
+    }
+
     /// The sorted union of every track's key times.
     pub fn key_times(&self) -> Vec<f64> {
         let mut all: Vec<f64> = self

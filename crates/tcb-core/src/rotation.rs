@@ -243,6 +243,19 @@ impl RotationTrack {
         })
     }
 
+    /// Heap bytes this track owns.
+    pub fn heap_bytes(&self) -> usize {
+        std::mem::size_of_val(self.times.as_slice())
+            + std::mem::size_of_val(self.keys.as_slice())
+            + std::mem::size_of_val(self.values.as_slice())
+            + std::mem::size_of_val(self.interps.as_slice())
+            + std::mem::size_of_val(self.eases.as_slice())
+            + match &self.shape {
+                Shape::Squad(s) => std::mem::size_of_val(s.as_slice()),
+                Shape::Hermite(t) => t.heap_bytes(),
+            }
+    }
+
     /// Key times.
     pub fn times(&self) -> &[f64] {
         &self.times

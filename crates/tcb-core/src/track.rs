@@ -231,6 +231,14 @@ impl<V: Value> Track<V> {
         })
     }
 
+    /// Heap bytes this track owns (times, values, tangents, segments).
+    pub fn heap_bytes(&self) -> usize {
+        std::mem::size_of_val(self.times.as_slice())
+            + std::mem::size_of_val(self.values.as_slice())
+            + std::mem::size_of_val(self.tangents.as_slice())
+            + std::mem::size_of_val(self.segments.as_slice())
+    }
+
     /// Key times.
     pub fn times(&self) -> &[f64] {
         &self.times

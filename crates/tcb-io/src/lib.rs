@@ -56,6 +56,9 @@ pub struct Loaded {
     pub clip: tcb_core::Clip,
     /// The joint hierarchy (BVH and glTF files).
     pub skeleton: Option<Skeleton>,
+    /// BVH End Sites: the joint each ends and its offset (not joints of
+    /// [`Loaded::skeleton`]; empty for other formats).
+    pub end_sites: Vec<(usize, glam::Vec3)>,
     /// Things that were read but look wrong, for the user to see.
     pub warnings: Vec<String>,
 }
@@ -84,6 +87,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let mut end_sites = Vec::new();
     let (doc, skeleton, warnings) = match ext.as_str() {
         "json" => (read_clip_doc(path)?, None, Vec::new()),
         "bvh" => {
@@ -92,6 +96,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
             let doc = bvh
                 .to_clip_doc(&stem, options.rotation)
                 .map_err(|e| e.in_file(path))?;
+            end_sites = bvh.end_sites;
             (doc, Some(bvh.skeleton), bvh.warnings)
         }
         "gltf" | "glb" => {
@@ -113,6 +118,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         doc,
         clip,
         skeleton,
+        end_sites,
         warnings,
     })
 }

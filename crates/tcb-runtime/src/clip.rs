@@ -494,6 +494,53 @@ impl Clip {
         self.source.time_range()
     }
 
+    /// Heap bytes of the compiled clip, counted from its buffers' lengths:
+    /// the kernels' controls, the time grids, the pose layout, and the copy
+    /// of the validated source clip it keeps (see
+    /// [`memory_bytes_compiled`](Self::memory_bytes_compiled) without it).
+    pub fn memory_bytes(&self) -> usize {
+        self.memory_bytes_compiled() + self.source.heap_bytes()
+    }
+
+    /// [`memory_bytes`](Self::memory_bytes) without the source clip's copy.
+    pub fn memory_bytes_compiled(&self) -> usize {
+        use std::mem::{size_of, size_of_val};
+        let grid = |g: &TimeGrid| size_of_val(g.times.as_slice()) + size_of_val(g.eases.as_slice());
+        let groups: usize = self
+            .groups
+            .iter()
+            .map(|g| {
+                size_of::<Group>()
+                    + grid(&g.grid)
+                    + size_of_val(g.vec.as_slice())
+                    + size_of_val(g.delta.as_slice())
+                    + size_of_val(g.hq.as_slice())
+                    + size_of_val(g.sq.as_slice())
+            })
+            .sum();
+        let loose: usize = self
+            .loose
+            .lanes
+            .iter()
+            .map(|l| size_of::<LooseLane>() + grid(&l.grid) + size_of_val(l.controls.as_slice()))
+            .sum::<usize>()
+            + self.loose.heap_bytes();
+        let layout = self
+            .layout
+            .slots
+            .iter()
+            .map(|s| size_of::<TrackSlot>() + s.name.len())
+            .sum::<usize>()
+            + size_of_val(self.layout.quat_blocks.as_slice())
+            + size_of_val(self.layout.loose_quats.as_slice());
+        self.name.len()
+            + groups
+            + loose
+            + layout
+            + size_of_val(self.reference.as_slice())
+            + size_of_val(self.squad_velocity.as_slice())
+    }
+
     /// Bytes of coefficients the kernels read per frame when every group is
     /// inside its keys (one stored segment per group).
     pub fn bytes_per_frame(&self) -> usize {

@@ -73,6 +73,18 @@ pub(crate) struct Loose {
 }
 
 impl Loose {
+    /// Heap bytes of the per-block tables (the lanes are counted by the clip).
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        [&self.t0, &self.tn, &self.len, &self.pre, &self.post]
+            .iter()
+            .map(|v| size_of_val(v.as_slice()))
+            .sum::<usize>()
+            + size_of_val(self.delta.as_slice())
+            + size_of_val(self.eased.as_slice())
+            + size_of_val(self.dims.as_slice())
+    }
+
     pub fn new(lanes: Vec<LooseLane>, out: usize) -> Self {
         let blocks = lanes.len().div_ceil(8);
         let lane = |i: usize| lanes.get(i);

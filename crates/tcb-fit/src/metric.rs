@@ -1,0 +1,227 @@
+//! What `spec/reduce.md` compares: the check times, clips as `tcb sample`
+//! plays them (the runtime), and the `shell` and `value` errors.
+//!
+//! ```text
+//! shell   e_j(t) = max over v in {0, R e_x, R e_y, R e_z} of |M_j(t) v - M'_j(t) v|
+//!         M_j = M_parent(j) T_j R_j S_j          (model space, composed down the hierarchy)
+//! value   vectors: max |x_c - x'_c| per component; rotations: 2 acos(|q . q'|)
+//! ```
+
+use glam::{Affine3A, Vec3};
+use std::sync::Arc;
+use tcb_core::sample_times::inbetweens;
+use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::{Clip, TrackKind};
+use tcb_runtime::{Instance, SkeletonBinding};
+
+/// The check times of a clip: every key time (the sorted union of its
+/// tracks' key times) and 3 evenly spaced times inside each interval.
+pub fn check_times(clip: &Clip) -> Vec<f64> {
+    inbetweens(&clip.key_times(), 3)
+}
+
+/// `clip` played by the runtime (as `tcb sample` plays it) at `times`: one
+/// row of [`Clip::channel_count`] values per time, concatenated.
+pub fn play(clip: &Clip, times: &[f64]) -> Vec<f32> {
+    let channels = clip.channel_count();
+    let runtime = Arc::new(tcb_runtime::Clip::compile(clip));
+    let mut instance = Instance::new(runtime, false);
+    let mut rows = vec![0.0f32; times.len() * channels];
+    for (row, &t) in rows.chunks_exact_mut(channels.max(1)).zip(times) {
+        instance.sample(t).write_row(row, None);
+    }
+    rows
+}
+
+/// The largest error found, where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Worst {
+    /// The error (model-space distance for `shell`; the track's units, or
+    /// degrees for rotations, for `value`).
+    pub error: f64,
+    /// Error over the tolerance it is held to.
+    pub ratio: f64,
+    /// The joint (`shell`) or track (`value`).
+    pub at: String,
+    /// The check time.
+    pub time: f64,
+}
+
+impl Worst {
+    fn none() -> Self {
+        Worst {
+            error: 0.0,
+            ratio: 0.0,
+            at: String::new(),
+            time: 0.0,
+        }
+    }
+
+    fn take(&mut self, error: f64, ratio: f64, at: &str, time: f64) {
+        // NaN counts as the worst there is.
+        if ratio > self.ratio || (ratio.is_nan() && !self.ratio.is_nan()) {
+            *self = Worst {
+                error,
+                ratio,
+                at: at.to_owned(),
+                time,
+            };
+        }
+    }
+}
+
+/// A skeleton with BVH End Sites (parent joint, offset) added as leaf joints
+/// named `<parent>_end` (the clip contract's convention), so their points
+/// count in the shell metric and in the rest-pose height.
+pub fn with_end_sites(skeleton: &Skeleton, end_sites: &[(usize, Vec3)]) -> Skeleton {
+    let mut out = skeleton.clone();
+    for &(parent, offset) in end_sites {
+        if parent < skeleton.joints.len() {
+            out.joints.push(Joint {
+                name: format!("{}_end", skeleton.joints[parent].name),
+                parent: Some(parent),
+                rest: Transform {
+                    translation: offset,
+                    ..Transform::IDENTITY
+                },
+            });
+        }
+    }
+    out
+}
+
+/// The rest-pose height H of `spec/reduce.md`: the largest distance of any
+/// joint from the (first) root in the rest pose.
+pub fn rest_height(skeleton: &Skeleton) -> f64 {
+    let local: Vec<Transform> = skeleton.joints.iter().map(|j| j.rest).collect();
+    let mut model = vec![Affine3A::IDENTITY; local.len()];
+    skeleton.model_transforms(&local, &mut model);
+    let Some(root) = model.first() else {
+        return 0.0;
+    };
+    model
+        .iter()
+        .map(|m| f64::from((m.translation - root.translation).length()))
+        .fold(0.0, f64::max)
+}
+
+/// The `shell` error of `reduced` against `reference` at `times`, with
+/// shell radius `radius`, over the joints of `skeleton`.
+pub fn shell_error(
+    skeleton: &Skeleton,
+    reference: &Clip,
+    reduced: &Clip,
+    times: &[f64],
+    radius: f64,
+    tolerance: f64,
+) -> Worst {
+    let a = Arc::new(tcb_runtime::Clip::compile(reference));
+    let b = Arc::new(tcb_runtime::Clip::compile(reduced));
+    let bind_a = SkeletonBinding::new(skeleton.clone(), &a);
+    let bind_b = SkeletonBinding::new(skeleton.clone(), &b);
+    let (mut ia, mut ib) = (Instance::new(a, false), Instance::new(b, false));
+    let n = skeleton.joints.len();
+    let mut local = vec![Transform::IDENTITY; n];
+    let (mut ma, mut mb) = (vec![Affine3A::IDENTITY; n], vec![Affine3A::IDENTITY; n]);
+    let mut worst = Worst::none();
+    for &t in times {
+        bind_a.model_transforms(ia.sample(t), &mut local, &mut ma);
+        bind_b.model_transforms(ib.sample(t), &mut local, &mut mb);
+        for (j, joint) in skeleton.joints.iter().enumerate() {
+            let e = point_error(&ma[j], &mb[j], radius);
+            worst.take(e, e / tolerance, &joint.name, t);
+        }
+    }
+    worst
+}
+
+/// `max over v in {0, R e_x, R e_y, R e_z} of |a v - b v|`, in f64.
+pub fn point_error(a: &Affine3A, b: &Affine3A, radius: f64) -> f64 {
+    let d = |x: glam::Vec3A, y: glam::Vec3A| x.as_dvec3() - y.as_dvec3();
+    let dt = d(a.translation, b.translation);
+    let cols = [
+        d(a.matrix3.x_axis, b.matrix3.x_axis),
+        d(a.matrix3.y_axis, b.matrix3.y_axis),
+        d(a.matrix3.z_axis, b.matrix3.z_axis),
+    ];
+    cols.iter()
+        .map(|c| (dt + *c * radius).length())
+        .fold(dt.length(), f64::max)
+}
+
+/// The `value` error of `reduced` against `reference` at `times`: vectors
+/// against `tolerance` (per component), rotations against
+/// `rotation_degrees`. The worst is the largest ratio.
+pub fn value_error(
+    reference: &Clip,
+    reduced: &Clip,
+    times: &[f64],
+    tolerance: f64,
+    rotation_degrees: f64,
+) -> Worst {
+    let channels = reference.channel_count();
+    let (ra, rb) = (play(reference, times), play(reduced, times));
+    let mut worst = Worst::none();
+    for (i, &t) in times.iter().enumerate() {
+        let (ya, yb) = (
+            &ra[i * channels..(i + 1) * channels],
+            &rb[i * channels..(i + 1) * channels],
+        );
+        let mut at = 0;
+        for track in &reference.tracks {
+            let kind = track.data.kind();
+            let dim = kind.dim();
+            let (a, b) = (&ya[at..at + dim], &yb[at..at + dim]);
+            if kind == TrackKind::Quat {
+                let deg = rotation_angle_degrees(a, b);
+                worst.take(deg, deg / rotation_degrees, &track.name, t);
+            } else {
+                let e = a
+                    .iter()
+                    .zip(b)
+                    .map(|(x, y)| f64::from(*x - *y).abs())
+                    .fold(0.0, f64::max);
+                worst.take(e, e / tolerance, &track.name, t);
+            }
+            at += dim;
+        }
+    }
+    worst
+}
+
+/// `2 acos(|q . q'|)` in degrees, for quaternions as `[x, y, z, w]`
+/// (normalized here).
+pub fn rotation_angle_degrees(a: &[f32], b: &[f32]) -> f64 {
+    let len = |q: &[f32]| q.iter().map(|v| f64::from(*v).powi(2)).sum::<f64>().sqrt();
+    let dot: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| f64::from(*x) * f64::from(*y))
+        .sum::<f64>()
+        / (len(a) * len(b));
+    // acos is ill-conditioned near 1: use the half-angle sine instead.
+    let sin_half = (1.0 - dot * dot).max(0.0).sqrt();
+    2.0 * sin_half.min(1.0).asin().to_degrees()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_quarter_turn_is_90_degrees() {
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        let d = rotation_angle_degrees(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, h, h]);
+        assert!((d - 90.0).abs() < 1e-5, "{d}");
+        assert!(rotation_angle_degrees(&[0.0, 0.0, 0.0, 1.0], &[0.0, 0.0, 0.0, -1.0]) < 1e-6);
+    }
+
+    #[test]
+    fn shell_points_see_rotation_at_the_radius() {
+        let a = Affine3A::IDENTITY;
+        let b = Affine3A::from_rotation_z(0.001);
+        let e = point_error(&a, &b, 2.0);
+        // chord of 0.001 rad at radius 2
+        assert!((e - 2.0 * 2.0 * (0.0005f64).sin()).abs() < 1e-6, "{e}");
+    }
+}

@@ -1,0 +1,828 @@
+//! The whole reduction (`tcb reduce`, `spec/reduce.md`).
+//!
+//! 1. Play the input on the runtime at the check times (the reference).
+//! 2. Give every track a tolerance of its own in its own units, such that
+//!    the errors of all tracks together stay within the clip's tolerance:
+//!
+//!    ```text
+//!    value    vectors: E per component; rotations: sin(θ/2) <= sin(θ_E/2)
+//!    shell    a point x in joint a's frame moves by |(R'_a - R_a) x| <= 2 sin(θ_a/2) |x|
+//!             when only a's rotation is off by θ_a, and by |Δt_a| when only its
+//!             translation is; |x| <= L_a = (longest rest chain below a) + R.
+//!             Errors along a chain add at worst, so each of the n tracks on the
+//!             longest chain through a gets e = κ E / n:
+//!             rotation sin(θ/2) <= e / (2 L_a), translation |Δt| <= e,
+//!             scale |Δs| <= e / L_a.
+//!    ```
+//!
+//!    κ = 1 is the guaranteed bound. Errors of a chain rarely line up, so
+//!    larger κ (2, 4, …) are tried and kept while the *measured* shell
+//!    error still holds.
+//! 3. Fit each group of tracks sharing key times (`--knots`) with
+//!    [`crate::fit::fit`], in parallel.
+//! 4. Write the clip, build it, play it on the runtime, and measure the
+//!    error by the contract's metric. Only a clip that holds is returned.
+//!
+//! Tracks the fitter does not take are kept as they are (exact): tracks
+//! whose `linear` or `offset-repeat` extrapolation is checked outside their
+//! keys, tracks no joint uses (under `shell`), and tracks whose fit would
+//! store as many numbers as they already do.
+
+use crate::fit::{self, Fit, Norm, Series, Tangents};
+use crate::metric::{self, Worst};
+use rayon::prelude::*;
+use std::fmt;
+use std::str::FromStr;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use tcb_core::skeleton::Skeleton;
+use tcb_core::{Clip, Ends, Extrapolation, RotationMode, TangentRule, TrackKind};
+use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
+
+/// The error measure (`--metric`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metric {
+    /// Model-space error of virtual points around each joint (needs a skeleton).
+    Shell,
+    /// Per component for vectors, angle for rotations.
+    Value,
+}
+
+impl Metric {
+    /// The contract's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Shell => "shell",
+            Metric::Value => "value",
+        }
+    }
+}
+
+impl FromStr for Metric {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "shell" => Ok(Metric::Shell),
+            "value" => Ok(Metric::Value),
+            _ => Err(format!("unknown metric '{s}' (expected shell or value)")),
+        }
+    }
+}
+
+/// Which tracks share key times (`--knots`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Knots {
+    /// Every track has its own key times (fewest keys).
+    #[default]
+    Track,
+    /// The tracks of one joint (`<joint>.translation`, `.rotation`, `.scale`) share them.
+    Joint,
+    /// Every track shares them (one Hermite row per frame for the whole clip).
+    Clip,
+}
+
+impl Knots {
+    /// The contract's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Knots::Track => "track",
+            Knots::Joint => "joint",
+            Knots::Clip => "clip",
+        }
+    }
+}
+
+impl FromStr for Knots {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "track" => Ok(Knots::Track),
+            "joint" => Ok(Knots::Joint),
+            "clip" => Ok(Knots::Clip),
+            _ => Err(format!(
+                "unknown knot sharing '{s}' (expected track, joint or clip)"
+            )),
+        }
+    }
+}
+
+/// Options of [`reduce`]; `None` takes the contract's default.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReduceOptions {
+    /// `--tolerance E` (model-space distance for `shell`, track units for `value`).
+    pub tolerance: Option<f64>,
+    /// `--shell R`, the radius of the virtual points.
+    pub shell: Option<f64>,
+    /// `--metric`; default `shell` with a skeleton, else `value`.
+    pub metric: Option<Metric>,
+    /// `--rotation-tolerance DEG` (`value`).
+    pub rotation_tolerance: Option<f64>,
+    /// `--knots`.
+    pub knots: Knots,
+    /// Stored or derived tangents (`--tangents`).
+    pub tangents: Tangents,
+}
+
+/// What [`reduce`] reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Input<'a> {
+    /// The input as a document (its tracks' settings are kept).
+    pub doc: &'a ClipDoc,
+    /// The input, built.
+    pub clip: &'a Clip,
+    /// Its rig, End Sites included as leaf joints ([`metric::with_end_sites`]).
+    pub skeleton: Option<&'a Skeleton>,
+}
+
+/// The values [`reduce`] worked with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The metric.
+    pub metric: Metric,
+    /// E.
+    pub tolerance: f64,
+    /// R (`shell`).
+    pub shell: f64,
+    /// Degrees (`value`).
+    pub rotation_tolerance: f64,
+    /// H, the skeleton's rest-pose height (0 without one).
+    pub height: f64,
+    /// Knot sharing.
+    pub knots: Knots,
+    /// Tangents.
+    pub tangents: Tangents,
+}
+
+/// Counts of a clip, as the summary line gives them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Counts {
+    /// Keys over all tracks.
+    pub keys: usize,
+    /// Stored numbers: each key's value and explicit tangents, all components.
+    pub values: usize,
+    /// The compiled runtime clip's memory ([`tcb_runtime::Clip::memory_bytes`]).
+    pub bytes: usize,
+}
+
+/// One try of a budget scale κ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attempt {
+    /// κ.
+    pub scale: f64,
+    /// Stored numbers written.
+    pub values: usize,
+    /// The measured error over the tolerance.
+    pub ratio: f64,
+    /// Where it was largest.
+    pub worst: Worst,
+}
+
+/// The reduced clip and what was measured.
+#[derive(Clone, Debug)]
+pub struct Reduced {
+    /// The clip to write.
+    pub doc: ClipDoc,
+    /// It, built (what was verified).
+    pub clip: Clip,
+    /// The values used.
+    pub settings: Settings,
+    /// The input's counts.
+    pub before: Counts,
+    /// The output's counts.
+    pub after: Counts,
+    /// The measured error of the output, by the metric, on the runtime.
+    pub worst: Worst,
+    /// Tracks kept as they were.
+    pub kept: Vec<String>,
+    /// Every κ tried.
+    pub attempts: Vec<Attempt>,
+}
+
+impl Reduced {
+    /// The contract's last line.
+    pub fn summary_line(&self) -> String {
+        format!(
+            "reduced: tracks {}, keys {} -> {}, values {} -> {}, bytes {} -> {}, max error {:e} ({}, joint {}, time {})",
+            self.doc.tracks.len(),
+            self.before.keys,
+            self.after.keys,
+            self.before.values,
+            self.after.values,
+            self.before.bytes,
+            self.after.bytes,
+            self.worst.error,
+            self.settings.metric.name(),
+            self.worst.at,
+            self.worst.time
+        )
+    }
+}
+
+/// Why nothing was reduced.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ReduceError {
+    /// An option is out of range.
+    Option(String),
+    /// `--metric shell` without a skeleton.
+    NoSkeleton,
+    /// Nothing to reduce.
+    Empty,
+    /// No clip within the tolerance was found.
+    CannotMeet {
+        /// Best error over tolerance reached.
+        ratio: f64,
+        /// Where.
+        worst: Worst,
+    },
+    /// The reduced clip did not build (a bug).
+    Build(String),
+}
+
+impl fmt::Display for ReduceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ReduceError::Option(s) => f.write_str(s),
+            ReduceError::NoSkeleton => f.write_str(
+                "--metric shell needs a skeleton: this clip has none (BVH and glTF files carry one; use --metric value)",
+            ),
+            ReduceError::Empty => f.write_str("the clip has no key times to reduce"),
+            ReduceError::CannotMeet { ratio, worst } => write!(
+                f,
+                "cannot meet the tolerance: the best reduction found is {ratio:.3}x over it ({} at time {}); nothing written",
+                worst.at, worst.time
+            ),
+            ReduceError::Build(s) => write!(f, "the reduced clip does not build: {s}"),
+        }
+    }
+}
+
+impl std::error::Error for ReduceError {}
+
+/// Numbers stored by a track: each key's value and explicit tangents.
+pub fn stored_values(track: &TrackDoc) -> usize {
+    let dim = track.kind.dim();
+    let tangents: usize = track
+        .keys
+        .iter()
+        .map(|k| usize::from(k.tangent_in.is_some()) + usize::from(k.tangent_out.is_some()))
+        .sum();
+    dim * (track.times.len() + tangents)
+}
+
+fn counts(doc: &ClipDoc, clip: &Clip) -> Counts {
+    Counts {
+        keys: doc.tracks.iter().map(|t| t.times.len()).sum(),
+        values: doc.tracks.iter().map(stored_values).sum(),
+        bytes: tcb_runtime::Clip::compile(clip).memory_bytes(),
+    }
+}
+
+fn positive(name: &str, v: f64) -> Result<f64, ReduceError> {
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ReduceError::Option(format!(
+            "{name} must be a positive number, got {v}"
+        )))
+    }
+}
+
+/// Tolerance budget left for the fitter below the target, for f32 rounding
+/// of the written keys and the runtime's own rounding.
+const MARGIN: f64 = 0.9;
+
+/// Reduce `input`. `progress(done, total)` is called as groups of tracks are
+/// fitted (from several threads).
+pub fn reduce(
+    input: Input,
+    options: &ReduceOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Reduced, ReduceError> {
+    let metric = match (options.metric, input.skeleton) {
+        (Some(Metric::Shell), None) => return Err(ReduceError::NoSkeleton),
+        (Some(m), _) => m,
+        (None, Some(_)) => Metric::Shell,
+        (None, None) => Metric::Value,
+    };
+    let height = input.skeleton.map_or(0.0, metric::rest_height);
+    let tolerance = match options.tolerance {
+        Some(e) => positive("--tolerance", e)?,
+        None if metric == Metric::Shell => {
+            if height.is_nan() || height <= 0.0 {
+                return Err(ReduceError::Option(
+                    "the skeleton's rest-pose height is zero: give --tolerance".into(),
+                ));
+            }
+            6e-5 * height
+        }
+        None => 1e-4,
+    };
+    let shell = match options.shell {
+        Some(r) if r >= 0.0 && r.is_finite() => r,
+        Some(r) => {
+            return Err(ReduceError::Option(format!(
+                "--shell must be a number >= 0, got {r}"
+            )));
+        }
+        None => 0.018 * height,
+    };
+    let rotation_tolerance = positive(
+        "--rotation-tolerance",
+        options.rotation_tolerance.unwrap_or(0.01),
+    )?;
+    let settings = Settings {
+        metric,
+        tolerance,
+        shell,
+        rotation_tolerance,
+        height,
+        knots: options.knots,
+        tangents: options.tangents,
+    };
+    let times = metric::check_times(input.clip);
+    if times.len() < 2 {
+        return Err(ReduceError::Empty);
+    }
+    let plan = Plan::new(input, &settings, &times);
+    let before = counts(input.doc, input.clip);
+    let verify = |clip: &Clip| match metric {
+        Metric::Shell => metric::shell_error(
+            input.skeleton.expect("shell has a skeleton"),
+            input.clip,
+            clip,
+            &times,
+            shell,
+            tolerance,
+        ),
+        Metric::Value => {
+            metric::value_error(input.clip, clip, &times, tolerance, rotation_tolerance)
+        }
+    };
+
+    // κ: 1 is the guaranteed bound; larger values are kept while they hold.
+    // κ from loose to tight: loose fits are quick, and a group that stores
+    // no fewer numbers than its original at some κ does so at every smaller
+    // κ too, so it is not fitted again.
+    let scales: &[f64] = match metric {
+        Metric::Shell => &[16.0, 8.0, 4.0, 2.0, 1.0, 0.5, 0.25, 0.1],
+        Metric::Value => &[1.0, 0.5, 0.25, 0.1],
+    };
+    let mut skip = vec![false; plan.groups.len()];
+    let mut attempts = Vec::new();
+    let mut best: Option<(ClipDoc, Clip, Worst, Vec<String>)> = None;
+    let mut failed: Option<Worst> = None;
+    let mut try_scale = |scale: f64, skip: &mut Vec<bool>| -> Result<bool, ReduceError> {
+        let (doc, kept, kept_groups) = plan.run(scale, skip, progress);
+        let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
+        let worst = verify(&clip);
+        let values = doc.tracks.iter().map(stored_values).sum();
+        attempts.push(Attempt {
+            scale,
+            values,
+            ratio: worst.ratio,
+            worst: worst.clone(),
+        });
+        let holds = worst.ratio <= 1.0;
+        if holds {
+            let better = best
+                .as_ref()
+                .is_none_or(|(d, ..)| values < d.tracks.iter().map(stored_values).sum::<usize>());
+            if better {
+                best = Some((doc, clip, worst, kept));
+            }
+        } else {
+            failed = Some(worst);
+            *skip = kept_groups;
+        }
+        Ok(holds)
+    };
+    let mut above: Option<f64> = None;
+    for &scale in scales {
+        if try_scale(scale, &mut skip)? {
+            // One step between the first κ that held and the one above it.
+            if let Some(up) = above {
+                try_scale((up * scale).sqrt(), &mut skip)?;
+            }
+            break;
+        }
+        above = Some(scale);
+    }
+    let Some((doc, clip, worst, kept)) = best else {
+        let worst = failed.unwrap_or_else(|| Worst {
+            error: f64::NAN,
+            ratio: f64::NAN,
+            at: String::new(),
+            time: 0.0,
+        });
+        return Err(ReduceError::CannotMeet {
+            ratio: worst.ratio,
+            worst,
+        });
+    };
+    let after = counts(&doc, &clip);
+    Ok(Reduced {
+        doc,
+        clip,
+        settings,
+        before,
+        after,
+        worst,
+        kept,
+        attempts,
+    })
+}
+
+/// What a track is to the fitter.
+struct Prepared {
+    /// Check-time indices it spans.
+    first: usize,
+    last: usize,
+    /// Samples there (rotations normalized and sign-continuous).
+    samples: Vec<[f64; 4]>,
+    /// Joint and part (0 translation, 1 rotation, 2 scale), under `shell`.
+    joint: Option<(usize, usize)>,
+}
+
+struct Plan<'a> {
+    input: Input<'a>,
+    settings: &'a Settings,
+    times: &'a [f64],
+    /// Per track: `None` when kept as it is.
+    tracks: Vec<Option<Prepared>>,
+    /// Per joint (`shell`): L_a and the number of fitted tracks on the
+    /// longest chain through it.
+    reach: Vec<f64>,
+    chain: Vec<usize>,
+    /// Groups of track indices sharing key times.
+    groups: Vec<Vec<usize>>,
+}
+
+impl<'a> Plan<'a> {
+    fn new(input: Input<'a>, settings: &'a Settings, times: &'a [f64]) -> Self {
+        let rows = metric::play(input.clip, times);
+        let channels = input.clip.channel_count();
+        let n = times.len();
+        let mut tracks = Vec::new();
+        let mut at = 0;
+        for (doc, track) in input.doc.tracks.iter().zip(&input.clip.tracks) {
+            let kind = track.data.kind();
+            let dim = kind.dim();
+            let (t0, t1) = (track.data.times()[0], *track.data.times().last().unwrap());
+            let first = times.partition_point(|&t| t < t0);
+            let last = times.partition_point(|&t| t <= t1).saturating_sub(1);
+            let (resolved, _) = doc.settings.or(&input.doc.defaults).resolve();
+            let outside_line = |mode: Extrapolation| {
+                matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat)
+            };
+            let joint = match (settings.metric, input.skeleton) {
+                (Metric::Shell, Some(s)) => bound_joint(s, &track.name, kind),
+                _ => None,
+            };
+            let fit_it = last > first
+                && !(first > 0 && outside_line(resolved.pre))
+                && !(last + 1 < n && outside_line(resolved.post))
+                && (settings.metric == Metric::Value || joint.is_some());
+            tracks.push(fit_it.then(|| {
+                let mut samples: Vec<[f64; 4]> = (first..=last)
+                    .map(|i| {
+                        let row = &rows[i * channels + at..i * channels + at + dim];
+                        std::array::from_fn(|c| row.get(c).map_or(0.0, |v| f64::from(*v)))
+                    })
+                    .collect();
+                if kind == TrackKind::Quat {
+                    continuous_rotations(&mut samples);
+                }
+                Prepared {
+                    first,
+                    last,
+                    samples,
+                    joint,
+                }
+            }));
+            at += dim;
+        }
+        let (reach, chain) = match input.skeleton {
+            Some(s) if settings.metric == Metric::Shell => {
+                chains(s, &tracks, input.clip, &rows, channels, settings.shell)
+            }
+            _ => (Vec::new(), Vec::new()),
+        };
+        let mut groups: Vec<(String, usize, usize, Vec<usize>)> = Vec::new();
+        for (i, p) in tracks.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let key = match settings.knots {
+                Knots::Track => input.clip.tracks[i].name.clone(),
+                Knots::Joint => joint_name(&input.clip.tracks[i].name).to_owned(),
+                Knots::Clip => String::new(),
+            };
+            match groups
+                .iter_mut()
+                .find(|g| g.0 == key && g.1 == p.first && g.2 == p.last)
+            {
+                Some(g) => g.3.push(i),
+                None => groups.push((key, p.first, p.last, vec![i])),
+            }
+        }
+        Plan {
+            input,
+            settings,
+            times,
+            tracks,
+            reach,
+            chain,
+            groups: groups.into_iter().map(|g| g.3).collect(),
+        }
+    }
+
+    /// The tolerance and norm of track `i` at budget scale `scale`.
+    fn budget(&self, i: usize, scale: f64) -> (Norm, f64) {
+        let s = self.settings;
+        let kind = self.input.clip.tracks[i].data.kind();
+        let p = self.tracks[i].as_ref().expect("a fitted track");
+        match (s.metric, p.joint) {
+            (Metric::Shell, Some((j, part))) => {
+                let e = scale * MARGIN * s.tolerance / self.chain[j].max(1) as f64;
+                let reach = self.reach[j].max(f64::MIN_POSITIVE);
+                match part {
+                    0 => (Norm::Euclid, e),
+                    1 => (Norm::Rotation, (e / (2.0 * reach)).min(1.0)),
+                    _ => (Norm::MaxAbs, e / reach),
+                }
+            }
+            _ if kind == TrackKind::Quat => {
+                let half = (scale * MARGIN * s.rotation_tolerance).to_radians() / 2.0;
+                (Norm::Rotation, half.min(std::f64::consts::FRAC_PI_2).sin())
+            }
+            _ => (Norm::MaxAbs, scale * MARGIN * s.tolerance),
+        }
+    }
+
+    /// Fit every group at budget scale `scale` and write the clip. Returns
+    /// it and the names of the tracks kept as they were.
+    /// Groups marked in `skip` are kept as they are without fitting; the
+    /// third result marks the groups kept this time.
+    fn run(
+        &self,
+        scale: f64,
+        skip: &[bool],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> (ClipDoc, Vec<String>, Vec<bool>) {
+        let done = AtomicUsize::new(0);
+        let total = self.groups.len();
+        let fits: Vec<Option<Fit>> = self
+            .groups
+            .par_iter()
+            .zip(skip)
+            .map(|(g, &skip)| {
+                if skip {
+                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                    return None;
+                }
+                let p0 = self.tracks[g[0]].as_ref().expect("a fitted track");
+                let series: Vec<Series> = g
+                    .iter()
+                    .map(|&i| {
+                        let (norm, tol) = self.budget(i, scale);
+                        Series {
+                            dim: self.input.clip.tracks[i].data.kind().dim(),
+                            samples: &self.tracks[i].as_ref().expect("fitted").samples,
+                            norm,
+                            tol,
+                        }
+                    })
+                    .collect();
+                // Insertion places about twice the keys removal keeps: past
+                // that, the fit would store more than the original does.
+                let original: usize = g
+                    .iter()
+                    .map(|&i| stored_values(&self.input.doc.tracks[i]))
+                    .sum();
+                let per_key: usize = series.iter().map(|s| s.dim).sum::<usize>()
+                    * match self.settings.tangents {
+                        Tangents::Explicit => 3,
+                        Tangents::Derived => 1,
+                    };
+                let f = fit::fit_within(
+                    &self.times[p0.first..=p0.last],
+                    &series,
+                    self.settings.tangents,
+                    3 * original / per_key.max(1),
+                );
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                f
+            })
+            .collect();
+        // Per track: its fit and its place in the group.
+        let mut fitted: Vec<Option<(&Fit, usize)>> = vec![None; self.tracks.len()];
+        for (g, f) in self.groups.iter().zip(&fits) {
+            if let Some(f) = f {
+                for (s, &i) in g.iter().enumerate() {
+                    fitted[i] = Some((f, s));
+                }
+            }
+        }
+        let (doc, kept) = self.write(&fitted);
+        let kept_groups = self
+            .groups
+            .iter()
+            .map(|g| {
+                g.iter()
+                    .all(|&i| kept.contains(&self.input.clip.tracks[i].name))
+            })
+            .collect();
+        (doc, kept, kept_groups)
+    }
+
+    fn write(&self, fitted: &[Option<(&Fit, usize)>]) -> (ClipDoc, Vec<String>) {
+        let src = self.input.doc;
+        let (base, _) = src.defaults.resolve();
+        let defaults = SettingsDoc {
+            tangent_rule: Some(TangentRule::Adjusted),
+            ends: Some(Ends::Copy),
+            match_speed: Some(false),
+            continuity_fade: Some(false),
+            tcb: Some([0.0; 3]),
+            pre: Some(base.pre),
+            post: Some(base.post),
+            rotation: Some(RotationMode::Hermite),
+        };
+        let mut tracks = Vec::new();
+        let mut kept = Vec::new();
+        for (i, doc) in src.tracks.iter().enumerate() {
+            let (resolved, tcb) = doc.settings.or(&src.defaults).resolve();
+            let reduced = fitted[i].map(|(f, s)| {
+                let p = self.tracks[i].as_ref().expect("fitted");
+                let times = f.knots.iter().map(|&k| self.times[p.first + k]).collect();
+                let to_f32 = |v: &[f64; 4]| v.map(|c| c as f32);
+                let values = f.values[s].iter().map(to_f32).collect();
+                let keys = match self.settings.tangents {
+                    Tangents::Explicit => f.tangents[s]
+                        .iter()
+                        .map(|g| KeyDoc {
+                            tangent_in: Some(to_f32(g)),
+                            tangent_out: Some(to_f32(g)),
+                            ..KeyDoc::default()
+                        })
+                        .collect(),
+                    Tangents::Derived => Vec::new(),
+                };
+                TrackDoc {
+                    name: doc.name.clone(),
+                    kind: doc.kind,
+                    times,
+                    values,
+                    keys,
+                    settings: SettingsDoc {
+                        pre: Some(resolved.pre).filter(|m| *m != base.pre),
+                        post: Some(resolved.post).filter(|m| *m != base.post),
+                        ..SettingsDoc::default()
+                    },
+                }
+            });
+            match reduced {
+                Some(t) if stored_values(&t) < stored_values(doc) => tracks.push(t),
+                _ => {
+                    kept.push(doc.name.clone());
+                    // The original, with every setting it had stated against the new defaults.
+                    let full = SettingsDoc {
+                        tangent_rule: Some(resolved.tangent_rule),
+                        ends: Some(resolved.ends),
+                        match_speed: Some(resolved.match_speed),
+                        continuity_fade: Some(resolved.continuity_fade),
+                        tcb: Some(tcb.to_array()),
+                        pre: Some(resolved.pre),
+                        post: Some(resolved.post),
+                        rotation: (doc.kind == TrackKind::Quat).then_some(resolved.rotation),
+                    };
+                    tracks.push(TrackDoc {
+                        settings: only_different(&full, &defaults),
+                        ..doc.clone()
+                    });
+                }
+            }
+        }
+        (
+            ClipDoc {
+                name: src.name.clone(),
+                defaults,
+                tracks,
+            },
+            kept,
+        )
+    }
+}
+
+/// The fields of `full` that differ from `defaults`.
+fn only_different(full: &SettingsDoc, defaults: &SettingsDoc) -> SettingsDoc {
+    fn diff<T: PartialEq + Copy>(a: Option<T>, b: Option<T>) -> Option<T> {
+        if a == b { None } else { a }
+    }
+    SettingsDoc {
+        tangent_rule: diff(full.tangent_rule, defaults.tangent_rule),
+        ends: diff(full.ends, defaults.ends),
+        match_speed: diff(full.match_speed, defaults.match_speed),
+        continuity_fade: diff(full.continuity_fade, defaults.continuity_fade),
+        tcb: diff(full.tcb, defaults.tcb),
+        pre: diff(full.pre, defaults.pre),
+        post: diff(full.post, defaults.post),
+        rotation: full.rotation.and_then(|r| diff(Some(r), defaults.rotation)),
+    }
+}
+
+/// `Hips` of `Hips.rotation`.
+fn joint_name(track: &str) -> &str {
+    track.rsplit_once('.').map_or(track, |(j, _)| j)
+}
+
+/// The joint and part a track animates: `<joint>.translation` (vec3),
+/// `.rotation` (quat), `.scale` (vec3).
+fn bound_joint(skeleton: &Skeleton, name: &str, kind: TrackKind) -> Option<(usize, usize)> {
+    let (joint, part) = name.rsplit_once('.')?;
+    let part = match (part, kind) {
+        ("translation", TrackKind::Vec3) => 0,
+        ("rotation", TrackKind::Quat) => 1,
+        ("scale", TrackKind::Vec3) => 2,
+        _ => return None,
+    };
+    Some((skeleton.joint(joint)?, part))
+}
+
+/// Unit quaternions, each on the hemisphere of the one before.
+fn continuous_rotations(samples: &mut [[f64; 4]]) {
+    let mut prev: Option<[f64; 4]> = None;
+    for q in samples.iter_mut() {
+        let len = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if len > 0.0 {
+            q.iter_mut().for_each(|c| *c /= len);
+        }
+        if let Some(p) = prev
+            && (0..4).map(|c| p[c] * q[c]).sum::<f64>() < 0.0
+        {
+            q.iter_mut().for_each(|c| *c = -*c);
+        }
+        prev = Some(*q);
+    }
+}
+
+/// Per joint: `L_a` (the longest chain of rest or animated offsets below it,
+/// plus the shell radius) and the number of fitted tracks on the longest
+/// root-to-leaf chain through it.
+fn chains(
+    skeleton: &Skeleton,
+    tracks: &[Option<Prepared>],
+    clip: &Clip,
+    rows: &[f32],
+    channels: usize,
+    radius: f64,
+) -> (Vec<f64>, Vec<usize>) {
+    let n = skeleton.joints.len();
+    let mut offset: Vec<f64> = skeleton
+        .joints
+        .iter()
+        .map(|j| f64::from(j.rest.translation.length()))
+        .collect();
+    let mut count = vec![0usize; n];
+    let mut at = 0;
+    for (t, p) in clip.tracks.iter().zip(tracks) {
+        let dim = t.data.kind().dim();
+        if let Some(Prepared {
+            joint: Some((j, part)),
+            ..
+        }) = p
+        {
+            count[*j] += 1;
+            if *part == 0 {
+                let longest = rows
+                    .chunks_exact(channels)
+                    .map(|r| {
+                        r[at..at + 3]
+                            .iter()
+                            .map(|v| f64::from(*v).powi(2))
+                            .sum::<f64>()
+                            .sqrt()
+                    })
+                    .fold(0.0, f64::max);
+                offset[*j] = offset[*j].max(longest);
+            }
+        }
+        at += dim;
+    }
+    let parent = |j: usize| skeleton.joints[j].parent.filter(|&p| p < j);
+    // Below: longest offset chain and most tracks on a chain, leaves up.
+    let mut reach = vec![0.0f64; n];
+    let mut down = count.clone();
+    for j in (0..n).rev() {
+        if let Some(p) = parent(j) {
+            reach[p] = reach[p].max(reach[j] + offset[j]);
+            down[p] = down[p].max(count[p] + down[j]);
+        }
+    }
+    let mut up = count.clone();
+    for j in 0..n {
+        if let Some(p) = parent(j) {
+            up[j] += up[p];
+        }
+    }
+    let chain = (0..n).map(|j| up[j] + down[j] - count[j]).collect();
+    (reach.into_iter().map(|r| r + radius).collect(), chain)
+}
