@@ -312,8 +312,13 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     }
     for a in &reduced.attempts {
         eprintln!(
-            "tcb: budget scale {}: values {}, error {:.3} of the tolerance ({} at {} s)",
-            a.scale, a.values, a.ratio, a.worst.at, a.worst.time
+            "tcb: round {}: {} groups fitted, values {}, error {:.3} of the tolerance ({} at {} s)",
+            a.round + 1,
+            a.fitted,
+            a.values,
+            a.ratio,
+            a.worst.at,
+            a.worst.time
         );
     }
     if !reduced.kept.is_empty() {

@@ -591,7 +591,11 @@ mod tests {
         for mode in [Tangents::Explicit, Tangents::Derived] {
             let fit = fit(&times, &s, mode).unwrap();
             assert!(fit.worst <= 1.0);
-            assert!(fit.knots.contains(&40) && fit.knots.contains(&41), "{:?}", fit.knots);
+            assert!(
+                fit.knots.contains(&40) && fit.knots.contains(&41),
+                "{:?}",
+                fit.knots
+            );
             assert!(fit.knots.len() < 20, "{:?}", fit.knots);
         }
         let mut bad = y.clone();

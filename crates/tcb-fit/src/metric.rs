@@ -7,7 +7,7 @@
 //! value   vectors: max |x_c - x'_c| per component; rotations: 2 acos(|q . q'|)
 //! ```
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, DAffine3, Vec3};
 use std::sync::Arc;
 use tcb_core::sample_times::inbetweens;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
@@ -70,6 +70,16 @@ impl Worst {
     }
 }
 
+/// An error measured over a whole clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measured {
+    /// The largest, and where.
+    pub worst: Worst,
+    /// Per joint (`shell`) or per track (`value`): the largest error over
+    /// the tolerance.
+    pub each: Vec<f64>,
+}
+
 /// A skeleton with BVH End Sites (parent joint, offset) added as leaf joints
 /// named `<parent>_end` (the clip contract's convention), so their points
 /// count in the shell metric and in the rest-pose height.
@@ -114,7 +124,7 @@ pub fn shell_error(
     times: &[f64],
     radius: f64,
     tolerance: f64,
-) -> Worst {
+) -> Measured {
     let a = Arc::new(tcb_runtime::Clip::compile(reference));
     let b = Arc::new(tcb_runtime::Clip::compile(reduced));
     let bind_a = SkeletonBinding::new(skeleton.clone(), &a);
@@ -122,27 +132,46 @@ pub fn shell_error(
     let (mut ia, mut ib) = (Instance::new(a, false), Instance::new(b, false));
     let n = skeleton.joints.len();
     let mut local = vec![Transform::IDENTITY; n];
-    let (mut ma, mut mb) = (vec![Affine3A::IDENTITY; n], vec![Affine3A::IDENTITY; n]);
+    let (mut ma, mut mb) = (vec![DAffine3::IDENTITY; n], vec![DAffine3::IDENTITY; n]);
     let mut worst = Worst::none();
+    let mut each = vec![0.0f64; n];
     for &t in times {
-        bind_a.model_transforms(ia.sample(t), &mut local, &mut ma);
-        bind_b.model_transforms(ib.sample(t), &mut local, &mut mb);
+        bind_a.local_transforms(ia.sample(t), &mut local);
+        compose(skeleton, &local, &mut ma);
+        bind_b.local_transforms(ib.sample(t), &mut local);
+        compose(skeleton, &local, &mut mb);
         for (j, joint) in skeleton.joints.iter().enumerate() {
             let e = point_error(&ma[j], &mb[j], radius);
             worst.take(e, e / tolerance, &joint.name, t);
+            each[j] = each[j].max(e / tolerance);
         }
     }
-    worst
+    Measured { worst, each }
 }
 
-/// `max over v in {0, R e_x, R e_y, R e_z} of |a v - b v|`, in f64.
-pub fn point_error(a: &Affine3A, b: &Affine3A, radius: f64) -> f64 {
-    let d = |x: glam::Vec3A, y: glam::Vec3A| x.as_dvec3() - y.as_dvec3();
-    let dt = d(a.translation, b.translation);
+/// Model-space transforms in f64 (`M_j = M_parent T_j R_j S_j`), so that
+/// composing 30 joints adds no rounding the tolerance has to absorb.
+fn compose(skeleton: &Skeleton, local: &[Transform], out: &mut [DAffine3]) {
+    for (j, (joint, l)) in skeleton.joints.iter().zip(local).enumerate() {
+        let m = DAffine3::from_scale_rotation_translation(
+            l.scale.as_dvec3(),
+            l.rotation.as_dquat().normalize(),
+            l.translation.as_dvec3(),
+        );
+        out[j] = match joint.parent {
+            Some(p) if p < j => out[p] * m,
+            _ => m,
+        };
+    }
+}
+
+/// `max over v in {0, R e_x, R e_y, R e_z} of |a v - b v|`.
+pub fn point_error(a: &DAffine3, b: &DAffine3, radius: f64) -> f64 {
+    let dt = a.translation - b.translation;
     let cols = [
-        d(a.matrix3.x_axis, b.matrix3.x_axis),
-        d(a.matrix3.y_axis, b.matrix3.y_axis),
-        d(a.matrix3.z_axis, b.matrix3.z_axis),
+        a.matrix3.x_axis - b.matrix3.x_axis,
+        a.matrix3.y_axis - b.matrix3.y_axis,
+        a.matrix3.z_axis - b.matrix3.z_axis,
     ];
     cols.iter()
         .map(|c| (dt + *c * radius).length())
@@ -158,23 +187,25 @@ pub fn value_error(
     times: &[f64],
     tolerance: f64,
     rotation_degrees: f64,
-) -> Worst {
+) -> Measured {
     let channels = reference.channel_count();
     let (ra, rb) = (play(reference, times), play(reduced, times));
     let mut worst = Worst::none();
+    let mut each = vec![0.0f64; reference.tracks.len()];
     for (i, &t) in times.iter().enumerate() {
         let (ya, yb) = (
             &ra[i * channels..(i + 1) * channels],
             &rb[i * channels..(i + 1) * channels],
         );
         let mut at = 0;
-        for track in &reference.tracks {
+        for (k, track) in reference.tracks.iter().enumerate() {
             let kind = track.data.kind();
             let dim = kind.dim();
             let (a, b) = (&ya[at..at + dim], &yb[at..at + dim]);
             if kind == TrackKind::Quat {
                 let deg = rotation_angle_degrees(a, b);
                 worst.take(deg, deg / rotation_degrees, &track.name, t);
+                each[k] = each[k].max(deg / rotation_degrees);
             } else {
                 let e = a
                     .iter()
@@ -182,11 +213,12 @@ pub fn value_error(
                     .map(|(x, y)| f64::from(*x - *y).abs())
                     .fold(0.0, f64::max);
                 worst.take(e, e / tolerance, &track.name, t);
+                each[k] = each[k].max(e / tolerance);
             }
             at += dim;
         }
     }
-    worst
+    Measured { worst, each }
 }
 
 /// `2 acos(|q . q'|)` in degrees, for quaternions as `[x, y, z, w]`
@@ -218,8 +250,8 @@ mod tests {
 
     #[test]
     fn shell_points_see_rotation_at_the_radius() {
-        let a = Affine3A::IDENTITY;
-        let b = Affine3A::from_rotation_z(0.001);
+        let a = DAffine3::IDENTITY;
+        let b = DAffine3::from_rotation_z(0.001);
         let e = point_error(&a, &b, 2.0);
         // chord of 0.001 rad at radius 2
         assert!((e - 2.0 * 2.0 * (0.0005f64).sin()).abs() < 1e-6, "{e}");

@@ -163,11 +163,13 @@ pub struct Counts {
     pub bytes: usize,
 }
 
-/// One try of a budget scale κ.
+/// One round of fitting and measuring.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Attempt {
-    /// κ.
-    pub scale: f64,
+    /// Round, from 0.
+    pub round: usize,
+    /// Groups of tracks fitted this round (the others reused or kept).
+    pub fitted: usize,
     /// Stored numbers written.
     pub values: usize,
     /// The measured error over the tolerance.
@@ -193,7 +195,7 @@ pub struct Reduced {
     pub worst: Worst,
     /// Tracks kept as they were.
     pub kept: Vec<String>,
-    /// Every κ tried.
+    /// Every round.
     pub attempts: Vec<Attempt>,
 }
 
@@ -291,6 +293,12 @@ fn positive(name: &str, v: f64) -> Result<f64, ReduceError> {
 /// of the written keys and the runtime's own rounding.
 const MARGIN: f64 = 0.9;
 
+/// Rounds of budget refinement before giving up.
+const MAX_ROUNDS: usize = 12;
+
+/// Below this budget scale a group is kept as it is.
+const MIN_SCALE: f64 = 1.0 / 64.0;
+
 /// Reduce `input`. `progress(done, total)` is called as groups of tracks are
 /// fitted (from several threads).
 pub fn reduce(
@@ -345,79 +353,80 @@ pub fn reduce(
     }
     let plan = Plan::new(input, &settings, &times);
     let before = counts(input.doc, input.clip);
-    let verify = |clip: &Clip| match metric {
-        Metric::Shell => metric::shell_error(
-            input.skeleton.expect("shell has a skeleton"),
-            input.clip,
-            clip,
-            &times,
-            shell,
-            tolerance,
-        ),
-        Metric::Value => {
-            metric::value_error(input.clip, clip, &times, tolerance, rotation_tolerance)
+    let verify = |clip: &Clip| -> metric::Measured {
+        match metric {
+            Metric::Shell => metric::shell_error(
+                input.skeleton.expect("shell has a skeleton"),
+                input.clip,
+                clip,
+                &times,
+                shell,
+                tolerance,
+            ),
+            Metric::Value => {
+                metric::value_error(input.clip, clip, &times, tolerance, rotation_tolerance)
+            }
         }
     };
 
     // κ: 1 is the guaranteed bound; larger values are kept while they hold.
-    // κ from loose to tight: loose fits are quick, and a group that stores
-    // no fewer numbers than its original at some κ does so at every smaller
-    // κ too, so it is not fitted again.
-    let scales: &[f64] = match metric {
-        Metric::Shell => &[16.0, 8.0, 4.0, 2.0, 1.0, 0.5, 0.25, 0.1],
-        Metric::Value => &[1.0, 0.5, 0.25, 0.1],
+    // Budgets: every group starts loose (κ = 16 for shell, whose bound
+    // is loose; 1 for value, which is exact). After each round, the groups
+    // that can move a joint (or track) measured over its tolerance are
+    // tightened by the ratio found there, and only they are fitted again.
+    let start = match metric {
+        Metric::Shell => 16.0,
+        Metric::Value => 1.0,
     };
-    let mut skip = vec![false; plan.groups.len()];
+    let units = plan.units();
+    let mut scale = vec![start; plan.groups.len()];
+    let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let mut attempts = Vec::new();
-    let mut best: Option<(ClipDoc, Clip, Worst, Vec<String>)> = None;
-    let mut failed: Option<Worst> = None;
-    let mut try_scale = |scale: f64, skip: &mut Vec<bool>| -> Result<bool, ReduceError> {
-        let (doc, kept, kept_groups) = plan.run(scale, skip, progress);
+    let mut best = None;
+    for round in 0..MAX_ROUNDS {
+        let fitted = scale
+            .iter()
+            .zip(&cache)
+            .filter(|(s, c)| **s > 0.0 && c.as_ref().is_none_or(|c| c.0 != **s))
+            .count();
+        let (doc, kept) = plan.run(&scale, &mut cache, progress);
         let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-        let worst = verify(&clip);
-        let values = doc.tracks.iter().map(stored_values).sum();
+        let measured = verify(&clip);
         attempts.push(Attempt {
-            scale,
-            values,
-            ratio: worst.ratio,
-            worst: worst.clone(),
+            round,
+            fitted,
+            values: doc.tracks.iter().map(stored_values).sum(),
+            ratio: measured.worst.ratio,
+            worst: measured.worst.clone(),
         });
-        let holds = worst.ratio <= 1.0;
-        if holds {
-            let better = best
-                .as_ref()
-                .is_none_or(|(d, ..)| values < d.tracks.iter().map(stored_values).sum::<usize>());
-            if better {
-                best = Some((doc, clip, worst, kept));
-            }
-        } else {
-            failed = Some(worst);
-            *skip = kept_groups;
-        }
-        Ok(holds)
-    };
-    let mut above: Option<f64> = None;
-    for &scale in scales {
-        if try_scale(scale, &mut skip)? {
-            // One step between the first κ that held and the one above it.
-            if let Some(up) = above {
-                try_scale((up * scale).sqrt(), &mut skip)?;
-            }
+        if measured.worst.ratio <= 1.0 {
+            best = Some((doc, clip, measured.worst, kept));
             break;
         }
-        above = Some(scale);
+        if round + 1 == MAX_ROUNDS {
+            return Err(ReduceError::CannotMeet {
+                ratio: measured.worst.ratio,
+                worst: measured.worst,
+            });
+        }
+        for (g, units) in units.iter().enumerate() {
+            let over = units.iter().map(|&u| measured.each[u]).fold(0.0, f64::max);
+            if over > 1.0 || over.is_nan() {
+                let all_kept = plan.groups[g]
+                    .iter()
+                    .all(|&i| kept.contains(&input.clip.tracks[i].name));
+                // Kept at this budget: kept at any smaller one.
+                let next = scale[g] / (1.1 * over);
+                scale[g] = if all_kept || !next.is_finite() || next < MIN_SCALE {
+                    0.0
+                } else {
+                    next
+                };
+            }
+        }
     }
     let Some((doc, clip, worst, kept)) = best else {
-        let worst = failed.unwrap_or_else(|| Worst {
-            error: f64::NAN,
-            ratio: f64::NAN,
-            at: String::new(),
-            time: 0.0,
-        });
-        return Err(ReduceError::CannotMeet {
-            ratio: worst.ratio,
-            worst,
-        });
+        return Err(ReduceError::Empty);
     };
     let after = counts(&doc, &clip);
     Ok(Reduced {
@@ -557,80 +566,112 @@ impl<'a> Plan<'a> {
         }
     }
 
-    /// Fit every group at budget scale `scale` and write the clip. Returns
-    /// it and the names of the tracks kept as they were.
-    /// Groups marked in `skip` are kept as they are without fitting; the
-    /// third result marks the groups kept this time.
+    /// Fit every group at its budget scale (0: kept as it is), reusing the
+    /// fit in `cache` where the scale has not changed, and write the clip.
+    /// Returns it and the names of the tracks kept as they were.
     fn run(
         &self,
-        scale: f64,
-        skip: &[bool],
+        scales: &[f64],
+        cache: &mut [Option<(f64, Option<Fit>)>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> (ClipDoc, Vec<String>, Vec<bool>) {
+    ) -> (ClipDoc, Vec<String>) {
         let done = AtomicUsize::new(0);
-        let total = self.groups.len();
-        let fits: Vec<Option<Fit>> = self
-            .groups
+        let todo: Vec<usize> = (0..self.groups.len())
+            .filter(|&g| scales[g] > 0.0 && cache[g].as_ref().is_none_or(|c| c.0 != scales[g]))
+            .collect();
+        let total = todo.len();
+        let fresh: Vec<(usize, Option<Fit>)> = todo
             .par_iter()
-            .zip(skip)
-            .map(|(g, &skip)| {
-                if skip {
-                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                    return None;
-                }
-                let p0 = self.tracks[g[0]].as_ref().expect("a fitted track");
-                let series: Vec<Series> = g
-                    .iter()
-                    .map(|&i| {
-                        let (norm, tol) = self.budget(i, scale);
-                        Series {
-                            dim: self.input.clip.tracks[i].data.kind().dim(),
-                            samples: &self.tracks[i].as_ref().expect("fitted").samples,
-                            norm,
-                            tol,
-                        }
-                    })
-                    .collect();
-                // Insertion places about twice the keys removal keeps: past
-                // that, the fit would store more than the original does.
-                let original: usize = g
-                    .iter()
-                    .map(|&i| stored_values(&self.input.doc.tracks[i]))
-                    .sum();
-                let per_key: usize = series.iter().map(|s| s.dim).sum::<usize>()
-                    * match self.settings.tangents {
-                        Tangents::Explicit => 3,
-                        Tangents::Derived => 1,
-                    };
-                let f = fit::fit_within(
-                    &self.times[p0.first..=p0.last],
-                    &series,
-                    self.settings.tangents,
-                    3 * original / per_key.max(1),
-                );
+            .map(|&gi| {
+                let f = self.fit_group(gi, scales[gi]);
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                f
+                (gi, f)
             })
             .collect();
+        for (g, f) in fresh {
+            cache[g] = Some((scales[g], f));
+        }
+        for (g, c) in cache.iter_mut().enumerate() {
+            if scales[g] == 0.0 {
+                *c = None;
+            }
+        }
         // Per track: its fit and its place in the group.
         let mut fitted: Vec<Option<(&Fit, usize)>> = vec![None; self.tracks.len()];
-        for (g, f) in self.groups.iter().zip(&fits) {
-            if let Some(f) = f {
+        for (g, c) in self.groups.iter().zip(cache.iter()) {
+            if let Some((_, Some(f))) = c {
                 for (s, &i) in g.iter().enumerate() {
                     fitted[i] = Some((f, s));
                 }
             }
         }
-        let (doc, kept) = self.write(&fitted);
-        let kept_groups = self
-            .groups
+        self.write(&fitted)
+    }
+
+    fn fit_group(&self, gi: usize, scale: f64) -> Option<Fit> {
+        let g = &self.groups[gi];
+        let p0 = self.tracks[g[0]].as_ref().expect("a fitted track");
+        let series: Vec<Series> = g
             .iter()
-            .map(|g| {
-                g.iter()
-                    .all(|&i| kept.contains(&self.input.clip.tracks[i].name))
+            .map(|&i| {
+                let (norm, tol) = self.budget(i, scale);
+                Series {
+                    dim: self.input.clip.tracks[i].data.kind().dim(),
+                    samples: &self.tracks[i].as_ref().expect("fitted").samples,
+                    norm,
+                    tol,
+                }
             })
             .collect();
-        (doc, kept, kept_groups)
+        // Insertion places about twice the keys removal keeps: past that,
+        // the fit would store more than the original does.
+        let original: usize = g
+            .iter()
+            .map(|&i| stored_values(&self.input.doc.tracks[i]))
+            .sum();
+        let per_key: usize = series.iter().map(|s| s.dim).sum::<usize>()
+            * match self.settings.tangents {
+                Tangents::Explicit => 3,
+                Tangents::Derived => 1,
+            };
+        fit::fit_within(
+            &self.times[p0.first..=p0.last],
+            &series,
+            self.settings.tangents,
+            3 * original / per_key.max(1),
+        )
+    }
+
+    /// Per group: the joints (`shell`, every joint its tracks can move) or
+    /// tracks (`value`) whose measured error it affects.
+    fn units(&self) -> Vec<Vec<usize>> {
+        let skeleton = self.input.skeleton;
+        self.groups
+            .iter()
+            .map(|g| {
+                let mut units = Vec::new();
+                for &i in g {
+                    match (self.settings.metric, skeleton, &self.tracks[i]) {
+                        (
+                            Metric::Shell,
+                            Some(s),
+                            Some(Prepared {
+                                joint: Some((a, _)),
+                                ..
+                            }),
+                        ) => {
+                            for d in 0..s.joints.len() {
+                                if descends(s, d, *a) && !units.contains(&d) {
+                                    units.push(d);
+                                }
+                            }
+                        }
+                        _ => units.push(i),
+                    }
+                }
+                units
+            })
+            .collect()
     }
 
     fn write(&self, fitted: &[Option<(&Fit, usize)>]) -> (ClipDoc, Vec<String>) {
@@ -726,6 +767,19 @@ fn only_different(full: &SettingsDoc, defaults: &SettingsDoc) -> SettingsDoc {
         pre: diff(full.pre, defaults.pre),
         post: diff(full.post, defaults.post),
         rotation: full.rotation.and_then(|r| diff(Some(r), defaults.rotation)),
+    }
+}
+
+/// Whether joint `d` is `a` or below it.
+fn descends(skeleton: &Skeleton, mut d: usize, a: usize) -> bool {
+    loop {
+        if d == a {
+            return true;
+        }
+        match skeleton.joints[d].parent {
+            Some(p) if p < d => d = p,
+            _ => return false,
+        }
     }
 }
 
