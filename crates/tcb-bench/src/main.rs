@@ -79,10 +79,11 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         }
     }
     let slice = Duration::from_millis(args.slice_ms.max(1));
-    let rows: Vec<_> = all
+    let mut rows: Vec<_> = all
         .iter()
         .map(|s| report::measure(s, args.rounds, slice))
         .collect();
+    report::relate(&mut rows);
     let (flags, machine) = (report::flags(), report::machine());
     print!("{}", report::table(&rows, &flags, &machine));
     println!("\ntargets:");

@@ -68,6 +68,11 @@ pub struct Row {
     pub parallel_speedup: Option<f64>,
     /// Largest difference between splines and the reference before timing.
     pub splines_agreement: Option<f64>,
+    /// The compiled clip's memory ([`tcb_runtime::Clip::memory_bytes`]).
+    pub bytes: usize,
+    /// `character-reduced`: the dense `character-hermite` runtime time over
+    /// this one (both measured in this run, so it holds across machines).
+    pub speedup_vs_dense: Option<f64>,
 }
 
 impl Row {
@@ -82,6 +87,7 @@ pub fn measure(s: &Scenario, rounds: usize, slice: Duration) -> Row {
     let mut row = Row {
         name: s.name.to_string(),
         channels: s.channels(),
+        bytes: s.clip.memory_bytes(),
         ..Row::default()
     };
     if let Some(peer) = &s.peer {
@@ -136,6 +142,17 @@ pub fn measure(s: &Scenario, rounds: usize, slice: Duration) -> Row {
     row
 }
 
+/// Ratios between rows: `character-reduced` against `character-hermite`.
+pub fn relate(rows: &mut [Row]) {
+    let dense = rows
+        .iter()
+        .find(|r| r.name == "character-hermite")
+        .and_then(|r| r.ns_of("runtime"));
+    for r in rows.iter_mut().filter(|r| r.name == "character-reduced") {
+        r.speedup_vs_dense = dense.zip(r.ns_of("runtime")).map(|(d, x)| d / x);
+    }
+}
+
 /// The JSON document.
 pub fn to_json(rows: &[Row], flags: &str, machine: &str) -> Value {
     let scenarios: Vec<Value> = rows
@@ -150,12 +167,14 @@ pub fn to_json(rows: &[Row], flags: &str, machine: &str) -> Value {
                     .collect();
             m.insert("ns_per_channel".into(), Value::Object(ns));
             m.insert("speedup_vs_baseline".into(), json!(r.speedup_vs_baseline));
+            m.insert("bytes".into(), json!(r.bytes));
             let optional = [
                 ("speedup_vs_splines", r.speedup_vs_splines),
                 ("read_limit_fraction", r.read_limit_fraction),
                 ("ns_per_joint", r.ns_per_joint),
                 ("parallel_speedup", r.parallel_speedup),
                 ("splines_agreement", r.splines_agreement),
+                ("speedup_vs_dense", r.speedup_vs_dense),
             ];
             for (k, v) in optional {
                 if let Some(v) = v {
@@ -188,7 +207,7 @@ pub fn table(rows: &[Row], flags: &str, machine: &str) -> String {
     let _ = writeln!(out, "machine: {machine}\n");
     let _ = writeln!(
         out,
-        "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10}",
+        "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9}",
         "scenario",
         "channels",
         "baseline",
@@ -198,12 +217,13 @@ pub fn table(rows: &[Row], flags: &str, machine: &str) -> String {
         "x base",
         "x splines",
         "read lim",
-        "ns/joint"
+        "ns/joint",
+        "MB"
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10}",
+            "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9.3}",
             r.name,
             r.channels,
             fmt(r.ns_of("baseline"), ""),
@@ -214,6 +234,7 @@ pub fn table(rows: &[Row], flags: &str, machine: &str) -> String {
             fmt(r.speedup_vs_splines, "x"),
             fmt(r.read_limit_fraction.map(|f| f * 100.0), "%"),
             fmt(r.ns_per_joint, ""),
+            r.bytes as f64 / 1e6,
         );
     }
     out
@@ -245,6 +266,21 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
             out.push((
                 format!("{n}: {j:.2} ns per joint per frame (target < {limit})"),
                 j < limit,
+            ));
+        }
+    }
+    if let (Some(r), Some(c)) = (get("character-reduced"), get("character-hermite"))
+        && let Some(j) = r.ns_per_joint
+    {
+        {
+            out.push((
+                format!(
+                    "character-reduced: {j:.2} ns per joint per frame (target <= 2), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
+                    r.bytes as f64 / 1e6,
+                    c.bytes as f64 / 1e6,
+                    c.bytes as f64 / r.bytes as f64
+                ),
+                j <= 2.0,
             ));
         }
     }
@@ -317,6 +353,7 @@ pub fn check(rows: &[Row], saved: &Value, max_regression: f64) -> (Vec<String>, 
         for (key, now) in [
             ("speedup_vs_baseline", Some(row.speedup_vs_baseline)),
             ("read_limit_fraction", row.read_limit_fraction),
+            ("speedup_vs_dense", row.speedup_vs_dense),
         ] {
             let (Some(then), Some(now)) = (s.get(key).and_then(Value::as_f64), now) else {
                 continue;
@@ -326,6 +363,16 @@ pub fn check(rows: &[Row], saved: &Value, max_regression: f64) -> (Vec<String>, 
             ok &= !bad;
             lines.push(format!(
                 "{} {name} {key}: {then:.3} -> {now:.3} ({change:+.1}%, allowed -{max_regression}%)",
+                if bad { "REGRESSION" } else { "ok" }
+            ));
+        }
+        // Memory is deterministic: any growth is a change to look at.
+        if let Some(then) = s.get("bytes").and_then(Value::as_u64) {
+            let now = row.bytes as u64;
+            let bad = now > then;
+            ok &= !bad;
+            lines.push(format!(
+                "{} {name} bytes: {then} -> {now}",
                 if bad { "REGRESSION" } else { "ok" }
             ));
         }

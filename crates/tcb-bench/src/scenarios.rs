@@ -7,6 +7,7 @@
 //! | `wide` | 10,000 scalar channels on one key grid (61 keys), 60 fps over 2 s |
 //! | `sparse` | 500 scalar tracks, each with its own random key times |
 //! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
+//! | `character-reduced` | the CMU clip (hermite) reduced by `tcb reduce` at the default shell tolerance, as `character` |
 
 use crate::Rng;
 use crate::baseline::Baseline;
@@ -204,6 +205,32 @@ pub fn character(bvh: &Path, rotation: RotationMode) -> Result<Scenario, tcb_io:
     Ok(s)
 }
 
+/// `character-reduced`: the hermite character after `tcb reduce` with the
+/// contract's defaults (shell metric, `--knots track`), played like
+/// `character-hermite`.
+pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
+    let options = tcb_io::ImportOptions {
+        rotation: RotationMode::Hermite,
+        ..Default::default()
+    };
+    let loaded = tcb_io::load_with(bvh, &options)?;
+    let skeleton = loaded
+        .skeleton
+        .as_ref()
+        .map(|s| tcb_fit::metric::with_end_sites(s, &loaded.end_sites));
+    let input = tcb_fit::reduce::Input {
+        doc: &loaded.doc,
+        clip: &loaded.clip,
+        skeleton: skeleton.as_ref(),
+    };
+    let reduced = tcb_fit::reduce(input, &tcb_fit::ReduceOptions::default(), &|_, _| {})
+        .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(bvh))?;
+    let end = reduced.clip.time_range().map_or(0.0, |r| r.1);
+    let mut s = Scenario::new("character-reduced", reduced.clip, frames(end, 60.0));
+    s.joints = loaded.skeleton.map(|k| k.joints.len());
+    Ok(s)
+}
+
 /// `seek`: the hermite character at random times.
 pub fn seek(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     let (clip, joints) = cmu(bvh, RotationMode::Hermite)?;
@@ -299,5 +326,6 @@ pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
         wide(),
         sparse(),
         seek(bvh)?,
+        character_reduced(bvh)?,
     ])
 }

@@ -88,7 +88,8 @@ impl Error {
         }
     }
 
-    pub(crate) fn import(message: impl Into<String>) -> Self {
+    /// A file that cannot be imported or used as a whole, with a message.
+    pub fn import(message: impl Into<String>) -> Self {
         Error {
             location: Location::default(),
             kind: ErrorKind::Import(message.into()),
