@@ -38,6 +38,10 @@ struct Args {
     /// Milliseconds per timing.
     #[arg(long, default_value_t = 20)]
     slice_ms: u64,
+    /// Time these clips (JSON, BVH, glTF) instead of the scenarios: 60 fps
+    /// forward over each clip, as `character`.
+    #[arg(long, value_name = "FILE")]
+    clip: Vec<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -70,7 +74,14 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
-    let mut all = scenarios::all(&args.bvh)?;
+    let mut all = if args.clip.is_empty() {
+        scenarios::all(&args.bvh)?
+    } else {
+        args.clip
+            .iter()
+            .map(|p| scenarios::file(p))
+            .collect::<Result<_, _>>()?
+    };
     if let Some(only) = &args.only {
         let names: Vec<&str> = only.split(',').map(str::trim).collect();
         all.retain(|s| names.contains(&s.name));

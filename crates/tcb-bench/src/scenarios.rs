@@ -231,6 +231,40 @@ pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     Ok(s)
 }
 
+/// A clip file of the user's, played at 60 fps forward over its keys. Its
+/// joints are its skeleton's (BVH, glTF), or for a clip JSON the distinct
+/// `<joint>` prefixes of its `<joint>.<part>` track names.
+pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
+    let loaded = tcb_io::load(path)?;
+    let joints = match &loaded.skeleton {
+        Some(s) => s.joints.len(),
+        None => {
+            let mut names: Vec<&str> = loaded
+                .clip
+                .tracks
+                .iter()
+                .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
+                .collect();
+            names.sort_unstable();
+            names.dedup();
+            names.len()
+        }
+    };
+    let (start, end) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
+    let times = frames(end - start, 60.0)
+        .into_iter()
+        .map(|t| t + start)
+        .collect();
+    let name: &'static str = Box::leak(
+        path.file_stem()
+            .map_or("clip".into(), |s| s.to_string_lossy().into_owned())
+            .into_boxed_str(),
+    );
+    let mut s = Scenario::new(name, loaded.clip, times);
+    s.joints = Some(joints);
+    Ok(s)
+}
+
 /// `seek`: the hermite character at random times.
 pub fn seek(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     let (clip, joints) = cmu(bvh, RotationMode::Hermite)?;

@@ -72,9 +72,14 @@ struct ReduceArgs {
     #[arg(long, value_name = "track|joint|clip", default_value = "track")]
     knots: tcb_fit::Knots,
     /// Tangents: derived by the TCB rule from neighbouring keys (values only
-    /// stored), or explicit in/out tangents on every key.
-    #[arg(long, value_name = "derived|explicit", default_value = "derived")]
+    /// stored), explicit in/out tangents on every key, or per track the one
+    /// that stores fewer numbers.
+    #[arg(long, value_name = "best|derived|explicit", default_value = "best")]
     tangents: tcb_fit::Tangents,
+    /// BVH input: rotation mode of its rotation tracks, as `tcb import`
+    /// (the reference is the input played that way).
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
 }
 
 #[derive(Args)]
@@ -262,7 +267,20 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         return Err(format!("{}: the output must end in .json", args.output.display()).into());
     }
     let started = std::time::Instant::now();
-    let loaded = tcb_io::load(&args.input)?;
+    let is_bvh = args
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
+    if args.rotation.is_some() && !is_bvh {
+        return Err(
+            "--rotation is for BVH inputs (other files keep their own rotation modes)".into(),
+        );
+    }
+    let import = tcb_io::ImportOptions {
+        rotation: args.rotation.unwrap_or_default(),
+        ..Default::default()
+    };
+    let loaded = tcb_io::load_with(&args.input, &import)?;
     warn(&loaded.warnings);
     let skeleton = loaded
         .skeleton

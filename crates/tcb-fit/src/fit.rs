@@ -48,8 +48,12 @@ pub enum Tangents {
     Explicit,
     /// Derived by the TCB rule from the neighbouring key values (t = c = b = 0):
     /// only the value is stored.
-    #[default]
     Derived,
+    /// Both fitted; the one that stores fewer numbers is kept. Derived
+    /// tangents win on noisy data (motion capture, where keys stay dense),
+    /// explicit ones on smooth data (fewer, wider keys).
+    #[default]
+    Best,
 }
 
 impl Tangents {
@@ -58,6 +62,7 @@ impl Tangents {
         match self {
             Tangents::Explicit => "explicit",
             Tangents::Derived => "derived",
+            Tangents::Best => "best",
         }
     }
 }
@@ -68,8 +73,9 @@ impl std::str::FromStr for Tangents {
         match s {
             "explicit" => Ok(Tangents::Explicit),
             "derived" => Ok(Tangents::Derived),
+            "best" => Ok(Tangents::Best),
             _ => Err(format!(
-                "unknown tangents '{s}' (expected derived or explicit)"
+                "unknown tangents '{s}' (expected best, derived or explicit)"
             )),
         }
     }
@@ -99,6 +105,22 @@ pub struct Fit {
     pub tangents: Vec<Vec<[f64; 4]>>,
     /// Largest error over tolerance ratio reached (at most 1).
     pub worst: f64,
+    /// How the tangents come ([`Tangents::Explicit`] or [`Tangents::Derived`]).
+    pub mode: Tangents,
+}
+
+impl Fit {
+    /// Numbers stored: each key's value, and with explicit tangents its
+    /// `in` and `out`, all components.
+    pub fn stored_values(&self, series: &[Series]) -> usize {
+        let dims: usize = series.iter().map(|s| s.dim).sum();
+        let per = if self.mode == Tangents::Explicit {
+            3
+        } else {
+            1
+        };
+        self.knots.len() * dims * per
+    }
 }
 
 /// Fit keys to `series`, all sampled at `times` (strictly increasing, at
@@ -108,15 +130,31 @@ pub fn fit(times: &[f64], series: &[Series], tangents: Tangents) -> Option<Fit> 
     fit_within(times, series, tangents, usize::MAX)
 }
 
-/// [`fit`], giving up (`None`) once insertion has placed more than
-/// `max_keys` keys: a caller that keeps the original track beyond some size
-/// need not wait for a fit it will not use.
+/// [`fit`], giving up (`None`) on a representation once its insertion has
+/// placed keys that would store more than `max_values` numbers: a caller
+/// that keeps the original track beyond some size need not wait for a fit
+/// it will not use. (Insertion places about twice the keys removal keeps.)
 pub fn fit_within(
     times: &[f64],
     series: &[Series],
     tangents: Tangents,
-    max_keys: usize,
+    max_values: usize,
 ) -> Option<Fit> {
+    if tangents == Tangents::Best {
+        let a = fit_within(times, series, Tangents::Derived, max_values);
+        let b = fit_within(times, series, Tangents::Explicit, max_values);
+        return match (a, b) {
+            (Some(a), Some(b)) => Some(if b.stored_values(series) < a.stored_values(series) {
+                b
+            } else {
+                a
+            }),
+            (a, b) => a.or(b),
+        };
+    }
+    let dims: usize = series.iter().map(|s| s.dim).sum();
+    let per = if tangents == Tangents::Explicit { 3 } else { 1 };
+    let max_keys = max_values / (dims * per).max(1);
     let n = times.len();
     if n < 2 || series.iter().any(|s| s.samples.len() != n) {
         return None;
@@ -160,8 +198,13 @@ pub fn fit_within(
         let inserts: Vec<usize> = (0..spans)
             .filter(|&k| split[k])
             .map(|k| {
+                // At the worst sample, kept to the middle half of the span:
+                // a key beside a key adds little, and splitting near the
+                // middle halves the span every round.
                 let (a, b) = (knots[k], knots[k + 1]);
-                a + 1 + argmax(&solved.ratio[a + 1..b])
+                let quarter = (b - a) / 4;
+                let (lo, hi) = (a + quarter.max(1), b - quarter.max(1));
+                lo + argmax(&solved.ratio[lo..=hi])
             })
             .collect();
         if inserts.is_empty() {
@@ -240,7 +283,7 @@ impl Problem<'_> {
     fn unknowns(&self, keys: usize) -> usize {
         match self.tangents {
             Tangents::Explicit => 2 * keys,
-            Tangents::Derived => keys,
+            _ => keys,
         }
     }
 
@@ -248,7 +291,7 @@ impl Problem<'_> {
     fn value_unknown(&self, k: usize) -> usize {
         match self.tangents {
             Tangents::Explicit => 2 * k,
-            Tangents::Derived => k,
+            _ => k,
         }
     }
 
@@ -263,7 +306,7 @@ impl Problem<'_> {
                 start: 2 * k,
                 coeffs: [h[0], h[2] * d, h[1], h[3] * d],
             },
-            Tangents::Derived => {
+            _ => {
                 let last = knots.len() - 1;
                 let interval = |j: usize| self.times[knots[j + 1]] - self.times[knots[j]];
                 // Coefficients over P_{k-1} .. P_{k+2} (index 0..4).
@@ -434,7 +477,7 @@ impl Problem<'_> {
         );
         let reach = match self.tangents {
             Tangents::Explicit => (1, 0),
-            Tangents::Derived => (2, 1),
+            _ => (2, 1),
         };
         let s0 = k0.saturating_sub(reach.0);
         let s1 = (k1 + reach.1).min(fewer.len() - 2);
@@ -486,7 +529,7 @@ impl Problem<'_> {
                     values.push((0..knots.len()).map(|k| get(2 * k)).collect());
                     tangents.push((0..knots.len()).map(|k| get(2 * k + 1)).collect());
                 }
-                Tangents::Derived => {
+                _ => {
                     values.push((0..knots.len()).map(get).collect());
                     tangents.push(Vec::new());
                 }
@@ -498,6 +541,7 @@ impl Problem<'_> {
             values,
             tangents,
             worst: solved.ratio.iter().copied().fold(0.0, f64::max),
+            mode: self.tangents,
         }
     }
 }

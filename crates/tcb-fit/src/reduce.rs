@@ -294,7 +294,13 @@ fn positive(name: &str, v: f64) -> Result<f64, ReduceError> {
 const MARGIN: f64 = 0.9;
 
 /// Rounds of budget refinement before giving up.
-const MAX_ROUNDS: usize = 12;
+const MAX_ROUNDS: usize = 16;
+
+/// A group over its tolerance by r is tightened by r^STEP per round: full
+/// steps (1) tighten a root, which every joint's error involves, by the
+/// worst ratio anywhere; smaller steps let the joints that recover stop
+/// pulling it down.
+const STEP: f64 = 0.5;
 
 /// Below this budget scale a group is kept as it is.
 const MIN_SCALE: f64 = 1.0 / 64.0;
@@ -416,7 +422,7 @@ pub fn reduce(
                     .iter()
                     .all(|&i| kept.contains(&input.clip.tracks[i].name));
                 // Kept at this budget: kept at any smaller one.
-                let next = scale[g] / (1.1 * over);
+                let next = scale[g] / (1.05 * over).powf(STEP);
                 scale[g] = if all_kept || !next.is_finite() || next < MIN_SCALE {
                     0.0
                 } else {
@@ -623,22 +629,15 @@ impl<'a> Plan<'a> {
                 }
             })
             .collect();
-        // Insertion places about twice the keys removal keeps: past that,
-        // the fit would store more than the original does.
         let original: usize = g
             .iter()
             .map(|&i| stored_values(&self.input.doc.tracks[i]))
             .sum();
-        let per_key: usize = series.iter().map(|s| s.dim).sum::<usize>()
-            * match self.settings.tangents {
-                Tangents::Explicit => 3,
-                Tangents::Derived => 1,
-            };
         fit::fit_within(
             &self.times[p0.first..=p0.last],
             &series,
             self.settings.tangents,
-            3 * original / per_key.max(1),
+            3 * original,
         )
     }
 
@@ -696,7 +695,7 @@ impl<'a> Plan<'a> {
                 let times = f.knots.iter().map(|&k| self.times[p.first + k]).collect();
                 let to_f32 = |v: &[f64; 4]| v.map(|c| c as f32);
                 let values = f.values[s].iter().map(to_f32).collect();
-                let keys = match self.settings.tangents {
+                let keys = match f.mode {
                     Tangents::Explicit => f.tangents[s]
                         .iter()
                         .map(|g| KeyDoc {
@@ -705,7 +704,7 @@ impl<'a> Plan<'a> {
                             ..KeyDoc::default()
                         })
                         .collect(),
-                    Tangents::Derived => Vec::new(),
+                    _ => Vec::new(),
                 };
                 TrackDoc {
                     name: doc.name.clone(),
