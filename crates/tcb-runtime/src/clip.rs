@@ -79,11 +79,30 @@ pub struct Clip {
     pub(crate) layout: Arc<PoseLayout>,
     /// Vector tracks of small groups, one lane each.
     pub(crate) loose: Loose,
+    /// Hermite rotations of small groups, one lane each (4 component
+    /// planes, normalized after sampling; padded to whole blocks with
+    /// constant identity lanes).
+    pub(crate) loose_rot: Loose,
     /// Tracks the scalar reference samples (value and velocity).
     pub(crate) reference: Vec<TrackId>,
     /// Squad tracks, whose velocity the scalar reference gives.
     pub(crate) squad_velocity: Vec<TrackId>,
     pub(crate) source: tcb_core::Clip,
+}
+
+/// A padding lane of loose rotations: the identity at all times.
+fn identity_lane() -> LooseLane {
+    let w = [1.0, 1.0, 0.0, 0.0];
+    LooseLane {
+        grid: TimeGrid {
+            times: vec![0.0, 1.0],
+            eases: vec![SegmentEase::default()],
+            pre: Extrapolation::Constant,
+            post: Extrapolation::Constant,
+        },
+        dim: 4,
+        controls: vec![[[0.0; 4], [0.0; 4], [0.0; 4], w]; 3],
+    }
 }
 
 /// Channel controls over the stored segments `0..=n`.
@@ -318,8 +337,35 @@ impl Clip {
 
         // Small groups of vector channels only: one lane per track (see loose.rs).
         let mut loose_lanes: Vec<(usize, LooseLane)> = Vec::new();
+        let mut loose_rots: Vec<(usize, LooseLane)> = Vec::new();
         let mut keep = vec![true; grids.len()];
         for g in 0..grids.len() {
+            // Small groups of hermite rotations only (reset, which gives the
+            // identity rather than zero, stays on the group path).
+            let resets = [grids[g].pre, grids[g].post].contains(&Extrapolation::Reset);
+            if vec_rows[g].is_empty()
+                && sq_rows[g].is_empty()
+                && !hq_rows[g].is_empty()
+                && hq_rows[g].len() < 8
+                && !resets
+            {
+                keep[g] = false;
+                for (track, rows) in &hq_rows[g] {
+                    let controls = rows
+                        .iter()
+                        .map(|row| std::array::from_fn(|c| std::array::from_fn(|j| row[4 * j + c])))
+                        .collect();
+                    loose_rots.push((
+                        *track,
+                        LooseLane {
+                            grid: grids[g].clone(),
+                            dim: 4,
+                            controls,
+                        },
+                    ));
+                }
+                continue;
+            }
             if hq_rows[g].is_empty() && sq_rows[g].is_empty() && vec_rows[g].len() < 8 {
                 keep[g] = false;
                 let mut by_track: Vec<(usize, Vec<&Controls>)> = Vec::new();
@@ -423,6 +469,20 @@ impl Clip {
         }
         let loose = Loose::new(loose_lanes.into_iter().map(|(_, l)| l).collect(), at);
         at += 4 * loose.blocks;
+        // Loose rotations: planes of 8 lanes, blended as rotations.
+        for (lane, (track, _)) in loose_rots.iter().enumerate() {
+            let base = (at + 4 * (lane / 8)) * 8 + lane % 8;
+            slots[*track].index = [base, base + 8, base + 16, base + 24];
+        }
+        let mut rot_lanes: Vec<LooseLane> = loose_rots.into_iter().map(|(_, l)| l).collect();
+        while !rot_lanes.len().is_multiple_of(8) {
+            rot_lanes.push(identity_lane());
+        }
+        let loose_rot = Loose::new(rot_lanes, at);
+        for b in 0..loose_rot.blocks {
+            quat_blocks.push(at + 4 * b);
+        }
+        at += 4 * loose_rot.blocks;
         // Reference-sampled rotations: four consecutive floats each.
         let mut loose_quats = Vec::new();
         if !reference.is_empty() {
@@ -443,6 +503,7 @@ impl Clip {
                 loose_quats,
             }),
             loose,
+            loose_rot,
             reference,
             squad_velocity,
             source: source.clone(),
@@ -481,7 +542,7 @@ impl Clip {
     /// Number of tracks sampled as loose lanes (their own time grid, mapped
     /// eight tracks at a time).
     pub fn loose_track_count(&self) -> usize {
-        self.loose.lanes.len()
+        self.loose.lanes.len() + self.loose_rot.lanes.len()
     }
 
     /// The validated clip this was compiled from.
@@ -518,13 +579,19 @@ impl Clip {
                     + size_of_val(g.sq.as_slice())
             })
             .sum();
-        let loose: usize = self
-            .loose
-            .lanes
+        let loose: usize = [&self.loose, &self.loose_rot]
             .iter()
-            .map(|l| size_of::<LooseLane>() + grid(&l.grid) + size_of_val(l.controls.as_slice()))
-            .sum::<usize>()
-            + self.loose.heap_bytes();
+            .map(|loose| {
+                loose
+                    .lanes
+                    .iter()
+                    .map(|l| {
+                        size_of::<LooseLane>() + grid(&l.grid) + size_of_val(l.controls.as_slice())
+                    })
+                    .sum::<usize>()
+                    + loose.heap_bytes()
+            })
+            .sum();
         let layout = self
             .layout
             .slots

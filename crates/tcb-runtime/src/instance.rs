@@ -16,6 +16,7 @@ pub struct Instance {
     clip: Arc<Clip>,
     cursors: Vec<Cursor>,
     loose: LooseState,
+    loose_rot: LooseState,
     pose: Pose,
 }
 
@@ -25,6 +26,7 @@ impl Instance {
         Instance {
             cursors: vec![Cursor::default(); clip.groups.len()],
             loose: LooseState::new(&clip.loose),
+            loose_rot: LooseState::new(&clip.loose_rot),
             pose: Pose::new(&clip, velocities),
             clip,
         }
@@ -47,6 +49,7 @@ impl Instance {
             time,
             &mut self.cursors,
             &mut self.loose,
+            &mut self.loose_rot,
             &mut self.pose,
         );
         &self.pose
@@ -59,6 +62,7 @@ pub(crate) fn sample_into(
     time: f64,
     cursors: &mut [Cursor],
     loose: &mut LooseState,
+    loose_rot: &mut LooseState,
     pose: &mut Pose,
 ) {
     let Pose {
@@ -118,6 +122,15 @@ pub(crate) fn sample_into(
     }
     if clip.loose.blocks > 0 {
         crate::loose::sample(&clip.loose, loose, time, values, velocities.as_deref_mut());
+    }
+    let r = &clip.loose_rot;
+    if r.blocks > 0 {
+        crate::loose::sample(r, loose_rot, time, values, velocities.as_deref_mut());
+        let planes = r.out..r.out + 4 * r.blocks;
+        kernel::normalize_blocks(
+            &mut values[planes.clone()],
+            velocities.as_deref_mut().map(|v| &mut v[planes]),
+        );
     }
     let want_velocity = pose.velocities.is_some();
     for &id in &clip.reference {

@@ -57,17 +57,47 @@ pub(crate) fn hermite_quats(
     for (b, c) in coeffs.chunks_exact(HQ_STRIDE).enumerate() {
         let p: [f32x8; 4] =
             std::array::from_fn(|i| hermite(h, c[i], c[4 + i], c[8 + i], c[12 + i]));
-        let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
-        let inv = f32x8::ONE / len;
-        let q = p.map(|x| x * inv);
+        let dp = vel.is_some().then(|| {
+            std::array::from_fn(|i| hermite(dh, c[i], c[4 + i], c[8 + i], c[12 + i]) * rate)
+        });
+        let (q, qv) = normalize(p, dp);
         out[4 * b..4 * b + 4].copy_from_slice(&q);
-        if let Some(vel) = vel.as_deref_mut() {
-            let dp: [f32x8; 4] =
-                std::array::from_fn(|i| hermite(dh, c[i], c[4 + i], c[8 + i], c[12 + i]) * rate);
-            let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
-            for i in 0..4 {
-                vel[4 * b + i] = (dp[i] - q[i] * qd) * inv;
-            }
+        if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
+            vel[4 * b..4 * b + 4].copy_from_slice(&qv);
+        }
+    }
+}
+
+/// A normalized hermite rotation and its velocity, from the curve `p` and
+/// its derivative `dp` (planes x, y, z, w):
+///
+/// ```text
+/// q = p / |p|        q' = (p' - q (q . p')) / |p|
+/// ```
+#[inline(always)]
+pub(crate) fn normalize(p: [f32x8; 4], dp: Option<[f32x8; 4]>) -> ([f32x8; 4], Option<[f32x8; 4]>) {
+    let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
+    let inv = f32x8::ONE / len;
+    let q = p.map(|x| x * inv);
+    let qv = dp.map(|dp| {
+        let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
+        std::array::from_fn(|i| (dp[i] - q[i] * qd) * inv)
+    });
+    (q, qv)
+}
+
+/// [`normalize`] in place over blocks of 4 planes (rotations sampled as
+/// loose lanes: the curve and its derivative, then normalized).
+pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8]>) {
+    for (b, v) in values.chunks_exact_mut(4).enumerate() {
+        let p: [f32x8; 4] = [v[0], v[1], v[2], v[3]];
+        let dp = vel
+            .as_deref()
+            .map(|d| [d[4 * b], d[4 * b + 1], d[4 * b + 2], d[4 * b + 3]]);
+        let (q, qv) = normalize(p, dp);
+        v.copy_from_slice(&q);
+        if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
+            vel[4 * b..4 * b + 4].copy_from_slice(&qv);
         }
     }
 }

@@ -399,6 +399,41 @@ fn wild_rotations_stay_within_1e_6() {
     assert!(worst < 1e-6, "worst difference {worst}");
 }
 
+/// Hermite rotations that each have their own key times (what `tcb reduce`
+/// writes) are sampled as loose lanes and normalized after, values and
+/// velocities within 1e-6 of the reference; every rule, end, ease, shape and
+/// extrapolation (with `reset`, a track stays on the group path).
+#[test]
+fn rotations_on_their_own_grids() {
+    let mut loose = 0;
+    for seed in 0..40u64 {
+        let mut rng = Rng(seed * 17 + 3);
+        let mut tracks = Vec::new();
+        for i in 0..(1 + rng.below(20)) {
+            let n = 2 + rng.below(8);
+            let t = times(&mut rng, n);
+            let mut s = settings(&mut rng, true);
+            s.rotation = RotationMode::Hermite;
+            s.pre = s.pre.min_rotation();
+            s.post = s.post.min_rotation();
+            if n < 3 && s.ends == Ends::Cyclic {
+                s.ends = Ends::Copy;
+            }
+            tracks.push(NamedTrack {
+                name: format!("rot{i}"),
+                data: TrackData::Quat(rotation_track(&mut rng, &t, &s)),
+            });
+        }
+        let clip = tcb_core::Clip {
+            name: "own rotations".into(),
+            tracks,
+        };
+        loose += Clip::compile(&clip).loose_track_count();
+        check_clip(&clip, seed);
+    }
+    assert!(loose > 100, "only {loose} rotations took the loose path");
+}
+
 /// Tracks that each have their own key times (as DCC tools export them) are
 /// sampled as loose lanes, eight at a time; every mode, ease and shape.
 #[test]
