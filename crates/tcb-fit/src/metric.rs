@@ -58,8 +58,10 @@ impl Worst {
     }
 
     fn take(&mut self, error: f64, ratio: f64, at: &str, time: f64) {
-        // NaN counts as the worst there is.
-        if ratio > self.ratio || (ratio.is_nan() && !self.ratio.is_nan()) {
+        // NaN counts as the worst there is; the first sample is taken even
+        // at zero error, so an exact result still names a joint and time.
+        let first = self.at.is_empty() && !at.is_empty();
+        if first || ratio > self.ratio || (ratio.is_nan() && !self.ratio.is_nan()) {
             *self = Worst {
                 error,
                 ratio,
