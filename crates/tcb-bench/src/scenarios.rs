@@ -184,8 +184,23 @@ fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::Clip, usize), tc
         ..Default::default()
     };
     let loaded = tcb_io::load_with(bvh, &options)?;
-    let joints = loaded.skeleton.map_or(0, |s| s.joints.len());
+    let joints = animated_joints(&loaded);
     Ok((loaded.clip, joints))
+}
+
+/// Joints a clip animates, for ns per joint: the distinct `<joint>` of its
+/// `<joint>.<part>` track names (End Sites and unanimated joints of a
+/// skeleton do not count).
+fn animated_joints(loaded: &tcb_io::Loaded) -> usize {
+    let mut names: Vec<&str> = loaded
+        .clip
+        .tracks
+        .iter()
+        .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
+        .collect();
+    names.sort_unstable();
+    names.dedup();
+    names.len()
 }
 
 /// `character-hermite` or `character-squad`.
@@ -214,42 +229,24 @@ pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
         ..Default::default()
     };
     let loaded = tcb_io::load_with(bvh, &options)?;
-    let skeleton = loaded
-        .skeleton
-        .as_ref()
-        .map(|s| tcb_fit::metric::with_end_sites(s, &loaded.end_sites));
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,
-        skeleton: skeleton.as_ref(),
+        skeleton: loaded.skeleton.as_ref(),
     };
     let reduced = tcb_fit::reduce(input, &tcb_fit::ReduceOptions::default(), &|_, _| {})
         .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(bvh))?;
     let end = reduced.clip.time_range().map_or(0.0, |r| r.1);
     let mut s = Scenario::new("character-reduced", reduced.clip, frames(end, 60.0));
-    s.joints = loaded.skeleton.map(|k| k.joints.len());
+    s.joints = Some(animated_joints(&loaded));
     Ok(s)
 }
 
-/// A clip file of the user's, played at 60 fps forward over its keys. Its
-/// joints are its skeleton's (BVH, glTF), or for a clip JSON the distinct
-/// `<joint>` prefixes of its `<joint>.<part>` track names.
+/// A clip file of the user's, played at 60 fps forward over its keys
+/// (joints counted as `animated_joints` counts them).
 pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
     let loaded = tcb_io::load(path)?;
-    let joints = match &loaded.skeleton {
-        Some(s) => s.joints.len(),
-        None => {
-            let mut names: Vec<&str> = loaded
-                .clip
-                .tracks
-                .iter()
-                .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
-                .collect();
-            names.sort_unstable();
-            names.dedup();
-            names.len()
-        }
-    };
+    let joints = animated_joints(&loaded);
     let (start, end) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
     let times = frames(end - start, 60.0)
         .into_iter()

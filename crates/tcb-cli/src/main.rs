@@ -282,10 +282,6 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     };
     let loaded = tcb_io::load_with(&args.input, &import)?;
     warn(&loaded.warnings);
-    let skeleton = loaded
-        .skeleton
-        .as_ref()
-        .map(|s| tcb_fit::metric::with_end_sites(s, &loaded.end_sites));
     let options = tcb_fit::ReduceOptions {
         tolerance: args.tolerance,
         shell: args.shell,
@@ -297,7 +293,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,
-        skeleton: skeleton.as_ref(),
+        skeleton: loaded.skeleton.as_ref(),
     };
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("tcb: fitting {bar:30} {pos}/{len} groups")

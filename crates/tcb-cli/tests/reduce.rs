@@ -190,3 +190,35 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
         stderr(&o)
     );
 }
+
+#[test]
+fn an_imported_clip_keeps_its_skeleton_and_reduces_by_shell() {
+    let bvh = short_cmu(120);
+    let json = dir().join("short-import.json");
+    let o = tcb(&[
+        "import",
+        bvh.to_str().unwrap(),
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let from_bvh = tcb_io::load(&bvh).unwrap().skeleton.unwrap();
+    let from_json = tcb_io::load(&json).unwrap().skeleton.unwrap();
+    assert_eq!(from_json, from_bvh);
+    assert!(from_json.joint("Head_end").is_some());
+    let out = dir().join("short-import-reduced.json");
+    let o = tcb(&[
+        "reduce",
+        json.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--tolerance",
+        "0.05",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let [.., e] = summary(&stdout, "shell");
+    assert!(e <= 0.05, "{stdout}");
+    // The reduced clip carries the rig on.
+    assert_eq!(tcb_io::load(&out).unwrap().skeleton.unwrap(), from_bvh);
+}

@@ -7,10 +7,10 @@
 //! value   vectors: max |x_c - x'_c| per component; rotations: 2 acos(|q . q'|)
 //! ```
 
-use glam::{Affine3A, DAffine3, Vec3};
+use glam::{Affine3A, DAffine3};
 use std::sync::Arc;
 use tcb_core::sample_times::inbetweens;
-use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::skeleton::{Skeleton, Transform};
 use tcb_core::{Clip, TrackKind};
 use tcb_runtime::{Instance, SkeletonBinding};
 
@@ -80,26 +80,6 @@ pub struct Measured {
     /// Per joint (`shell`) or per track (`value`): the largest error over
     /// the tolerance.
     pub each: Vec<f64>,
-}
-
-/// A skeleton with BVH End Sites (parent joint, offset) added as leaf joints
-/// named `<parent>_end` (the clip contract's convention), so their points
-/// count in the shell metric and in the rest-pose height.
-pub fn with_end_sites(skeleton: &Skeleton, end_sites: &[(usize, Vec3)]) -> Skeleton {
-    let mut out = skeleton.clone();
-    for &(parent, offset) in end_sites {
-        if parent < skeleton.joints.len() {
-            out.joints.push(Joint {
-                name: format!("{}_end", skeleton.joints[parent].name),
-                parent: Some(parent),
-                rest: Transform {
-                    translation: offset,
-                    ..Transform::IDENTITY
-                },
-            });
-        }
-    }
-    out
 }
 
 /// The rest-pose height H of `spec/reduce.md`: the largest distance of any

@@ -129,7 +129,7 @@ pub struct Input<'a> {
     pub doc: &'a ClipDoc,
     /// The input, built.
     pub clip: &'a Clip,
-    /// Its rig, End Sites included as leaf joints ([`metric::with_end_sites`]).
+    /// Its rig (BVH End Sites are leaf joints in it, as `tcb_io::load` gives them).
     pub skeleton: Option<&'a Skeleton>,
 }
 
@@ -245,7 +245,7 @@ impl fmt::Display for ReduceError {
         match self {
             ReduceError::Option(s) => f.write_str(s),
             ReduceError::NoSkeleton => f.write_str(
-                "--metric shell needs a skeleton: this clip has none (BVH and glTF files carry one; use --metric value)",
+                "--metric shell needs a skeleton: this clip has none (BVH and glTF files carry one, and so do clips `tcb import` writes; or use --metric value)",
             ),
             ReduceError::Empty => f.write_str("the clip has no key times to reduce"),
             ReduceError::CannotMeet { ratio, worst } => write!(
@@ -746,6 +746,7 @@ impl<'a> Plan<'a> {
                 name: src.name.clone(),
                 defaults,
                 tracks,
+                skeleton: src.skeleton.clone(),
             },
             kept,
         )

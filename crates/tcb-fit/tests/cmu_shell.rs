@@ -157,8 +157,7 @@ fn reduced_cmu_is_within_the_shell_tolerance_at_three_tolerances() {
     let text = std::fs::read_to_string(BVH).unwrap();
     let rig = read_rig(&text);
     let loaded = tcb_io::load(BVH.as_ref()).unwrap();
-    let skeleton =
-        tcb_fit::metric::with_end_sites(loaded.skeleton.as_ref().unwrap(), &loaded.end_sites);
+    let skeleton = loaded.skeleton.clone().unwrap();
     assert_eq!(skeleton.joints.len(), rig.names.len());
     let h = rest_height(&rig);
     let (default_e, radius) = (6e-5 * h, 0.018 * h);

@@ -462,6 +462,33 @@ impl Bvh {
                 ..SettingsDoc::default()
             },
             tracks,
+            skeleton: Some(self.skeleton_with_end_sites()),
         })
+    }
+
+    /// The skeleton with each End Site as a leaf joint named
+    /// `<parent>_end` (clip-format.md), so that tools composing the rig
+    /// reach the ends of its chains (`<parent>_end2`, ... when a joint has
+    /// several, or the name is taken).
+    pub fn skeleton_with_end_sites(&self) -> Skeleton {
+        let mut out = self.skeleton.clone();
+        for &(parent, offset) in &self.end_sites {
+            let base = format!("{}_end", self.skeleton.joints[parent].name);
+            let mut name = base.clone();
+            let mut n = 1;
+            while out.joint(&name).is_some() {
+                n += 1;
+                name = format!("{base}{n}");
+            }
+            out.joints.push(Joint {
+                name,
+                parent: Some(parent),
+                rest: Transform {
+                    translation: offset,
+                    ..Transform::IDENTITY
+                },
+            });
+        }
+        out
     }
 }

@@ -15,6 +15,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::str::FromStr;
+use tcb_core::skeleton::Skeleton;
 use tcb_core::{
     Clip, Ease, Ends, Extrapolation, Interp, KeyParams, NamedTrack, RotationMode, RotationTrack,
     TangentRule, Tcb, Track, TrackData, TrackKind, TrackSettings, Value,
@@ -134,6 +135,8 @@ pub struct ClipDoc {
     pub defaults: SettingsDoc,
     /// `tracks`, in file order.
     pub tracks: Vec<TrackDoc>,
+    /// `skeleton`: the rig the clip animates (BVH and glTF imports fill it).
+    pub skeleton: Option<Skeleton>,
 }
 
 /// Read, parse and build the clip at `path`.
@@ -168,7 +171,7 @@ impl ClipDoc {
         let obj = as_object(&json, &top, "the clip")?;
         check_fields(
             obj,
-            &["format", "name", "defaults", "tracks"],
+            &["format", "name", "defaults", "tracks", "skeleton"],
             &top,
             "the clip",
         )?;
@@ -209,10 +212,15 @@ impl ClipDoc {
             .enumerate()
             .map(|(i, t)| parse_track(i, t))
             .collect::<Result<Vec<_>, _>>()?;
+        let skeleton = match obj.get("skeleton") {
+            None => None,
+            Some(v) => Some(crate::skeleton_json::parse(v)?),
+        };
         Ok(ClipDoc {
             name,
             defaults,
             tracks,
+            skeleton,
         })
     }
 
@@ -260,6 +268,9 @@ impl ClipDoc {
         let defaults = settings_json(&self.defaults);
         if !defaults.is_empty() {
             let _ = writeln!(out, "  \"defaults\": {{{}}},", defaults.join(", "));
+        }
+        if let Some(skeleton) = &self.skeleton {
+            crate::skeleton_json::write(skeleton, &mut out);
         }
         out.push_str("  \"tracks\": [");
         for (i, t) in self.tracks.iter().enumerate() {
@@ -426,7 +437,7 @@ fn settings_json(s: &SettingsDoc) -> Vec<String> {
 }
 
 /// Shortest round-trip form of an f32 (as JSON: `1` not `1.0` is fine).
-fn num32(x: f32) -> String {
+pub(crate) fn num32(x: f32) -> String {
     format!("{x}")
 }
 
@@ -434,7 +445,7 @@ fn num64(x: f64) -> String {
     format!("{x}")
 }
 
-fn json_str(s: &str) -> String {
+pub(crate) fn json_str(s: &str) -> String {
     Json::String(s.to_owned()).to_string()
 }
 
@@ -517,12 +528,16 @@ fn strip_position(message: &str) -> String {
     }
 }
 
-fn as_object<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a Map<String, Json>, Error> {
+pub(crate) fn as_object<'a>(
+    v: &'a Json,
+    loc: &Location,
+    what: &str,
+) -> Result<&'a Map<String, Json>, Error> {
     v.as_object()
         .ok_or_else(|| Error::invalid(loc.clone(), format!("{what} must be a JSON object")))
 }
 
-fn as_str<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a str, Error> {
+pub(crate) fn as_str<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a str, Error> {
     v.as_str()
         .ok_or_else(|| Error::invalid(loc.clone(), format!("{what} must be a string, found {v}")))
 }
@@ -548,7 +563,7 @@ fn as_f64(v: &Json, loc: &Location, what: &str) -> Result<f64, Error> {
 }
 
 /// A JSON number that fits an f32 (finite after rounding).
-fn as_f32(v: &Json, loc: &Location, what: &str) -> Result<f32, Error> {
+pub(crate) fn as_f32(v: &Json, loc: &Location, what: &str) -> Result<f32, Error> {
     let x = as_f64(v, loc, what)? as f32;
     if x.is_finite() {
         Ok(x)
@@ -560,7 +575,7 @@ fn as_f32(v: &Json, loc: &Location, what: &str) -> Result<f32, Error> {
     }
 }
 
-fn as_array<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a [Json], Error> {
+pub(crate) fn as_array<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a [Json], Error> {
     v.as_array().map(Vec::as_slice).ok_or_else(|| {
         Error::invalid(
             loc.clone(),
@@ -569,7 +584,11 @@ fn as_array<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a [Json], E
     })
 }
 
-fn as_numbers<const N: usize>(v: &Json, loc: &Location, what: &str) -> Result<[f64; N], Error> {
+pub(crate) fn as_numbers<const N: usize>(
+    v: &Json,
+    loc: &Location,
+    what: &str,
+) -> Result<[f64; N], Error> {
     let a = as_array(v, loc, what)?;
     if a.len() != N {
         return Err(Error::invalid(
@@ -604,7 +623,7 @@ fn brief(v: &Json) -> String {
     }
 }
 
-fn check_fields(
+pub(crate) fn check_fields(
     obj: &Map<String, Json>,
     allowed: &[&str],
     loc: &Location,

@@ -179,6 +179,7 @@ pub fn import(
             name: anim.name().unwrap_or(name).to_string(),
             defaults: SettingsDoc::default(),
             tracks,
+            skeleton: Some(skeleton.clone()),
         },
         skeleton,
         warnings,

@@ -29,6 +29,7 @@ pub mod clip;
 pub mod error;
 pub mod gltf_export;
 pub mod gltf_import;
+mod skeleton_json;
 
 pub use clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc, write_clip_doc};
 pub use error::{Error, ErrorKind, Location};
@@ -54,11 +55,9 @@ pub struct Loaded {
     pub doc: ClipDoc,
     /// The clip, built and validated.
     pub clip: tcb_core::Clip,
-    /// The joint hierarchy (BVH and glTF files).
+    /// The joint hierarchy: the clip's `skeleton` (BVH and glTF imports
+    /// fill it; BVH End Sites are leaf joints `<parent>_end`).
     pub skeleton: Option<Skeleton>,
-    /// BVH End Sites: the joint each ends and its offset (not joints of
-    /// [`Loaded::skeleton`]; empty for other formats).
-    pub end_sites: Vec<(usize, glam::Vec3)>,
     /// Things that were read but look wrong, for the user to see.
     pub warnings: Vec<String>,
 }
@@ -69,7 +68,7 @@ pub struct Loaded {
 /// ```
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
 /// let loaded = tcb_io::load(path.as_ref())?;
-/// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31);
+/// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31 + 7); // joints and End Sites
 /// assert_eq!(loaded.clip.tracks[0].name, "Hips.translation");
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
@@ -87,24 +86,22 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut end_sites = Vec::new();
-    let (doc, skeleton, warnings) = match ext.as_str() {
-        "json" => (read_clip_doc(path)?, None, Vec::new()),
+    let (doc, warnings) = match ext.as_str() {
+        "json" => (read_clip_doc(path)?, Vec::new()),
         "bvh" => {
             let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
             let bvh = bvh::Bvh::parse(&text).map_err(|e| e.in_file(path))?;
             let doc = bvh
                 .to_clip_doc(&stem, options.rotation)
                 .map_err(|e| e.in_file(path))?;
-            end_sites = bvh.end_sites;
-            (doc, Some(bvh.skeleton), bvh.warnings)
+            (doc, bvh.warnings)
         }
         "gltf" | "glb" => {
             let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
             let base = path.parent().unwrap_or(Path::new("."));
             let g = gltf_import::import(&bytes, Some(base), options.animation.as_deref(), &stem)
                 .map_err(|e| e.in_file(path))?;
-            (g.doc, Some(g.skeleton), g.warnings)
+            (g.doc, g.warnings)
         }
         _ => {
             return Err(Error::import(format!(
@@ -115,10 +112,9 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
     };
     let clip = doc.build().map_err(|e| e.in_file(path))?;
     Ok(Loaded {
+        skeleton: doc.skeleton.clone(),
         doc,
         clip,
-        skeleton,
-        end_sites,
         warnings,
     })
 }

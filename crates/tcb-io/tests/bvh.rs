@@ -81,7 +81,16 @@ fn cmu_every_frame_reproduced() {
         let loaded = load_with(&path, &options).unwrap();
         assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
         let clip = &loaded.clip;
-        assert_eq!(loaded.skeleton.as_ref().unwrap().joints.len(), 31);
+        // 31 joints and 7 End Sites as leaf joints `<parent>_end`.
+        let skeleton = loaded.skeleton.as_ref().unwrap();
+        assert_eq!(skeleton.joints.len(), 31 + 7);
+        assert_eq!(
+            skeleton.joints[31..]
+                .iter()
+                .filter(|j| j.name.ends_with("_end"))
+                .count(),
+            7
+        );
         assert_eq!(clip.channel_count(), 3 + 31 * 4);
         let mut row = vec![0.0f32; clip.channel_count()];
         let (mut worst_t, mut worst_q) = (0.0f64, 0.0f64);
