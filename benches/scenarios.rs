@@ -11,7 +11,7 @@ use tcb_bench::scenarios;
 fn bench(c: &mut Criterion) {
     let all = scenarios::all(&scenarios::default_bvh()).expect("the bundled CMU clip loads");
     for s in &all {
-        let mut g = c.benchmark_group(s.name);
+        let mut g = c.benchmark_group(s.name.as_str());
         g.sample_size(20);
         let mut run = s.baseline_pass();
         g.bench_function("baseline", |b| b.iter(&mut run));

@@ -84,7 +84,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     };
     if let Some(only) = &args.only {
         let names: Vec<&str> = only.split(',').map(str::trim).collect();
-        all.retain(|s| names.contains(&s.name));
+        all.retain(|s| names.contains(&s.name.as_str()));
         if all.is_empty() {
             return Err(format!("--only {only}: no such scenario").into());
         }

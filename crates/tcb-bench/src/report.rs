@@ -272,17 +272,15 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     if let (Some(r), Some(c)) = (get("character-reduced"), get("character-hermite"))
         && let Some(j) = r.ns_per_joint
     {
-        {
-            out.push((
-                format!(
-                    "character-reduced: {j:.2} ns per joint per frame (target <= 2), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
-                    r.bytes as f64 / 1e6,
-                    c.bytes as f64 / 1e6,
-                    c.bytes as f64 / r.bytes as f64
-                ),
-                j <= 2.0,
-            ));
-        }
+        out.push((
+            format!(
+                "character-reduced: {j:.2} ns per joint per frame (target <= 2), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
+                r.bytes as f64 / 1e6,
+                c.bytes as f64 / 1e6,
+                c.bytes as f64 / r.bytes as f64
+            ),
+            j <= 2.0,
+        ));
     }
     if let (Some(s), Some(c)) = (get("seek"), get("character-hermite")) {
         let (a, b) = (

@@ -28,7 +28,7 @@ pub fn default_bvh() -> PathBuf {
 /// A clip, how it is played, and every implementation's view of it.
 pub struct Scenario {
     /// Name in the report.
-    pub name: &'static str,
+    pub name: String,
     /// The validated clip (the tcb-core reference).
     pub source: tcb_core::Clip,
     /// The runtime's compiled clip.
@@ -50,9 +50,9 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    fn new(name: &'static str, source: tcb_core::Clip, times: Vec<f64>) -> Self {
+    fn new(name: impl Into<String>, source: tcb_core::Clip, times: Vec<f64>) -> Self {
         Scenario {
-            name,
+            name: name.into(),
             clip: Arc::new(tcb_runtime::Clip::compile(&source)),
             baseline: Baseline::new(&source),
             source,
@@ -252,11 +252,9 @@ pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
         .into_iter()
         .map(|t| t + start)
         .collect();
-    let name: &'static str = Box::leak(
-        path.file_stem()
-            .map_or("clip".into(), |s| s.to_string_lossy().into_owned())
-            .into_boxed_str(),
-    );
+    let name = path
+        .file_stem()
+        .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
     let mut s = Scenario::new(name, loaded.clip, times);
     s.joints = Some(joints);
     Ok(s)

@@ -80,6 +80,9 @@ struct ReduceArgs {
     /// (the reference is the input played that way).
     #[arg(long, value_name = "squad|hermite")]
     rotation: Option<tcb_core::RotationMode>,
+    /// glTF input: the animation to reduce, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
 }
 
 #[derive(Args)]
@@ -168,32 +171,49 @@ fn warn(warnings: &[String]) {
     }
 }
 
-fn import(args: &ImportArgs) -> Result<(), BoxError> {
-    let ext = args
-        .file
-        .extension()
+/// A file's extension, lower case (empty without one).
+fn extension(path: &std::path::Path) -> String {
+    path.extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "bvh" if args.animation.is_some() => return Err("--animation is for glTF files".into()),
-        "gltf" | "glb" if args.rotation.is_some() => {
+        .unwrap_or_default()
+}
+
+/// Import options for `file`, refusing the ones its format does not take.
+fn import_options(
+    file: &std::path::Path,
+    rotation: Option<tcb_core::RotationMode>,
+    animation: Option<&String>,
+) -> Result<tcb_io::ImportOptions, BoxError> {
+    match extension(file).as_str() {
+        "bvh" if animation.is_some() => return Err("--animation is for glTF files".into()),
+        "gltf" | "glb" if rotation.is_some() => {
             return Err(
                 "--rotation is for BVH files (glTF rotations keep their own interpolation)".into(),
             );
         }
-        "bvh" | "gltf" | "glb" => {}
-        _ => {
-            return Err(format!(
-                "{}: can import .bvh, .gltf and .glb files",
-                args.file.display()
-            )
-            .into());
+        "json" if rotation.is_some() || animation.is_some() => {
+            return Err(
+                "--rotation and --animation are for BVH and glTF files (a clip keeps its own modes)"
+                    .into(),
+            );
         }
+        _ => {}
     }
-    let options = tcb_io::ImportOptions {
-        rotation: args.rotation.unwrap_or_default(),
-        animation: args.animation.clone(),
-    };
+    Ok(tcb_io::ImportOptions {
+        rotation: rotation.unwrap_or_default(),
+        animation: animation.cloned(),
+    })
+}
+
+fn import(args: &ImportArgs) -> Result<(), BoxError> {
+    if !matches!(extension(&args.file).as_str(), "bvh" | "gltf" | "glb") {
+        return Err(format!(
+            "{}: can import .bvh, .gltf and .glb files",
+            args.file.display()
+        )
+        .into());
+    }
+    let options = import_options(&args.file, args.rotation, args.animation.as_ref())?;
     let loaded = tcb_io::load_with(&args.file, &options)?;
     warn(&loaded.warnings);
     tcb_io::write_clip_doc(&loaded.doc, &args.output)?;
@@ -215,11 +235,7 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         )
         .into());
     }
-    let ext = args
-        .output
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
+    let ext = extension(&args.output);
     if ext != "glb" && ext != "gltf" {
         return Err(format!(
             "{}: the output must end in .glb or .gltf",
@@ -258,28 +274,17 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
 }
 
 fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
-    let ext = args
-        .output
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if ext != "json" {
+    if extension(&args.output) != "json" {
         return Err(format!("{}: the output must end in .json", args.output.display()).into());
     }
-    let started = std::time::Instant::now();
-    let is_bvh = args
-        .input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-    if args.rotation.is_some() && !is_bvh {
-        return Err(
-            "--rotation is for BVH inputs (other files keep their own rotation modes)".into(),
-        );
+    // Found out before the work, not after it.
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(format!("{}: no such directory", dir.display()).into());
     }
-    let import = tcb_io::ImportOptions {
-        rotation: args.rotation.unwrap_or_default(),
-        ..Default::default()
-    };
+    let started = std::time::Instant::now();
+    let import = import_options(&args.input, args.rotation, args.animation.as_ref())?;
     let loaded = tcb_io::load_with(&args.input, &import)?;
     warn(&loaded.warnings);
     let options = tcb_fit::ReduceOptions {

@@ -107,24 +107,80 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     }
 }
 
+/// `tcb sample --at` of `clip` at `times`: one row of numbers per time.
+fn sample_at(clip: &Path, times: &[f64]) -> Vec<Vec<f64>> {
+    let at: Vec<String> = times.iter().map(|t| t.to_string()).collect();
+    let o = tcb(&["sample", clip.to_str().unwrap(), "--at", &at.join(",")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    String::from_utf8(o.stdout)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').skip(1).map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
 #[test]
 fn a_clip_without_skeleton_reduces_by_value() {
-    let out = dir().join("bounce.json");
+    // A dense smooth clip: 241 keys at 120 fps of a scalar and a rotation.
+    let n = 241;
+    let times: Vec<f64> = (0..n).map(|i| i as f64 / 120.0).collect();
+    let list =
+        |f: &dyn Fn(f64) -> String| times.iter().map(|&t| f(t)).collect::<Vec<_>>().join(", ");
+    let text = format!(
+        r#"{{"format": "tcb-clip/1", "tracks": [
+          {{"name": "x", "kind": "scalar", "times": [{t}], "values": [{x}]}},
+          {{"name": "r", "kind": "quat", "times": [{t}], "values": [{q}], "rotation": "hermite"}}]}}"#,
+        t = list(&|t| t.to_string()),
+        x = list(&|t| (3.0 * t).sin().to_string()),
+        q = list(&|t| format!("[0, {}, 0, {}]", (0.4 * t).sin(), (0.4 * t).cos())),
+    );
+    let input = dir().join("dense-smooth.json");
+    std::fs::write(&input, text).unwrap();
+    let out = dir().join("dense-smooth-reduced.json");
     let o = tcb(&[
         "reduce",
-        &repo("examples/clips/bounce.json"),
+        input.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
-    let [_, _, _, v0, v1, ..] = summary(&stdout, "value");
-    assert!(v1 <= v0, "{stdout}");
     assert!(
         stderr(&o).contains("metric value, tolerance 1e-4, rotation tolerance 0.01 degrees"),
         "{}",
         stderr(&o)
     );
+    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let [_, k0, k1, v0, v1, ..] = summary(&stdout, "value");
+    assert!(k1 < k0 / 4.0 && v1 < v0 / 4.0, "{stdout}");
+    // Measured here, by sampling both files at every key time and 3
+    // inbetweens, as the contract checks.
+    let mut check = Vec::new();
+    for w in times.windows(2) {
+        check.extend((0..4).map(|j| w[0] + (w[1] - w[0]) * j as f64 / 4.0));
+    }
+    check.push(times[n - 1]);
+    for chunk in check.chunks(200) {
+        let (a, b) = (sample_at(&input, chunk), sample_at(&out, chunk));
+        for (ra, rb) in a.iter().zip(&b) {
+            assert!((ra[0] - rb[0]).abs() <= 1e-4, "{ra:?} {rb:?}");
+            // The rotation angle between them from the chord of the unit
+            // quaternions, |a - b| = 2 sin(angle / 4) (well conditioned).
+            let unit = |r: &[f64]| {
+                let l = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+                r.iter().map(|x| x / l).collect::<Vec<_>>()
+            };
+            let (qa, qb) = (unit(&ra[1..5]), unit(&rb[1..5]));
+            let chord = qa
+                .iter()
+                .zip(&qb)
+                .map(|(x, y)| (x - y).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let angle = 4.0 * (chord / 2.0).asin().to_degrees();
+            assert!(angle <= 0.01, "{angle}: {ra:?} {rb:?}");
+        }
+    }
 }
 
 #[test]
@@ -186,6 +242,12 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     ]);
     assert!(
         stderr(&o).contains("the output must end in .json"),
+        "{}",
+        stderr(&o)
+    );
+    let o = tcb(&["reduce", &bounce, "-o", "/nonexistent-tcb-dir/x.json"]);
+    assert!(
+        stderr(&o).contains("/nonexistent-tcb-dir: no such directory"),
         "{}",
         stderr(&o)
     );

@@ -2,7 +2,7 @@
 //! rest transforms. Binding one to a sampled pose is the runtime's job
 //! (`tcb_runtime::SkeletonBinding`).
 
-use glam::{Affine3A, Quat, Vec3};
+use glam::{Affine3A, DAffine3, Quat, Vec3};
 
 /// A local transform: scale, then rotation, then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +26,15 @@ impl Transform {
     /// As an affine matrix.
     pub fn to_affine(&self) -> Affine3A {
         Affine3A::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+
+    /// As an affine matrix in f64 (the rotation normalized in f64).
+    pub fn to_daffine(&self) -> DAffine3 {
+        DAffine3::from_scale_rotation_translation(
+            self.scale.as_dvec3(),
+            self.rotation.as_dquat().normalize(),
+            self.translation.as_dvec3(),
+        )
     }
 }
 
@@ -77,13 +86,29 @@ impl Skeleton {
     /// assert_eq!(model[1].translation, glam::Vec3A::new(3.0, 0.0, 0.0));
     /// ```
     pub fn model_transforms(&self, local: &[Transform], out: &mut [Affine3A]) {
+        self.compose(local, out, Transform::to_affine);
+    }
+
+    /// [`Skeleton::model_transforms`] in f64: composing a long chain adds no
+    /// f32 rounding (what model-space error measures need).
+    pub fn model_transforms_f64(&self, local: &[Transform], out: &mut [DAffine3]) {
+        self.compose(local, out, Transform::to_daffine);
+    }
+
+    /// `out[i] = out[parent] * m(local[i])`, parents first.
+    fn compose<M: Copy + std::ops::Mul<Output = M>>(
+        &self,
+        local: &[Transform],
+        out: &mut [M],
+        m: impl Fn(&Transform) -> M,
+    ) {
         for (i, joint) in self
             .joints
             .iter()
             .enumerate()
             .take(local.len().min(out.len()))
         {
-            let m = local[i].to_affine();
+            let m = m(&local[i]);
             out[i] = match joint.parent {
                 Some(p) if p < i => out[p] * m,
                 _ => m,

@@ -7,7 +7,8 @@
 //! value   vectors: max |x_c - x'_c| per component; rotations: 2 acos(|q . q'|)
 //! ```
 
-use glam::{Affine3A, DAffine3};
+use crate::fit::{Norm, error};
+use glam::DAffine3;
 use std::sync::Arc;
 use tcb_core::sample_times::inbetweens;
 use tcb_core::skeleton::{Skeleton, Transform};
@@ -20,12 +21,11 @@ pub fn check_times(clip: &Clip) -> Vec<f64> {
     inbetweens(&clip.key_times(), 3)
 }
 
-/// `clip` played by the runtime (as `tcb sample` plays it) at `times`: one
-/// row of [`Clip::channel_count`] values per time, concatenated.
-pub fn play(clip: &Clip, times: &[f64]) -> Vec<f32> {
-    let channels = clip.channel_count();
-    let runtime = Arc::new(tcb_runtime::Clip::compile(clip));
-    let mut instance = Instance::new(runtime, false);
+/// A compiled clip played by the runtime (as `tcb sample` plays it) at
+/// `times`: one row of [`Clip::channel_count`] values per time, concatenated.
+pub fn play(clip: &Arc<tcb_runtime::Clip>, times: &[f64]) -> Vec<f32> {
+    let channels = clip.source().channel_count();
+    let mut instance = Instance::new(clip.clone(), false);
     let mut rows = vec![0.0f32; times.len() * channels];
     for (row, &t) in rows.chunks_exact_mut(channels.max(1)).zip(times) {
         instance.sample(t).write_row(row, None);
@@ -86,32 +86,32 @@ pub struct Measured {
 /// joint from the (first) root in the rest pose.
 pub fn rest_height(skeleton: &Skeleton) -> f64 {
     let local: Vec<Transform> = skeleton.joints.iter().map(|j| j.rest).collect();
-    let mut model = vec![Affine3A::IDENTITY; local.len()];
-    skeleton.model_transforms(&local, &mut model);
+    let mut model = vec![DAffine3::IDENTITY; local.len()];
+    skeleton.model_transforms_f64(&local, &mut model);
     let Some(root) = model.first() else {
         return 0.0;
     };
     model
         .iter()
-        .map(|m| f64::from((m.translation - root.translation).length()))
+        .map(|m| (m.translation - root.translation).length())
         .fold(0.0, f64::max)
 }
 
-/// The `shell` error of `reduced` against `reference` at `times`, with
-/// shell radius `radius`, over the joints of `skeleton`.
+/// The `shell` error of `reduced` against `reference` (both compiled) at
+/// `times`, with shell radius `radius`, over the joints of `skeleton`.
+/// Joints are composed in f64 ([`Skeleton::model_transforms_f64`]).
 pub fn shell_error(
     skeleton: &Skeleton,
-    reference: &Clip,
-    reduced: &Clip,
+    reference: &Arc<tcb_runtime::Clip>,
+    reduced: &Arc<tcb_runtime::Clip>,
     times: &[f64],
     radius: f64,
     tolerance: f64,
 ) -> Measured {
-    let a = Arc::new(tcb_runtime::Clip::compile(reference));
-    let b = Arc::new(tcb_runtime::Clip::compile(reduced));
-    let bind_a = SkeletonBinding::new(skeleton.clone(), &a);
-    let bind_b = SkeletonBinding::new(skeleton.clone(), &b);
-    let (mut ia, mut ib) = (Instance::new(a, false), Instance::new(b, false));
+    let bind_a = SkeletonBinding::new(skeleton.clone(), reference);
+    let bind_b = SkeletonBinding::new(skeleton.clone(), reduced);
+    let mut ia = Instance::new(reference.clone(), false);
+    let mut ib = Instance::new(reduced.clone(), false);
     let n = skeleton.joints.len();
     let mut local = vec![Transform::IDENTITY; n];
     let (mut ma, mut mb) = (vec![DAffine3::IDENTITY; n], vec![DAffine3::IDENTITY; n]);
@@ -119,9 +119,9 @@ pub fn shell_error(
     let mut each = vec![0.0f64; n];
     for &t in times {
         bind_a.local_transforms(ia.sample(t), &mut local);
-        compose(skeleton, &local, &mut ma);
+        skeleton.model_transforms_f64(&local, &mut ma);
         bind_b.local_transforms(ib.sample(t), &mut local);
-        compose(skeleton, &local, &mut mb);
+        skeleton.model_transforms_f64(&local, &mut mb);
         for (j, joint) in skeleton.joints.iter().enumerate() {
             let e = point_error(&ma[j], &mb[j], radius);
             worst.take(e, e / tolerance, &joint.name, t);
@@ -129,22 +129,6 @@ pub fn shell_error(
         }
     }
     Measured { worst, each }
-}
-
-/// Model-space transforms in f64 (`M_j = M_parent T_j R_j S_j`), so that
-/// composing 30 joints adds no rounding the tolerance has to absorb.
-fn compose(skeleton: &Skeleton, local: &[Transform], out: &mut [DAffine3]) {
-    for (j, (joint, l)) in skeleton.joints.iter().zip(local).enumerate() {
-        let m = DAffine3::from_scale_rotation_translation(
-            l.scale.as_dvec3(),
-            l.rotation.as_dquat().normalize(),
-            l.translation.as_dvec3(),
-        );
-        out[j] = match joint.parent {
-            Some(p) if p < j => out[p] * m,
-            _ => m,
-        };
-    }
 }
 
 /// `max over v in {0, R e_x, R e_y, R e_z} of |a v - b v|`.
@@ -160,18 +144,20 @@ pub fn point_error(a: &DAffine3, b: &DAffine3, radius: f64) -> f64 {
         .fold(dt.length(), f64::max)
 }
 
-/// The `value` error of `reduced` against `reference` at `times`: vectors
-/// against `tolerance` (per component), rotations against
-/// `rotation_degrees`. The worst is the largest ratio.
+/// The `value` error of `reduced` (compiled) against `reference` played at
+/// `times` (`reference_rows`, from [`play`]): vectors against `tolerance`
+/// (per component), rotations against `rotation_degrees`. The worst is the
+/// largest ratio.
 pub fn value_error(
     reference: &Clip,
-    reduced: &Clip,
+    reference_rows: &[f32],
+    reduced: &Arc<tcb_runtime::Clip>,
     times: &[f64],
     tolerance: f64,
     rotation_degrees: f64,
 ) -> Measured {
     let channels = reference.channel_count();
-    let (ra, rb) = (play(reference, times), play(reduced, times));
+    let (ra, rb) = (reference_rows, play(reduced, times));
     let mut worst = Worst::none();
     let mut each = vec![0.0f64; reference.tracks.len()];
     for (i, &t) in times.iter().enumerate() {
@@ -184,19 +170,13 @@ pub fn value_error(
             let kind = track.data.kind();
             let dim = kind.dim();
             let (a, b) = (&ya[at..at + dim], &yb[at..at + dim]);
-            if kind == TrackKind::Quat {
-                let deg = rotation_angle_degrees(a, b);
-                worst.take(deg, deg / rotation_degrees, &track.name, t);
-                each[k] = each[k].max(deg / rotation_degrees);
+            let (e, limit) = if kind == TrackKind::Quat {
+                (rotation_angle_degrees(a, b), rotation_degrees)
             } else {
-                let e = a
-                    .iter()
-                    .zip(b)
-                    .map(|(x, y)| f64::from(*x - *y).abs())
-                    .fold(0.0, f64::max);
-                worst.take(e, e / tolerance, &track.name, t);
-                each[k] = each[k].max(e / tolerance);
-            }
+                (error(Norm::MaxAbs, &lanes(a), &lanes(b), dim), tolerance)
+            };
+            worst.take(e, e / limit, &track.name, t);
+            each[k] = each[k].max(e / limit);
             at += dim;
         }
     }
@@ -206,16 +186,14 @@ pub fn value_error(
 /// `2 acos(|q . q'|)` in degrees, for quaternions as `[x, y, z, w]`
 /// (normalized here).
 pub fn rotation_angle_degrees(a: &[f32], b: &[f32]) -> f64 {
-    let len = |q: &[f32]| q.iter().map(|v| f64::from(*v).powi(2)).sum::<f64>().sqrt();
-    let dot: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| f64::from(*x) * f64::from(*y))
-        .sum::<f64>()
-        / (len(a) * len(b));
-    // acos is ill-conditioned near 1: use the half-angle sine instead.
-    let sin_half = (1.0 - dot * dot).max(0.0).sqrt();
+    // acos is ill-conditioned near 1: the fitter's half-angle sine instead.
+    let sin_half = error(Norm::Rotation, &lanes(a), &lanes(b), 4);
     2.0 * sin_half.min(1.0).asin().to_degrees()
+}
+
+/// Up to 4 components in f64, zero-padded.
+fn lanes(v: &[f32]) -> [f64; 4] {
+    std::array::from_fn(|c| v.get(c).map_or(0.0, |x| f64::from(*x)))
 }
 
 #[cfg(test)]

@@ -15,13 +15,16 @@
 //!             scale |Δs| <= e / L_a.
 //!    ```
 //!
-//!    κ = 1 is the guaranteed bound. Errors of a chain rarely line up, so
-//!    larger κ (2, 4, …) are tried and kept while the *measured* shell
-//!    error still holds.
+//!    κ = 1 is the guaranteed bound, but errors of a chain rarely line up:
+//!    every group starts at κ = 16 and is tightened only where it is shown
+//!    to be too loose.
 //! 3. Fit each group of tracks sharing key times (`--knots`) with
 //!    [`crate::fit::fit`], in parallel.
 //! 4. Write the clip, build it, play it on the runtime, and measure the
-//!    error by the contract's metric. Only a clip that holds is returned.
+//!    error by the contract's metric, per joint (or track). Groups that
+//!    move a joint over the tolerance by r get κ / (1.05 r)^0.5 and are
+//!    refitted; the others keep their fit. Only a clip that holds is
+//!    returned.
 //!
 //! Tracks the fitter does not take are kept as they are (exact): tracks
 //! whose `linear` or `offset-repeat` extrapolation is checked outside their
@@ -33,6 +36,7 @@ use crate::metric::{self, Worst};
 use rayon::prelude::*;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{Clip, Ends, Extrapolation, RotationMode, TangentRule, TrackKind};
@@ -271,11 +275,11 @@ pub fn stored_values(track: &TrackDoc) -> usize {
     dim * (track.times.len() + tangents)
 }
 
-fn counts(doc: &ClipDoc, clip: &Clip) -> Counts {
+fn counts(doc: &ClipDoc, compiled: &tcb_runtime::Clip) -> Counts {
     Counts {
         keys: doc.tracks.iter().map(|t| t.times.len()).sum(),
         values: doc.tracks.iter().map(stored_values).sum(),
-        bytes: tcb_runtime::Clip::compile(clip).memory_bytes(),
+        bytes: compiled.memory_bytes(),
     }
 }
 
@@ -357,29 +361,36 @@ pub fn reduce(
     if times.len() < 2 {
         return Err(ReduceError::Empty);
     }
-    let plan = Plan::new(input, &settings, &times);
-    let before = counts(input.doc, input.clip);
-    let verify = |clip: &Clip| -> metric::Measured {
+    // The input is compiled and played once: the reference for the fitter
+    // and for every round's measurement.
+    let reference = Arc::new(tcb_runtime::Clip::compile(input.clip));
+    let plan = Plan::new(input, &settings, &times, &reference);
+    let before = counts(input.doc, &reference);
+    let verify = |clip: &Arc<tcb_runtime::Clip>| -> metric::Measured {
         match metric {
             Metric::Shell => metric::shell_error(
                 input.skeleton.expect("shell has a skeleton"),
-                input.clip,
+                &reference,
                 clip,
                 &times,
                 shell,
                 tolerance,
             ),
-            Metric::Value => {
-                metric::value_error(input.clip, clip, &times, tolerance, rotation_tolerance)
-            }
+            Metric::Value => metric::value_error(
+                input.clip,
+                &plan.rows,
+                clip,
+                &times,
+                tolerance,
+                rotation_tolerance,
+            ),
         }
     };
 
-    // κ: 1 is the guaranteed bound; larger values are kept while they hold.
-    // Budgets: every group starts loose (κ = 16 for shell, whose bound
-    // is loose; 1 for value, which is exact). After each round, the groups
+    // Budgets: every group starts loose (κ = 16 for shell, whose bound is
+    // loose; 1 for value, which is exact). After each round, the groups
     // that can move a joint (or track) measured over its tolerance are
-    // tightened by the ratio found there, and only they are fitted again.
+    // tightened, and only they are fitted again.
     let start = match metric {
         Metric::Shell => 16.0,
         Metric::Value => 1.0,
@@ -388,16 +399,12 @@ pub fn reduce(
     let mut scale = vec![start; plan.groups.len()];
     let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let mut attempts = Vec::new();
-    let mut best = None;
-    for round in 0..MAX_ROUNDS {
-        let fitted = scale
-            .iter()
-            .zip(&cache)
-            .filter(|(s, c)| **s > 0.0 && c.as_ref().is_none_or(|c| c.0 != **s))
-            .count();
-        let (doc, kept) = plan.run(&scale, &mut cache, progress);
+    let mut round = 0;
+    let (doc, clip, compiled, worst, kept) = loop {
+        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress);
         let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-        let measured = verify(&clip);
+        let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
+        let measured = verify(&compiled);
         attempts.push(Attempt {
             round,
             fitted,
@@ -406,10 +413,10 @@ pub fn reduce(
             worst: measured.worst.clone(),
         });
         if measured.worst.ratio <= 1.0 {
-            best = Some((doc, clip, measured.worst, kept));
-            break;
+            break (doc, clip, compiled, measured.worst, kept);
         }
-        if round + 1 == MAX_ROUNDS {
+        round += 1;
+        if round == MAX_ROUNDS {
             return Err(ReduceError::CannotMeet {
                 ratio: measured.worst.ratio,
                 worst: measured.worst,
@@ -418,10 +425,8 @@ pub fn reduce(
         for (g, units) in units.iter().enumerate() {
             let over = units.iter().map(|&u| measured.each[u]).fold(0.0, f64::max);
             if over > 1.0 || over.is_nan() {
-                let all_kept = plan.groups[g]
-                    .iter()
-                    .all(|&i| kept.contains(&input.clip.tracks[i].name));
                 // Kept at this budget: kept at any smaller one.
+                let all_kept = plan.groups[g].iter().all(|&i| kept[i]);
                 let next = scale[g] / (1.05 * over).powf(STEP);
                 scale[g] = if all_kept || !next.is_finite() || next < MIN_SCALE {
                     0.0
@@ -430,11 +435,12 @@ pub fn reduce(
                 };
             }
         }
-    }
-    let Some((doc, clip, worst, kept)) = best else {
-        return Err(ReduceError::Empty);
     };
-    let after = counts(&doc, &clip);
+    let after = counts(&doc, &compiled);
+    let kept = (0..kept.len())
+        .filter(|&i| kept[i])
+        .map(|i| input.clip.tracks[i].name.clone())
+        .collect();
     Ok(Reduced {
         doc,
         clip,
@@ -470,11 +476,18 @@ struct Plan<'a> {
     chain: Vec<usize>,
     /// Groups of track indices sharing key times.
     groups: Vec<Vec<usize>>,
+    /// The input played at the check times ([`metric::play`]).
+    rows: Vec<f32>,
 }
 
 impl<'a> Plan<'a> {
-    fn new(input: Input<'a>, settings: &'a Settings, times: &'a [f64]) -> Self {
-        let rows = metric::play(input.clip, times);
+    fn new(
+        input: Input<'a>,
+        settings: &'a Settings,
+        times: &'a [f64],
+        reference: &Arc<tcb_runtime::Clip>,
+    ) -> Self {
+        let rows = metric::play(reference, times);
         let channels = input.clip.channel_count();
         let n = times.len();
         let mut tracks = Vec::new();
@@ -546,6 +559,7 @@ impl<'a> Plan<'a> {
             reach,
             chain,
             groups: groups.into_iter().map(|g| g.3).collect(),
+            rows,
         }
     }
 
@@ -574,13 +588,14 @@ impl<'a> Plan<'a> {
 
     /// Fit every group at its budget scale (0: kept as it is), reusing the
     /// fit in `cache` where the scale has not changed, and write the clip.
-    /// Returns it and the names of the tracks kept as they were.
+    /// Returns it, per track whether it was kept as it was, and how many
+    /// groups were fitted.
     fn run(
         &self,
         scales: &[f64],
         cache: &mut [Option<(f64, Option<Fit>)>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> (ClipDoc, Vec<String>) {
+    ) -> (ClipDoc, Vec<bool>, usize) {
         let done = AtomicUsize::new(0);
         let todo: Vec<usize> = (0..self.groups.len())
             .filter(|&g| scales[g] > 0.0 && cache[g].as_ref().is_none_or(|c| c.0 != scales[g]))
@@ -611,7 +626,8 @@ impl<'a> Plan<'a> {
                 }
             }
         }
-        self.write(&fitted)
+        let (doc, kept) = self.write(&fitted);
+        (doc, kept, total)
     }
 
     fn fit_group(&self, gi: usize, scale: f64) -> Option<Fit> {
@@ -673,7 +689,8 @@ impl<'a> Plan<'a> {
             .collect()
     }
 
-    fn write(&self, fitted: &[Option<(&Fit, usize)>]) -> (ClipDoc, Vec<String>) {
+    /// The clip, and per track whether it was kept as it was.
+    fn write(&self, fitted: &[Option<(&Fit, usize)>]) -> (ClipDoc, Vec<bool>) {
         let src = self.input.doc;
         let (base, _) = src.defaults.resolve();
         let defaults = SettingsDoc {
@@ -687,7 +704,7 @@ impl<'a> Plan<'a> {
             rotation: Some(RotationMode::Hermite),
         };
         let mut tracks = Vec::new();
-        let mut kept = Vec::new();
+        let mut kept = vec![false; src.tracks.len()];
         for (i, doc) in src.tracks.iter().enumerate() {
             let (resolved, tcb) = doc.settings.or(&src.defaults).resolve();
             let reduced = fitted[i].map(|(f, s)| {
@@ -722,7 +739,7 @@ impl<'a> Plan<'a> {
             match reduced {
                 Some(t) if stored_values(&t) < stored_values(doc) => tracks.push(t),
                 _ => {
-                    kept.push(doc.name.clone());
+                    kept[i] = true;
                     // The original, with every setting it had stated against the new defaults.
                     let full = SettingsDoc {
                         tangent_rule: Some(resolved.tangent_rule),

@@ -90,6 +90,13 @@ pub struct Clip {
     pub(crate) source: tcb_core::Clip,
 }
 
+/// Flat pose indices of component planes x..w of `lane` in blocks of 8
+/// lanes, 4 planes a block, from pose block `out`.
+fn plane_slots(out: usize, lane: usize) -> [usize; 4] {
+    let base = (out + 4 * (lane / 8)) * 8 + lane % 8;
+    [base, base + 8, base + 16, base + 24]
+}
+
 /// A padding lane of loose rotations: the identity at all times.
 fn identity_lane() -> LooseLane {
     let w = [1.0, 1.0, 0.0, 0.0];
@@ -282,7 +289,8 @@ impl Clip {
         let mut grids: Vec<TimeGrid> = Vec::new();
         // Per group: vector channel rows (track, component), hermite rows, squad rows.
         let mut vec_rows: Vec<Vec<(usize, usize, Controls)>> = Vec::new();
-        let mut hq_rows: Vec<Vec<(usize, Vec<[f32; HQ_STRIDE]>)>> = Vec::new();
+        // Hermite rotations: per component (x, y, z, w), as vectors keep them.
+        let mut hq_rows: Vec<Vec<(usize, Vec<Controls>)>> = Vec::new();
         let mut sq_rows: Vec<Vec<(usize, Vec<[f64; SQ_STRIDE]>)>> = Vec::new();
         let mut reference = Vec::new();
         let mut squad_velocity = Vec::new();
@@ -314,18 +322,7 @@ impl Clip {
                 TrackData::Quat(r) => match rot_layout(r) {
                     RotLayout::Hermite => {
                         let comps = vector_controls(r.hermite_track().expect("hermite"));
-                        let rows = (0..comps[0].len())
-                            .map(|seg| {
-                                let mut row = [0.0f32; HQ_STRIDE];
-                                for (c, comp) in comps.iter().enumerate() {
-                                    for j in 0..4 {
-                                        row[4 * j + c] = comp[seg][j];
-                                    }
-                                }
-                                row
-                            })
-                            .collect();
-                        hq_rows[g].push((i, rows));
+                        hq_rows[g].push((i, comps));
                     }
                     _ => {
                         squad_velocity.push(TrackId(i));
@@ -350,19 +347,9 @@ impl Clip {
                 && !resets
             {
                 keep[g] = false;
-                for (track, rows) in &hq_rows[g] {
-                    let controls = rows
-                        .iter()
-                        .map(|row| std::array::from_fn(|c| std::array::from_fn(|j| row[4 * j + c])))
-                        .collect();
-                    loose_rots.push((
-                        *track,
-                        LooseLane {
-                            grid: grids[g].clone(),
-                            dim: 4,
-                            controls,
-                        },
-                    ));
+                for (track, comps) in &hq_rows[g] {
+                    let comps: Vec<&Controls> = comps.iter().collect();
+                    loose_rots.push((*track, LooseLane::new(grids[g].clone(), &comps)));
                 }
                 continue;
             }
@@ -376,19 +363,7 @@ impl Clip {
                     }
                 }
                 for (track, comps) in by_track {
-                    let controls = (0..comps[0].len())
-                        .map(|seg| {
-                            std::array::from_fn(|c| comps.get(c).map_or([0.0; 4], |r| r[seg]))
-                        })
-                        .collect();
-                    loose_lanes.push((
-                        track,
-                        LooseLane {
-                            grid: grids[g].clone(),
-                            dim: comps.len(),
-                            controls,
-                        },
-                    ));
+                    loose_lanes.push((track, LooseLane::new(grids[g].clone(), &comps)));
                 }
             }
         }
@@ -433,8 +408,7 @@ impl Clip {
                 let blocks = tracks.len().div_ceil(8);
                 let out = *at;
                 for (lane, track) in tracks.iter().enumerate() {
-                    let base = (out + 4 * (lane / 8)) * 8 + lane % 8;
-                    slots[*track].index = [base, base + 8, base + 16, base + 24];
+                    slots[*track].index = plane_slots(out, lane);
                 }
                 for b in 0..blocks {
                     quat_blocks.push(out + 4 * b);
@@ -446,7 +420,15 @@ impl Clip {
             let (hq_blocks, hq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
             let ids: Vec<usize> = sq_rows[g].iter().map(|r| r.0).collect();
             let (sq_blocks, sq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
-            let hrows: Vec<_> = hq_rows[g].iter().map(|r| r.1.clone()).collect();
+            // [P0 P1 M0 M1] x [x y z w] per stored segment.
+            let hrows: Vec<Vec<[f32; HQ_STRIDE]>> = hq_rows[g]
+                .iter()
+                .map(|(_, comps)| {
+                    (0..comps[0].len())
+                        .map(|seg| std::array::from_fn(|k| comps[k % 4][seg][k / 4]))
+                        .collect()
+                })
+                .collect();
             let srows: Vec<_> = sq_rows[g].iter().map(|r| r.1.clone()).collect();
             groups.push(Group {
                 vec: pack(&vrows, segments, [0.0; VEC_STRIDE]),
@@ -464,15 +446,13 @@ impl Clip {
         }
         // Loose tracks: planes of 8 lanes, like rotations.
         for (lane, (track, _)) in loose_lanes.iter().enumerate() {
-            let base = (at + 4 * (lane / 8)) * 8 + lane % 8;
-            slots[*track].index = [base, base + 8, base + 16, base + 24];
+            slots[*track].index = plane_slots(at, lane);
         }
         let loose = Loose::new(loose_lanes.into_iter().map(|(_, l)| l).collect(), at);
         at += 4 * loose.blocks;
         // Loose rotations: planes of 8 lanes, blended as rotations.
         for (lane, (track, _)) in loose_rots.iter().enumerate() {
-            let base = (at + 4 * (lane / 8)) * 8 + lane % 8;
-            slots[*track].index = [base, base + 8, base + 16, base + 24];
+            slots[*track].index = plane_slots(at, lane);
         }
         let mut rot_lanes: Vec<LooseLane> = loose_rots.into_iter().map(|(_, l)| l).collect();
         while !rot_lanes.len().is_multiple_of(8) {
@@ -579,19 +559,7 @@ impl Clip {
                     + size_of_val(g.sq.as_slice())
             })
             .sum();
-        let loose: usize = [&self.loose, &self.loose_rot]
-            .iter()
-            .map(|loose| {
-                loose
-                    .lanes
-                    .iter()
-                    .map(|l| {
-                        size_of::<LooseLane>() + grid(&l.grid) + size_of_val(l.controls.as_slice())
-                    })
-                    .sum::<usize>()
-                    + loose.heap_bytes()
-            })
-            .sum();
+        let loose = self.loose.heap_bytes() + self.loose_rot.heap_bytes();
         let layout = self
             .layout
             .slots

@@ -51,6 +51,21 @@ pub(crate) struct LooseLane {
     pub controls: Vec<[[f32; 4]; 4]>,
 }
 
+impl LooseLane {
+    /// A lane on `grid` from its components' controls per stored segment
+    /// (`[P0, P1, M0, M1]` each, as `clip.rs` builds them for every track).
+    pub fn new(grid: TimeGrid, comps: &[&Vec<[f32; 4]>]) -> Self {
+        let controls = (0..comps[0].len())
+            .map(|seg| std::array::from_fn(|c| comps.get(c).map_or([0.0; 4], |r| r[seg])))
+            .collect();
+        LooseLane {
+            grid,
+            dim: comps.len(),
+            controls,
+        }
+    }
+}
+
 /// The loose tracks of a clip and their per-lane constants.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Loose {
@@ -73,13 +88,24 @@ pub(crate) struct Loose {
 }
 
 impl Loose {
-    /// Heap bytes of the per-block tables (the lanes are counted by the clip).
+    /// Heap bytes: the lanes (grids and controls) and the per-block tables.
     pub fn heap_bytes(&self) -> usize {
-        use std::mem::size_of_val;
-        [&self.t0, &self.tn, &self.len, &self.pre, &self.post]
+        use std::mem::{size_of, size_of_val};
+        let lanes: usize = self
+            .lanes
             .iter()
-            .map(|v| size_of_val(v.as_slice()))
-            .sum::<usize>()
+            .map(|l| {
+                size_of::<LooseLane>()
+                    + size_of_val(l.grid.times.as_slice())
+                    + size_of_val(l.grid.eases.as_slice())
+                    + size_of_val(l.controls.as_slice())
+            })
+            .sum();
+        lanes
+            + [&self.t0, &self.tn, &self.len, &self.pre, &self.post]
+                .iter()
+                .map(|v| size_of_val(v.as_slice()))
+                .sum::<usize>()
             + size_of_val(self.delta.as_slice())
             + size_of_val(self.eased.as_slice())
             + size_of_val(self.dims.as_slice())
