@@ -38,6 +38,13 @@ impl Real for f64 {
     }
 }
 
+impl Real for wide::f64x4 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        wide::f64x4::splat(f64::from(x))
+    }
+}
+
 impl Real for wide::f32x8 {
     #[inline(always)]
     fn splat(x: f32) -> Self {

@@ -142,8 +142,3 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Error::io(path, e)
     })
 }
-
-/// The README's example, compiled as a doctest so that it stays true.
-#[cfg(doctest)]
-#[doc = include_str!("../../../README.md")]
-pub struct ReadmeDoctests;

@@ -92,7 +92,7 @@ pub struct Clip {
 
 /// Flat pose indices of component planes x..w of `lane` in blocks of 8
 /// lanes, 4 planes a block, from pose block `out`.
-fn plane_slots(out: usize, lane: usize) -> [usize; 4] {
+pub(crate) fn plane_slots(out: usize, lane: usize) -> [usize; 4] {
     let base = (out + 4 * (lane / 8)) * 8 + lane % 8;
     [base, base + 8, base + 16, base + 24]
 }
@@ -497,11 +497,7 @@ impl Clip {
 
     /// The track called `name`.
     pub fn track(&self, name: &str) -> Option<TrackId> {
-        self.layout
-            .slots
-            .iter()
-            .position(|s| s.name == name)
-            .map(TrackId)
+        self.layout.track(name)
     }
 
     /// Every track's slot, in file order.

@@ -1,10 +1,12 @@
 //! Per-instance playback: cursors and a pose, sampled without allocating.
 
+use crate::BlendMask;
 use crate::clip::{Clip, TrackId};
 use crate::grid::Cursor;
 use crate::kernel;
 use crate::loose::LooseState;
 use crate::pose::Pose;
+use crate::rig::{Rig, RigError, RigMap};
 use std::sync::Arc;
 use tcb_core::TrackData;
 use wide::f32x8;
@@ -18,6 +20,8 @@ pub struct Instance {
     loose: LooseState,
     loose_rot: LooseState,
     pose: Pose,
+    /// With a rig: the map into its layout and the pose in it.
+    rig: Option<Box<(RigMap, Pose)>>,
 }
 
 impl Instance {
@@ -29,6 +33,30 @@ impl Instance {
             loose_rot: LooseState::new(&clip.loose_rot),
             pose: Pose::new(&clip, velocities),
             clip,
+            rig: None,
+        }
+    }
+
+    /// An instance whose [`pose`](Self::pose) is in `rig`'s layout (see
+    /// [`crate::rig`]): every track of `clip` must be a rig track of the same
+    /// kind; rig tracks the clip lacks keep their rest values.
+    pub fn with_rig(clip: Arc<Clip>, rig: &Arc<Rig>, velocities: bool) -> Result<Self, RigError> {
+        let map = rig.map(&clip)?;
+        let mut inst = Instance::new(clip, velocities);
+        inst.rig = Some(Box::new((map, rig.rest_pose(velocities))));
+        Ok(inst)
+    }
+
+    /// Per track of the pose: 1 where the clip animates it, 0 where it
+    /// keeps its rest value (every track, without a rig). Multiply it into a
+    /// layer's mask so that a clip's missing tracks do not pull the blend
+    /// towards the rest pose.
+    pub fn coverage_mask(&self) -> BlendMask {
+        match &self.rig {
+            Some(rig) => {
+                BlendMask::for_layout(&rig.1.layout, |t| f32::from(u8::from(rig.0.covered[t.0])))
+            }
+            None => BlendMask::new(&self.clip, |_| 1.0),
         }
     }
 
@@ -37,9 +65,12 @@ impl Instance {
         &self.clip
     }
 
-    /// The last sampled pose.
+    /// The last sampled pose (in the rig's layout if the instance has one).
     pub fn pose(&self) -> &Pose {
-        &self.pose
+        match &self.rig {
+            Some(rig) => &rig.1,
+            None => &self.pose,
+        }
     }
 
     /// Sample every track at `time` (seconds; any f64) into the pose.
@@ -52,7 +83,13 @@ impl Instance {
             &mut self.loose_rot,
             &mut self.pose,
         );
-        &self.pose
+        match self.rig.as_deref_mut() {
+            Some((map, out)) => {
+                map.apply(&self.pose, out);
+                out
+            }
+            None => &self.pose,
+        }
     }
 }
 

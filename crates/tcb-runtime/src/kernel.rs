@@ -1,7 +1,7 @@
 //! The SIMD kernels: one stored segment, eight channels per `f32x8`, the
 //! frame's rows broadcast. No branch depends on a channel.
 
-use tcb_core::basis::hermite;
+use tcb_core::basis::{Real, hermite};
 use wide::{f32x8, f64x4};
 
 /// `[P0, P1, M0, M1]` of 8 channels.
@@ -102,9 +102,10 @@ pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8
     }
 }
 
-/// Hamilton product of two quaternions in planes `[x, y, z, w]`.
+/// Hamilton product of two quaternions in planes `[x, y, z, w]`, for any
+/// lane type (squad in `f64x4`, additive blending in `f32x8`).
 #[inline(always)]
-fn quat_mul(a: &[f64x4; 4], b: &[f64x4; 4]) -> [f64x4; 4] {
+pub(crate) fn quat_mul<R: Real>(a: &[R; 4], b: &[R; 4]) -> [R; 4] {
     [
         a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
         a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],

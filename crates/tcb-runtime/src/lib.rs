@@ -23,7 +23,7 @@
 //!     walk.sample(t);
 //!     run.sample(t + 0.5);
 //!     let fade = (frame as f32 / 120.0).min(1.0);
-//!     blend(&mut out, &[(walk.pose(), 1.0 - fade), (run.pose(), fade)], None);
+//!     blend(&mut out, &[(walk.pose(), 1.0 - fade), (run.pose(), fade)], None).unwrap();
 //!     let p = out.vec3(ball);
 //!     assert!(p.is_finite());
 //! }
@@ -41,6 +41,7 @@ mod instance;
 mod kernel;
 mod loose;
 pub mod pose;
+pub mod rig;
 pub mod skeleton;
 
 #[cfg(feature = "rayon")]
@@ -50,4 +51,11 @@ pub use blend::{BlendMask, blend};
 pub use clip::{Clip, TrackId, TrackSlot};
 pub use instance::Instance;
 pub use pose::Pose;
+pub use rig::{Rig, RigError, RigTrack};
 pub use skeleton::SkeletonBinding;
+
+/// The README's examples, compiled as doctests so that they stay true
+/// (here, where every crate they use is a dependency).
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;

@@ -15,6 +15,13 @@ pub struct PoseLayout {
     /// Flat index of each rotation stored as 4 consecutive floats.
     pub loose_quats: Vec<usize>,
 }
+impl PoseLayout {
+    /// The track called `name`.
+    pub fn track(&self, name: &str) -> Option<TrackId> {
+        self.slots.iter().position(|s| s.name == name).map(TrackId)
+    }
+}
+
 use glam::{Quat, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 use wide::f32x8;
@@ -90,6 +97,27 @@ impl Pose {
         vec3, vec3_velocity, Vec3, 3, |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
         vec4, vec4_velocity, Vec4, 4, Vec4::from_array;
         quat, quat_velocity, Quat, 4, Quat::from_array;
+    }
+
+    /// The angular velocity of a rotation track in rad/s, as a vector in
+    /// the frame the rotation maps into (a joint's parent):
+    /// `omega = 2 q' conj(q)` (its vector part; zero without velocities).
+    ///
+    /// ```
+    /// # use std::sync::Arc;
+    /// // A quarter turn about z per second.
+    /// let text = r#"{"format": "tcb-clip/1", "tracks": [{"name": "r", "kind": "quat", "times": [0, 1],
+    ///   "values": [[0, 0, 0, 1], [0, 0, 0.70710678, 0.70710678]],
+    ///   "keys": [{"interp": "linear"}, {"interp": "linear"}]}]}"#;
+    /// let clip = Arc::new(tcb_runtime::Clip::compile(&tcb_io::ClipDoc::parse(text).unwrap().build().unwrap()));
+    /// let mut inst = tcb_runtime::Instance::new(clip.clone(), true);
+    /// let w = inst.sample(0.3).angular_velocity(clip.track("r").unwrap());
+    /// assert!((w - glam::Vec3::new(0.0, 0.0, std::f32::consts::FRAC_PI_2)).length() < 1e-5);
+    /// ```
+    pub fn angular_velocity(&self, track: TrackId) -> Vec3 {
+        let (q, dq) = (self.quat(track), self.quat_velocity(track));
+        let w = dq * q.conjugate();
+        2.0 * Vec3::new(w.x, w.y, w.z)
     }
 
     /// Every track's components in file order (the CSV columns of

@@ -1,6 +1,7 @@
 //! Binding a joint hierarchy to a clip: from a sampled [`Pose`] to local
 //! and model-space joint transforms.
 
+use crate::pose::PoseLayout;
 use crate::{Clip, Pose, TrackId};
 use glam::Affine3A;
 use tcb_core::TrackKind;
@@ -32,9 +33,16 @@ pub struct SkeletonBinding {
 impl SkeletonBinding {
     /// Find each joint's tracks in `clip` (by name and kind).
     pub fn new(skeleton: Skeleton, clip: &Clip) -> Self {
+        SkeletonBinding::for_layout(skeleton, clip.layout())
+    }
+
+    /// Find each joint's tracks in poses of `layout` (a clip's or a
+    /// [`Rig`](crate::Rig)'s).
+    pub fn for_layout(skeleton: Skeleton, layout: &PoseLayout) -> Self {
         let find = |name: String, kind: TrackKind| {
-            clip.track(&name)
-                .filter(|t| clip.tracks()[t.0].kind == kind)
+            layout
+                .track(&name)
+                .filter(|t| layout.slots[t.0].kind == kind)
         };
         let tracks = skeleton
             .joints

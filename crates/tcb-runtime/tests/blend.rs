@@ -34,7 +34,7 @@ fn weighted_blend_by_hand() {
     a.sample(0.0);
     b.sample(2.0);
     let mut out = a.pose().clone();
-    blend(&mut out, &[(a.pose(), 3.0), (b.pose(), 1.0)], None);
+    blend(&mut out, &[(a.pose(), 3.0), (b.pose(), 1.0)], None).unwrap();
     // Vectors: (3 a + 1 b) / 4.
     assert!(
         (out.vec3(pos) - Vec3::new(1.0, 0.0, 0.5))
@@ -62,11 +62,11 @@ fn hemisphere_correction() {
     b.sample(0.4);
     // b with every rotation negated (same rotations): a single layer of weight -1.
     let mut flipped = b.pose().clone();
-    blend(&mut flipped, &[(b.pose(), -1.0)], None);
+    blend(&mut flipped, &[(b.pose(), -1.0)], None).unwrap();
     assert!(flipped.quat(rot).dot(b.pose().quat(rot)) < -0.99);
     let (mut plain, mut corrected) = (a.pose().clone(), a.pose().clone());
-    blend(&mut plain, &[(a.pose(), 0.6), (b.pose(), 0.4)], None);
-    blend(&mut corrected, &[(a.pose(), 0.6), (&flipped, 0.4)], None);
+    blend(&mut plain, &[(a.pose(), 0.6), (b.pose(), 0.4)], None).unwrap();
+    blend(&mut corrected, &[(a.pose(), 0.6), (&flipped, 0.4)], None).unwrap();
     for t in [rot, rot_h] {
         assert!(
             close(plain.quat(t), corrected.quat(t)),
@@ -93,7 +93,8 @@ fn masks_weigh_tracks_separately() {
         &mut out,
         &[(a.pose(), 1.0), (b.pose(), 1.0)],
         Some(&[&all, &only_pos]),
-    );
+    )
+    .unwrap();
     assert!(
         (out.vec3(pos) - Vec3::new(1.0, 2.0, 3.0))
             .abs()
@@ -107,12 +108,13 @@ fn masks_weigh_tracks_separately() {
         &mut out,
         &[(b.pose(), 1.0), (a.pose(), 1.0)],
         Some(&[&none, &none]),
-    );
+    )
+    .unwrap();
     assert_eq!(out.vec3(pos), b.pose().vec3(pos));
 }
 
 #[test]
-fn layers_of_another_clip_with_the_same_layout_blend_others_are_skipped() {
+fn layers_of_another_clip_with_the_same_layout_blend_others_are_refused() {
     let (one, two) = (clip(), clip()); // compiled twice: equal layouts, different Arcs
     let pos = one.track("pos").unwrap();
     let mut a = Instance::new(one.clone(), false);
@@ -120,14 +122,14 @@ fn layers_of_another_clip_with_the_same_layout_blend_others_are_skipped() {
     a.sample(0.0);
     b.sample(1.0);
     let mut out = a.pose().clone();
-    blend(&mut out, &[(a.pose(), 1.0), (b.pose(), 1.0)], None);
+    blend(&mut out, &[(a.pose(), 1.0), (b.pose(), 1.0)], None).unwrap();
     assert!(
         (out.vec3(pos) - Vec3::new(1.0, 2.0, 3.0))
             .abs()
             .max_element()
             < 1e-6
     );
-    // A pose of a clip with other tracks does not take part.
+    // A pose of a clip with other tracks is refused, and nothing is written.
     let other = tcb_io::ClipDoc::parse(
         r#"{"format": "tcb-clip/1", "tracks": [{"name": "pos", "kind": "vec3", "times": [0, 1], "values": [[9, 9, 9], [9, 9, 9]]}]}"#,
     )
@@ -136,6 +138,29 @@ fn layers_of_another_clip_with_the_same_layout_blend_others_are_skipped() {
     .unwrap();
     let mut c = Instance::new(Arc::new(Clip::compile(&other)), false);
     c.sample(0.5);
-    blend(&mut out, &[(a.pose(), 1.0), (c.pose(), 1.0)], None);
-    assert_eq!(out.vec3(pos), a.pose().vec3(pos));
+    let before = out.clone();
+    assert_eq!(
+        blend(&mut out, &[(a.pose(), 1.0), (c.pose(), 1.0)], None),
+        Err(tcb_runtime::blend::BlendError::Layout { layer: 1 })
+    );
+    assert_eq!(out.as_slice(), before.as_slice());
+    // So is a mask of another layout, or a mask count that does not match.
+    let foreign = BlendMask::new(&Arc::new(Clip::compile(&other)), |_| 1.0);
+    let own = BlendMask::new(&one, |_| 1.0);
+    assert_eq!(
+        blend(
+            &mut out,
+            &[(a.pose(), 1.0), (b.pose(), 1.0)],
+            Some(&[&own, &foreign])
+        ),
+        Err(tcb_runtime::blend::BlendError::Mask { layer: 1 })
+    );
+    assert_eq!(
+        blend(&mut out, &[(a.pose(), 1.0), (b.pose(), 1.0)], Some(&[&own])),
+        Err(tcb_runtime::blend::BlendError::MaskCount {
+            layers: 2,
+            masks: 1
+        })
+    );
+    assert_eq!(out.as_slice(), before.as_slice());
 }

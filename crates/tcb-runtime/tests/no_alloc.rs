@@ -65,6 +65,17 @@ fn steady_playback_and_blending_allocate_nothing() {
         let mut b = tcb_runtime::Instance::new(clip.clone(), true);
         let mut out = a.pose().clone();
         let mask = tcb_runtime::BlendMask::new(&clip, |t| if t.0 % 2 == 0 { 1.0 } else { 0.25 });
+        // Through a rig (every track, plus one the clip lacks).
+        let mut tracks = tcb_runtime::Rig::from_clip(clip.source()).tracks().to_vec();
+        tracks.push(tcb_runtime::RigTrack {
+            name: "extra".into(),
+            kind: tcb_core::TrackKind::Quat,
+            rest: [0.0, 0.0, 0.0, 1.0],
+        });
+        let rig = Arc::new(tcb_runtime::Rig::new(tracks).unwrap());
+        let mut r = tcb_runtime::Instance::with_rig(clip.clone(), &rig, true).unwrap();
+        let mut rest = rig.rest_pose(true);
+        r.sample(0.0);
         // Warm up once.
         a.sample(0.0);
         b.sample(0.0);
@@ -74,12 +85,16 @@ fn steady_playback_and_blending_allocate_nothing() {
             let t = -3.0 + frame as f64 / 120.0;
             a.sample(t);
             b.sample(t * 0.5 + 1e6);
-            tcb_runtime::blend(&mut out, &[(a.pose(), 0.7), (b.pose(), 0.3)], None);
+            tcb_runtime::blend(&mut out, &[(a.pose(), 0.7), (b.pose(), 0.3)], None).unwrap();
             tcb_runtime::blend(
                 &mut out,
                 &[(a.pose(), 1.0), (b.pose(), 1.0)],
                 Some(&[&mask, &mask]),
-            );
+            )
+            .unwrap();
+            r.sample(t * 0.25);
+            tcb_runtime::blend::add(&mut rest, r.pose(), r.pose(), 0.5, None).unwrap();
+            tcb_runtime::blend::add(&mut out, a.pose(), b.pose(), 0.5, Some(&mask)).unwrap();
         }
         COUNTING.with(|c| c.set(false));
         let after = ALLOCATIONS.load(Ordering::Relaxed);
