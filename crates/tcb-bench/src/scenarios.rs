@@ -242,13 +242,46 @@ pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     Ok(s)
 }
 
+/// How [`file_with`] plays a user's clip.
+#[derive(Clone, Debug)]
+pub struct FileOptions {
+    /// Frames per second, forward over the clip's keys.
+    pub fps: f64,
+    /// Instances at random phases (more than one adds the rayon column).
+    pub instances: usize,
+    /// Import options (BVH rotation mode, glTF animation).
+    pub import: tcb_io::ImportOptions,
+}
+
+impl Default for FileOptions {
+    fn default() -> Self {
+        FileOptions {
+            fps: 60.0,
+            instances: 1,
+            import: Default::default(),
+        }
+    }
+}
+
 /// A clip file of the user's, played at 60 fps forward over its keys
 /// (joints counted as `animated_joints` counts them).
 pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
-    let loaded = tcb_io::load(path)?;
+    file_with(path, &FileOptions::default())
+}
+
+/// [`file`] with a frame rate, instance count and import options. With
+/// several instances, each plays from its own random phase within the clip,
+/// one second (or the whole clip, if shorter) per pass.
+pub fn file_with(path: &Path, options: &FileOptions) -> Result<Scenario, tcb_io::Error> {
+    let loaded = tcb_io::load_with(path, &options.import)?;
     let joints = animated_joints(&loaded);
     let (start, end) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
-    let times = frames(end - start, 60.0)
+    let span = if options.instances > 1 {
+        (end - start).min(1.0)
+    } else {
+        end - start
+    };
+    let times = frames(span, options.fps)
         .into_iter()
         .map(|t| t + start)
         .collect();
@@ -257,6 +290,14 @@ pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
         .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
     let mut s = Scenario::new(name, loaded.clip, times);
     s.joints = Some(joints);
+    if options.instances > 1 {
+        let mut rng = Rng(0xf11e);
+        let room = (end - start - span).max(0.0);
+        s.phases = (0..options.instances)
+            .map(|_| rng.range(0.0, room))
+            .collect();
+        s.parallel = true;
+    }
     Ok(s)
 }
 

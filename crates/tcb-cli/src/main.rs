@@ -6,6 +6,8 @@
 //! tcb sample CLIP.json --inbetweens N [--scalar] [--velocity]
 //! tcb import FILE.bvh -o CLIP.json [--rotation squad|hermite]
 //! tcb import FILE.gltf|FILE.glb -o CLIP.json [--animation NAME_OR_INDEX]
+//! tcb info CLIP
+//! tcb bench CLIP [--fps 60] [--instances N] [--threads N]
 //! ```
 //!
 //! `sample` also reads BVH and glTF files directly (imported on the fly).
@@ -46,6 +48,49 @@ enum Command {
     Export(ExportArgs),
     /// Fit dense animation with far fewer Hermite keys within a stated error.
     Reduce(ReduceArgs),
+    /// Print a clip's tracks, key grids, runtime layout and bytes.
+    Info(InfoArgs),
+    /// Time the runtime on a clip: ns per joint and per channel, bytes, flags.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    /// The clip: clip JSON, BVH, glTF or GLB.
+    clip: PathBuf,
+    /// BVH: rotation mode of its rotation tracks, as `tcb import`.
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF: the animation, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// The clip: clip JSON, BVH, glTF or GLB.
+    clip: PathBuf,
+    /// Frames per second of playback.
+    #[arg(long, value_name = "FPS", default_value_t = 60.0)]
+    fps: f64,
+    /// Instances at random phases (more than 1 also times them with rayon).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    instances: usize,
+    /// Rayon threads for the parallel column (default: one per core).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// Timing rounds (the median is reported).
+    #[arg(long, default_value_t = 11)]
+    rounds: usize,
+    /// Milliseconds per timing.
+    #[arg(long, value_name = "MS", default_value_t = 20)]
+    slice_ms: u64,
+    /// BVH: rotation mode of its rotation tracks, as `tcb import`.
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF: the animation, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
 }
 
 #[derive(Args)]
@@ -147,6 +192,8 @@ fn main() -> ExitCode {
         Command::Import(args) => import(&args),
         Command::Export(args) => export(&args),
         Command::Reduce(args) => reduce(&args),
+        Command::Info(args) => info(&args),
+        Command::Bench(args) => bench(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -354,6 +401,162 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         started.elapsed().as_secs_f64()
     );
     println!("{}", reduced.summary_line());
+    Ok(())
+}
+
+/// Bytes as MB with three decimals.
+fn mb(bytes: usize) -> String {
+    format!("{:.3} MB", bytes as f64 / 1e6)
+}
+
+fn info(args: &InfoArgs) -> Result<(), BoxError> {
+    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
+    let loaded = tcb_io::load_with(&args.clip, &options)?;
+    warn(&loaded.warnings);
+    let clip = &loaded.clip;
+    let runtime = tcb_runtime::Clip::compile(clip);
+    let stats = runtime.stats();
+    let keys: usize = clip.tracks.iter().map(|t| t.data.times().len()).sum();
+    let mut out = String::new();
+    use std::fmt::Write as _;
+    writeln!(out, "file: {}", args.clip.display())?;
+    let range = clip
+        .time_range()
+        .map_or("no keys".to_string(), |(a, b)| format!("{a} to {b} s"));
+    writeln!(
+        out,
+        "clip: {:?}, {} tracks, {} channels, {keys} keys, {range}",
+        clip.name,
+        clip.tracks.len(),
+        clip.channel_count()
+    )?;
+    match &loaded.skeleton {
+        Some(s) => {
+            let roots = s.joints.iter().filter(|j| j.parent.is_none()).count();
+            writeln!(out, "skeleton: {} joints, {roots} root(s)", s.joints.len())?
+        }
+        None => writeln!(out, "skeleton: none")?,
+    }
+    writeln!(out, "tracks:")?;
+    writeln!(
+        out,
+        "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
+        "name", "kind", "keys", "first", "last"
+    )?;
+    for t in &clip.tracks {
+        let times = t.data.times();
+        let (mode, settings) = match &t.data {
+            tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
+            tcb_core::TrackData::Scalar(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec2(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec3(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec4(v) => ("-", v.settings()),
+        };
+        writeln!(
+            out,
+            "  {:<32} {:<6} {:>6} {:>12} {:>12}  {mode} {}/{}",
+            t.name,
+            t.data.kind().name(),
+            times.len(),
+            times[0],
+            times[times.len() - 1],
+            settings.pre.name(),
+            settings.post.name()
+        )?;
+    }
+    writeln!(
+        out,
+        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation(s) on the scalar reference, {} squad velocity fallback(s)",
+        stats.grids.len(),
+        stats.loose_vector_tracks,
+        stats.loose_rotation_tracks,
+        stats.reference_rotations,
+        stats.squad_velocity_fallbacks
+    )?;
+    for (i, g) in stats.grids.iter().enumerate() {
+        writeln!(
+            out,
+            "  grid {i}: {} keys, {} vector channels, {} hermite rotations, {} squad rotations",
+            g.keys, g.vector_channels, g.hermite_rotations, g.squad_rotations
+        )?;
+    }
+    writeln!(
+        out,
+        "bytes: {} compiled, {} with the source copy, {} read per frame inside the keys",
+        mb(stats.bytes_compiled),
+        mb(stats.bytes),
+        stats.bytes_per_frame
+    )?;
+    io::stdout().lock().write_all(out.as_bytes())?;
+    Ok(())
+}
+
+fn bench(args: &BenchArgs) -> Result<(), BoxError> {
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 100_000.0) {
+        return Err(format!("--fps {}: must be in (0, 100000]", args.fps).into());
+    }
+    if args.instances == 0 || args.instances > 1_000_000 {
+        return Err("--instances must be 1 to 1000000".into());
+    }
+    if args.rounds == 0 || args.threads == Some(0) {
+        return Err("--rounds and --threads must be at least 1".into());
+    }
+    let options = tcb_bench::scenarios::FileOptions {
+        fps: args.fps,
+        instances: args.instances,
+        import: import_options(&args.clip, args.rotation, args.animation.as_ref())?,
+    };
+    let scenario = tcb_bench::scenarios::file_with(&args.clip, &options)?;
+    if scenario.source.tracks.is_empty() {
+        return Err(format!("{}: the clip has no tracks to time", args.clip.display()).into());
+    }
+    if cfg!(debug_assertions) {
+        eprintln!("tcb: warning: a debug build; numbers mean little (build with --release)");
+    }
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder.build()?;
+    let slice = std::time::Duration::from_millis(args.slice_ms.max(1));
+    eprintln!(
+        "tcb: timing {} ({} instance(s), {} frames a pass at {} fps, {} rounds)...",
+        args.clip.display(),
+        args.instances,
+        scenario.times.len(),
+        args.fps,
+        args.rounds
+    );
+    let row = pool.install(|| tcb_bench::report::measure(&scenario, args.rounds, slice));
+    let (flags, machine) =
+        pool.install(|| (tcb_bench::report::flags(), tcb_bench::report::machine()));
+    let mut out = tcb_bench::report::table(std::slice::from_ref(&row), &flags, &machine);
+    use std::fmt::Write as _;
+    let joints = scenario.joints.unwrap_or(0);
+    let rt = row.ns_of("runtime").unwrap_or(f64::NAN);
+    let frame = rt * row.channels as f64;
+    writeln!(
+        out,
+        "\nruntime: {:.1} ns per frame per instance, {} ns per joint ({joints} animated joints), {:.3} ns per channel",
+        frame,
+        row.ns_per_joint.map_or("-".into(), |j| format!("{j:.2}")),
+        rt
+    )?;
+    if let Some(p) = row.parallel_speedup {
+        writeln!(
+            out,
+            "rayon: {:.2}x one thread, on {} thread(s)",
+            p,
+            pool.current_num_threads()
+        )?;
+    }
+    writeln!(
+        out,
+        "bytes: {} ({} without the source copy)",
+        mb(row.bytes),
+        mb(scenario.clip.memory_bytes_compiled())
+    )?;
+    io::stdout().lock().write_all(out.as_bytes())?;
     Ok(())
 }
 

@@ -45,6 +45,40 @@ pub struct TrackSlot {
     pub index: [usize; 4],
 }
 
+/// One shared key grid of a compiled clip (see [`Clip::stats`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GridStats {
+    /// Keys of the grid.
+    pub keys: usize,
+    /// Vector channels on it (a vec3 counts 3).
+    pub vector_channels: usize,
+    /// `hermite` rotations on it.
+    pub hermite_rotations: usize,
+    /// `squad` (and all-slerp) rotations on it.
+    pub squad_rotations: usize,
+}
+
+/// The layout and size of a compiled clip (see [`Clip::stats`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ClipStats {
+    /// Grids whose channels share one basis per frame.
+    pub grids: Vec<GridStats>,
+    /// Vector tracks on key times of their own (loose lanes).
+    pub loose_vector_tracks: usize,
+    /// `hermite` rotations on key times of their own (loose lanes).
+    pub loose_rotation_tracks: usize,
+    /// Rotations the scalar reference samples (`hermite` mixing slerp and curve keys).
+    pub reference_rotations: usize,
+    /// Squad rotations whose velocity the scalar reference gives.
+    pub squad_velocity_fallbacks: usize,
+    /// [`Clip::memory_bytes`].
+    pub bytes: usize,
+    /// [`Clip::memory_bytes_compiled`].
+    pub bytes_compiled: usize,
+    /// [`Clip::bytes_per_frame`].
+    pub bytes_per_frame: usize,
+}
+
 /// How a rotation track is evaluated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum RotLayout {
@@ -57,6 +91,8 @@ enum RotLayout {
 #[derive(Clone, Debug)]
 pub(crate) struct Group {
     pub grid: TimeGrid,
+    /// Vector channels, hermite and squad rotations (lanes in use).
+    pub lanes: [usize; 3],
     pub vec_blocks: usize,
     pub vec: Vec<f32x8>,
     /// `P_{n-1} - P_0` per vector block, when a side is `offset-repeat`.
@@ -83,6 +119,8 @@ pub struct Clip {
     /// planes, normalized after sampling; padded to whole blocks with
     /// constant identity lanes).
     pub(crate) loose_rot: Loose,
+    /// Real tracks among `loose_rot`'s lanes (the rest are padding).
+    pub(crate) loose_rot_tracks: usize,
     /// Tracks the scalar reference samples (value and velocity).
     pub(crate) reference: Vec<TrackId>,
     /// Squad tracks, whose velocity the scalar reference gives.
@@ -431,6 +469,7 @@ impl Clip {
                 .collect();
             let srows: Vec<_> = sq_rows[g].iter().map(|r| r.1.clone()).collect();
             groups.push(Group {
+                lanes: [vrows.len(), hq_rows[g].len(), sq_rows[g].len()],
                 vec: pack(&vrows, segments, [0.0; VEC_STRIDE]),
                 delta,
                 vec_blocks,
@@ -454,6 +493,7 @@ impl Clip {
         for (lane, (track, _)) in loose_rots.iter().enumerate() {
             slots[*track].index = plane_slots(at, lane);
         }
+        let loose_rot_tracks = loose_rots.len();
         let mut rot_lanes: Vec<LooseLane> = loose_rots.into_iter().map(|(_, l)| l).collect();
         while !rot_lanes.len().is_multiple_of(8) {
             rot_lanes.push(identity_lane());
@@ -484,6 +524,7 @@ impl Clip {
             }),
             loose,
             loose_rot,
+            loose_rot_tracks,
             reference,
             squad_velocity,
             source: source.clone(),
@@ -518,7 +559,7 @@ impl Clip {
     /// Number of tracks sampled as loose lanes (their own time grid, mapped
     /// eight tracks at a time).
     pub fn loose_track_count(&self) -> usize {
-        self.loose.lanes.len() + self.loose_rot.lanes.len()
+        self.loose.lanes.len() + self.loose_rot_tracks
     }
 
     /// The validated clip this was compiled from.
@@ -570,6 +611,30 @@ impl Clip {
             + layout
             + size_of_val(self.reference.as_slice())
             + size_of_val(self.squad_velocity.as_slice())
+    }
+
+    /// How the clip was laid out: its shared grids, loose tracks and
+    /// reference fallbacks, and its bytes (what `tcb info` prints).
+    pub fn stats(&self) -> ClipStats {
+        ClipStats {
+            grids: self
+                .groups
+                .iter()
+                .map(|g| GridStats {
+                    keys: g.grid.keys(),
+                    vector_channels: g.lanes[0],
+                    hermite_rotations: g.lanes[1],
+                    squad_rotations: g.lanes[2],
+                })
+                .collect(),
+            loose_vector_tracks: self.loose.lanes.len(),
+            loose_rotation_tracks: self.loose_rot_tracks,
+            reference_rotations: self.reference.len(),
+            squad_velocity_fallbacks: self.squad_velocity.len(),
+            bytes: self.memory_bytes(),
+            bytes_compiled: self.memory_bytes_compiled(),
+            bytes_per_frame: self.bytes_per_frame(),
+        }
     }
 
     /// Bytes of coefficients the kernels read per frame when every group is

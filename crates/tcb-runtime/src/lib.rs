@@ -48,7 +48,7 @@ pub mod skeleton;
 pub mod batch;
 
 pub use blend::{BlendMask, blend};
-pub use clip::{Clip, TrackId, TrackSlot};
+pub use clip::{Clip, ClipStats, GridStats, TrackId, TrackSlot};
 pub use instance::Instance;
 pub use pose::Pose;
 pub use rig::{Rig, RigError, RigTrack};

@@ -1,0 +1,107 @@
+//! `tcb info` and `tcb bench` as a user runs them.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn tcb(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tcb"))
+        .args(args)
+        .output()
+        .expect("run tcb")
+}
+
+fn file(rel: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8(b.to_vec()).unwrap()
+}
+
+#[test]
+fn info_names_tracks_grids_and_bytes() {
+    let o = tcb(&["info", &file("examples/clips/bounce.json")]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(
+        out.contains("3 tracks, 8 channels, 10 keys, 0 to 2 s"),
+        "{out}"
+    );
+    assert!(
+        out.contains("ball.squash                      scalar      2"),
+        "{out}"
+    );
+    assert!(
+        out.contains("1 shared key grid(s), 2 loose vector track(s)"),
+        "{out}"
+    );
+    assert!(
+        out.contains("grid 0: 4 keys, 0 vector channels, 0 hermite rotations, 1 squad rotations")
+    );
+    assert!(out.contains("bytes: "));
+    // A BVH file, imported on the fly, with its skeleton.
+    let o = tcb(&["info", &file("data/cmu-01_01.bvh"), "--rotation", "hermite"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(
+        out.contains("32 tracks") && out.contains("skeleton: 38 joints"),
+        "{out}"
+    );
+    assert!(out.contains("31 hermite rotations"), "{out}");
+}
+
+#[test]
+fn bench_reports_ns_per_joint_bytes_and_flags() {
+    let o = tcb(&[
+        "bench",
+        &file("examples/clips/bounce.json"),
+        "--rounds",
+        "1",
+        "--slice-ms",
+        "1",
+        "--instances",
+        "3",
+        "--threads",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    for want in [
+        "flags:",
+        "RUSTFLAGS=",
+        "ns per joint",
+        "ns per channel",
+        "bytes:",
+        "on 2 thread(s)",
+    ] {
+        assert!(out.contains(want), "{want:?} missing from\n{out}");
+    }
+}
+
+#[test]
+fn bench_and_info_refuse_bad_input() {
+    let bounce = file("examples/clips/bounce.json");
+    for args in [
+        vec!["bench", &bounce, "--fps", "0"],
+        vec!["bench", &bounce, "--fps", "nan"],
+        vec!["bench", &bounce, "--instances", "0"],
+        vec!["bench", &bounce, "--threads", "0"],
+        vec!["bench", &bounce, "--rotation", "hermite"],
+        vec!["bench", "/no/such/file.json"],
+        vec!["info", "/no/such/file.bvh"],
+        vec!["info", &bounce, "--animation", "0"],
+    ] {
+        let o = tcb(&args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let err = text(&o.stderr);
+        assert!(
+            err.starts_with("tcb: error: ") || err.contains("error:"),
+            "{args:?}: {err}"
+        );
+        assert!(o.stdout.is_empty(), "{args:?} printed {}", text(&o.stdout));
+    }
+}
