@@ -15,6 +15,8 @@
 //! the segment, is constant in the middle, and falls linearly to zero over the
 //! last `e`.
 
+use crate::lane::Lane;
+
 /// The ease of one segment, normalized so that `from + to <= 1`.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct SegmentEase {
@@ -53,20 +55,32 @@ impl SegmentEase {
     /// assert_eq!(e.apply(1.0).0, 1.0);
     /// ```
     pub fn apply(&self, u: f64) -> (f64, f64) {
-        let (a, e) = (self.from, self.to);
-        if self.is_none() {
-            return (u, 1.0);
-        }
-        let k = 1.0 / (2.0 - a - e);
-        if u < a {
-            (k * u * u / a, 2.0 * k * u / a)
-        } else if e > 0.0 && u >= 1.0 - e {
-            let w = 1.0 - u;
-            (1.0 - k * w * w / e, 2.0 * k * w / e)
-        } else {
-            (k * (2.0 * u - a), 2.0 * k)
-        }
+        ease(u, self.from, self.to)
     }
+}
+
+/// `(s, ds/du)` of the ease `a = from`, `e = to` (normalized, `a + e <= 1`)
+/// at `u`, in any [`Lane`]: the one formula of the module docs for the
+/// reference (`f64`) and the runtime's lanes (`f64x4`).
+#[inline(always)]
+pub fn ease<L: Lane>(u: L, a: L, e: L) -> (L, L) {
+    let (zero, one, two) = (L::of(0.0), L::of(1.0), L::of(2.0));
+    let none = a.eq(zero) & e.eq(zero);
+    let k = one / (two - a - e);
+    let w = one - u;
+    let first = u.lt(a);
+    let last = e.gt(zero) & u.ge(one - e);
+    let s = L::select(
+        first,
+        k * u * u / a,
+        L::select(last, one - k * w * w / e, k * (two * u - a)),
+    );
+    let d = L::select(
+        first,
+        two * k * u / a,
+        L::select(last, two * k * w / e, two * k),
+    );
+    (L::select(none, u, s), L::select(none, one, d))
 }
 
 #[cfg(test)]

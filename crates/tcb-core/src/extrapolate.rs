@@ -19,6 +19,7 @@
 //! an infinite time the value of the end key on its side (as `constant`
 //! would, or zero for `reset`), all with zero velocity.
 
+use crate::lane::{Lane, Mask};
 use crate::params::Extrapolation;
 
 /// Where a sample time lands.
@@ -64,54 +65,156 @@ pub enum Mapped {
 /// assert_eq!(m, Mapped::Inside { time: 0.5, direction: -1.0, cycles: 0.0 });
 /// ```
 pub fn map_time(time: f64, t0: f64, tn: f64, pre: Extrapolation, post: Extrapolation) -> Mapped {
-    if time.is_nan() {
-        return Mapped::Hold { last: false };
-    }
-    if (t0..=tn).contains(&time) {
-        return Mapped::Inside {
-            time,
-            direction: 1.0,
-            cycles: 0.0,
-        };
-    }
-    let after = time > tn;
-    let mode = if after { post } else { pre };
-    if time.is_infinite() {
-        return match mode {
-            Extrapolation::Reset => Mapped::Reset,
-            _ => Mapped::Hold { last: after },
-        };
-    }
-    match mode {
-        Extrapolation::Constant => Mapped::Hold { last: after },
-        Extrapolation::Reset => Mapped::Reset,
-        Extrapolation::Linear => Mapped::Line {
-            last: after,
-            dt: if after { time - tn } else { time - t0 },
-        },
-        Extrapolation::Repeat | Extrapolation::Oscillate | Extrapolation::OffsetRepeat => {
-            let len = tn - t0;
-            let m = ((time - t0) / len).floor();
-            // Rounding can push r a hair outside [0, L].
-            let r = ((time - t0) - m * len).clamp(0.0, len);
-            match mode {
-                Extrapolation::Oscillate if m.rem_euclid(2.0) == 1.0 => Mapped::Inside {
-                    time: tn - r,
-                    direction: -1.0,
-                    cycles: 0.0,
-                },
-                Extrapolation::OffsetRepeat => Mapped::Inside {
-                    time: t0 + r,
-                    direction: 1.0,
-                    cycles: m,
-                },
-                _ => Mapped::Inside {
-                    time: t0 + r,
-                    direction: 1.0,
-                    cycles: 0.0,
-                },
-            }
+    let l = map_lanes(time, t0, tn, &ModeLanes::of(pre), &ModeLanes::of(post));
+    if l.inside {
+        Mapped::Inside {
+            time: l.time,
+            direction: l.direction,
+            cycles: l.cycles,
         }
+    } else if l.reset {
+        Mapped::Reset
+    } else if l.line {
+        Mapped::Line {
+            last: l.last,
+            dt: l.dt,
+        }
+    } else {
+        Mapped::Hold { last: l.last }
+    }
+}
+
+/// An extrapolation mode per lane, as one mask per mode (exactly one set in
+/// each lane), so that [`map_lanes`] selects instead of branching.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeLanes<M> {
+    /// `constant`.
+    pub constant: M,
+    /// `reset`.
+    pub reset: M,
+    /// `repeat`.
+    pub repeat: M,
+    /// `oscillate`.
+    pub oscillate: M,
+    /// `offset-repeat`.
+    pub offset_repeat: M,
+    /// `linear`.
+    pub linear: M,
+}
+
+impl ModeLanes<bool> {
+    /// One lane of `mode`.
+    pub fn of(mode: Extrapolation) -> Self {
+        use Extrapolation as E;
+        ModeLanes {
+            constant: mode == E::Constant,
+            reset: mode == E::Reset,
+            repeat: mode == E::Repeat,
+            oscillate: mode == E::Oscillate,
+            offset_repeat: mode == E::OffsetRepeat,
+            linear: mode == E::Linear,
+        }
+    }
+}
+
+impl<M: Mask> ModeLanes<M> {
+    /// Lanes of `lanes` modes, built from one lane each (`make` turns the
+    /// lanes' booleans into a mask).
+    pub fn from_lanes<const N: usize>(
+        lanes: [Extrapolation; N],
+        make: impl Fn([bool; N]) -> M,
+    ) -> Self {
+        let one = lanes.map(ModeLanes::of);
+        let m = |f: fn(&ModeLanes<bool>) -> bool| make(std::array::from_fn(|i| f(&one[i])));
+        ModeLanes {
+            constant: m(|x| x.constant),
+            reset: m(|x| x.reset),
+            repeat: m(|x| x.repeat),
+            oscillate: m(|x| x.oscillate),
+            offset_repeat: m(|x| x.offset_repeat),
+            linear: m(|x| x.linear),
+        }
+    }
+
+    /// `post` where `after`, else `pre`.
+    #[inline(always)]
+    fn pick(after: M, pre: &Self, post: &Self) -> Self {
+        let p = |a: M, b: M| (after & b) | (!after & a);
+        ModeLanes {
+            constant: p(pre.constant, post.constant),
+            reset: p(pre.reset, post.reset),
+            repeat: p(pre.repeat, post.repeat),
+            oscillate: p(pre.oscillate, post.oscillate),
+            offset_repeat: p(pre.offset_repeat, post.offset_repeat),
+            linear: p(pre.linear, post.linear),
+        }
+    }
+}
+
+/// Where sample times land, lane by lane: the select form of [`Mapped`].
+/// In each lane exactly one of `inside`, `hold`, `reset`, `line` is set.
+#[derive(Clone, Copy, Debug)]
+pub struct MappedLanes<L: Lane> {
+    /// Evaluate the keys at `time` (with `direction` and `cycles`).
+    pub inside: L::Mask,
+    /// The end key's value (`last` says which), zero velocity.
+    pub hold: L::Mask,
+    /// Zero (identity for rotations).
+    pub reset: L::Mask,
+    /// Along the end tangent, `dt` from the end key `last` says.
+    pub line: L::Mask,
+    /// For `hold` and `line`: the last key (else the first).
+    pub last: L::Mask,
+    /// The time inside the keys.
+    pub time: L,
+    /// +1, or -1 on the backward legs of `oscillate`.
+    pub direction: L,
+    /// Whole cycles of `offset-repeat`.
+    pub cycles: L,
+    /// Seconds from the end key (negative before the first).
+    pub dt: L,
+}
+
+/// [`map_time`] for any [`Lane`]: each lane its own time, key span and
+/// modes. The one formula of the module docs, for the reference (one
+/// `f64` lane) and for the runtime's tracks on their own key times (`f64x4`).
+#[inline(always)]
+pub fn map_lanes<L: Lane>(
+    time: L,
+    t0: L,
+    tn: L,
+    pre: &ModeLanes<L::Mask>,
+    post: &ModeLanes<L::Mask>,
+) -> MappedLanes<L> {
+    let (zero, one, two) = (L::of(0.0), L::of(1.0), L::of(2.0));
+    let nan = !time.eq(time);
+    let within = time.ge(t0) & time.le(tn);
+    let (before, after) = (time.lt(t0), time.gt(tn));
+    let infinite = time.abs().eq(L::of(f64::INFINITY));
+    let mode = ModeLanes::pick(after, pre, post);
+    // Finite and outside the keys (NaN is neither before nor after).
+    let out = (before | after) & !infinite;
+    let len = tn - t0;
+    let rel = time - t0;
+    let m = (rel / len).floor();
+    // Rounding can push r a hair outside [0, L].
+    let r = (rel - m * len).clamp_to(zero, len);
+    let odd = (m - (m * L::of(0.5)).floor() * two).eq(one);
+    let back = out & mode.oscillate & odd;
+    let wraps = out & (mode.repeat | mode.oscillate | mode.offset_repeat);
+    let inside = within | wraps;
+    let reset = (out | infinite) & mode.reset & !nan;
+    let line = out & mode.linear;
+    MappedLanes {
+        inside,
+        hold: !(inside | reset | line),
+        reset,
+        line,
+        last: after,
+        time: L::select(within, time, L::select(back, tn - r, t0 + r)),
+        direction: L::select(back, L::of(-1.0), one),
+        cycles: L::select(out & mode.offset_repeat, m, zero),
+        dt: L::select(after, time - tn, time - t0),
     }
 }
 

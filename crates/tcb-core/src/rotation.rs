@@ -350,13 +350,14 @@ impl RotationTrack {
             (_, Shape::Hermite(track)) => {
                 let (p, dp) = track.sample_with_velocity(time);
                 let (p, dp) = (p.as_dvec4(), dp.as_dvec4());
-                let len = p.length();
-                if len == 0.0 {
+                if p.length() == 0.0 {
                     return (self.keys[k], DVec4::ZERO);
                 }
-                let q = p / len;
-                // d/dt (p / |p|) = (p' - q (q . p')) / |p|
-                (DQuat::from_vec4(q), (dp - q * q.dot(dp)) / len)
+                let (q, dq) = crate::quat::normalize(p.to_array(), Some(dp.to_array()));
+                (
+                    DQuat::from_array(q),
+                    DVec4::from_array(dq.expect("asked for")),
+                )
             }
         }
     }

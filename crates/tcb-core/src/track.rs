@@ -41,13 +41,41 @@ pub struct Segment<V> {
 /// assert_eq!(locate(&times, 3.0), (1, 1.0));
 /// ```
 pub fn locate(times: &[f64], time: f64) -> (usize, f64) {
-    let n = times.len();
-    let k = times
-        .partition_point(|&t| t <= time)
-        .saturating_sub(1)
-        .min(n - 2);
+    let k = segment_from(times, time, 0);
     let u = (time - times[k]) / (times[k + 1] - times[k]);
     (k, if u.is_nan() { 1.0 } else { u.clamp(0.0, 1.0) })
+}
+
+/// Segment `k` with `times[k] <= time < times[k+1]`, clamped to
+/// `0..=n-2` (times before the first key and NaN give 0, times from the
+/// last key on give n-2), for `times` with at least 2 strictly increasing
+/// entries. Segments `hint` and `hint + 1` are tried first, so forward
+/// playback finds its segment in O(1); anything else is a binary search.
+/// The one segment search of the reference and the runtime.
+///
+/// ```
+/// use tcb_core::track::segment_from;
+/// let times = [0.0, 1.0, 3.0, 4.0];
+/// assert_eq!(segment_from(&times, 3.5, 1), 2); // the next segment
+/// assert_eq!(segment_from(&times, 0.5, 2), 0); // a seek back
+/// assert_eq!(segment_from(&times, 9.0, 0), 2);
+/// ```
+#[inline]
+pub fn segment_from(times: &[f64], time: f64, hint: usize) -> usize {
+    let last = times.len() - 2;
+    let k = hint.min(last);
+    if times[k] <= time {
+        if time < times[k + 1] {
+            return k;
+        }
+        if k < last && time < times[k + 2] {
+            return k + 1;
+        }
+    }
+    times
+        .partition_point(|&t| t <= time)
+        .saturating_sub(1)
+        .min(last)
 }
 
 /// Check what every track needs of its times and per-key parameters.

@@ -27,6 +27,7 @@ use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::SegmentEase;
 use tcb_core::extrapolate::{Mapped, map_time};
+use tcb_core::track::segment_from;
 
 /// Key times, segment eases and extrapolation shared by a group of channels.
 #[derive(Clone, Debug, PartialEq)]
@@ -87,26 +88,12 @@ impl TimeGrid {
         self.times.len()
     }
 
-    /// Segment k with `times[k] <= time < times[k+1]`, for `time` in
-    /// `[t_0, t_{n-1})`, starting from the cursor.
+    /// Segment k with `times[k] <= time < times[k+1]`, starting from the
+    /// cursor ([`tcb_core::track::segment_from`]).
     #[inline]
     fn locate(&self, time: f64, cursor: &mut Cursor) -> usize {
-        let t = &self.times;
-        let last = t.len() - 2;
-        let k = cursor.0.min(last);
-        let k = if t[k] <= time {
-            if time < t[k + 1] {
-                k
-            } else if k < last && time < t[k + 2] {
-                k + 1
-            } else {
-                search(t, time)
-            }
-        } else {
-            search(t, time)
-        };
-        cursor.0 = k;
-        k
+        cursor.0 = segment_from(&self.times, time, cursor.0);
+        cursor.0
     }
 
     /// The basis for `time` (any f64), advancing `cursor`.
@@ -160,12 +147,6 @@ impl TimeGrid {
             ),
         }
     }
-}
-
-fn search(t: &[f64], time: f64) -> usize {
-    t.partition_point(|&x| x <= time)
-        .saturating_sub(1)
-        .min(t.len() - 2)
 }
 
 #[cfg(test)]

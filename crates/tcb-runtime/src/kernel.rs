@@ -1,7 +1,7 @@
 //! The SIMD kernels: one stored segment, eight channels per `f32x8`, the
 //! frame's rows broadcast. No branch depends on a channel.
 
-use tcb_core::basis::{Real, hermite};
+use tcb_core::basis::hermite;
 use wide::{f32x8, f64x4};
 
 /// `[P0, P1, M0, M1]` of 8 channels.
@@ -68,23 +68,7 @@ pub(crate) fn hermite_quats(
     }
 }
 
-/// A normalized hermite rotation and its velocity, from the curve `p` and
-/// its derivative `dp` (planes x, y, z, w):
-///
-/// ```text
-/// q = p / |p|        q' = (p' - q (q . p')) / |p|
-/// ```
-#[inline(always)]
-pub(crate) fn normalize(p: [f32x8; 4], dp: Option<[f32x8; 4]>) -> ([f32x8; 4], Option<[f32x8; 4]>) {
-    let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
-    let inv = f32x8::ONE / len;
-    let q = p.map(|x| x * inv);
-    let qv = dp.map(|dp| {
-        let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
-        std::array::from_fn(|i| (dp[i] - q[i] * qd) * inv)
-    });
-    (q, qv)
-}
+pub(crate) use tcb_core::quat::normalize;
 
 /// [`normalize`] in place over blocks of 4 planes (rotations sampled as
 /// loose lanes: the curve and its derivative, then normalized).
@@ -102,17 +86,7 @@ pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8
     }
 }
 
-/// Hamilton product of two quaternions in planes `[x, y, z, w]`, for any
-/// lane type (squad in `f64x4`, additive blending in `f32x8`).
-#[inline(always)]
-pub(crate) fn quat_mul<R: Real>(a: &[R; 4], b: &[R; 4]) -> [R; 4] {
-    [
-        a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
-        a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
-        a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
-        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
-    ]
-}
+pub(crate) use tcb_core::quat::mul as quat_mul;
 
 /// `p exp(s alpha n)`: slerp from `p` along unit axis `n` (log-space angle
 /// `alpha`). No division by `sin`, so well conditioned for any angle.

@@ -15,12 +15,15 @@
 //! 3. `u`, ease, and the Hermite rows per lane, then the same
 //!    [`tcb_core::basis::hermite`] on `f32x8` as every other kernel.
 //!
-//! The stored segments and sentinel rows are those of [`crate::grid`].
-//! Non-finite times take the scalar [`TimeGrid::frame`] per lane.
+//! The stored segments and sentinel rows are those of [`crate::grid`]; the
+//! time mapping is [`tcb_core::extrapolate::map_lanes`], the reference's own.
 
-use crate::grid::{Cursor, FrameBasis, TimeGrid};
+use crate::grid::TimeGrid;
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
+use tcb_core::ease::ease;
+use tcb_core::extrapolate::{ModeLanes, map_lanes};
+use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 
 /// Controls per block: 4 component planes x `[P0, P1, M0, M1]`.
@@ -29,17 +32,6 @@ const CTL: usize = 16;
 /// Padding lanes: keys at -PAD_SPAN and +PAD_SPAN (finite, so u stays finite),
 /// zero controls.
 const PAD_SPAN: f64 = 1e300;
-
-fn mode_code(m: Extrapolation) -> f64 {
-    match m {
-        Extrapolation::Reset => 1.0,
-        Extrapolation::Repeat => 2.0,
-        Extrapolation::Oscillate => 3.0,
-        Extrapolation::OffsetRepeat => 4.0,
-        Extrapolation::Linear => 5.0,
-        _ => 0.0,
-    }
-}
 
 /// One loose track.
 #[derive(Clone, Debug)]
@@ -73,12 +65,11 @@ pub(crate) struct Loose {
     pub blocks: usize,
     /// First pose block (4 planes per block).
     pub out: usize,
-    /// Per half block (4 lanes): first key, last key, span, pre and post codes.
+    /// Per half block (4 lanes): first key, last key, pre and post modes.
     t0: Vec<f64x4>,
     tn: Vec<f64x4>,
-    len: Vec<f64x4>,
-    pre: Vec<f64x4>,
-    post: Vec<f64x4>,
+    pre: Vec<ModeLanes<f64x4>>,
+    post: Vec<ModeLanes<f64x4>>,
     /// `P_{n-1} - P_0` per block and component plane (offset-repeat).
     delta: Vec<f32x8>,
     /// Whether any lane of a block has an eased segment.
@@ -102,10 +93,10 @@ impl Loose {
             })
             .sum();
         lanes
-            + [&self.t0, &self.tn, &self.len, &self.pre, &self.post]
-                .iter()
-                .map(|v| size_of_val(v.as_slice()))
-                .sum::<usize>()
+            + size_of_val(self.t0.as_slice())
+            + size_of_val(self.tn.as_slice())
+            + size_of_val(self.pre.as_slice())
+            + size_of_val(self.post.as_slice())
             + size_of_val(self.delta.as_slice())
             + size_of_val(self.eased.as_slice())
             + size_of_val(self.dims.as_slice())
@@ -121,12 +112,19 @@ impl Loose {
         };
         let t0 = half(&|l| l.grid.times[0], 0.0);
         let tn = half(&|l| l.grid.times[l.grid.times.len() - 1], 1.0);
-        let len = half(
-            &|l| l.grid.times[l.grid.times.len() - 1] - l.grid.times[0],
-            1.0,
-        );
-        let pre = half(&|l| mode_code(l.grid.pre), 0.0);
-        let post = half(&|l| mode_code(l.grid.post), 0.0);
+        let modes = |f: fn(&LooseLane) -> Extrapolation| -> Vec<ModeLanes<f64x4>> {
+            (0..2 * blocks)
+                .map(|h| {
+                    let m =
+                        std::array::from_fn(|l| lane(4 * h + l).map_or(Extrapolation::Constant, f));
+                    ModeLanes::from_lanes(m, |b: [bool; 4]| {
+                        f64x4::new(b.map(|x| f64::from_bits(if x { u64::MAX } else { 0 })))
+                    })
+                })
+                .collect()
+        };
+        let pre = modes(|l| l.grid.pre);
+        let post = modes(|l| l.grid.post);
         let mut delta = vec![f32x8::ZERO; 4 * blocks];
         for b in 0..blocks {
             for c in 0..4 {
@@ -162,7 +160,6 @@ impl Loose {
             out,
             t0,
             tn,
-            len,
             pre,
             post,
             delta,
@@ -180,7 +177,6 @@ pub(crate) struct LooseState {
     ease_from: Vec<f64>,
     ease_to: Vec<f64>,
     seg: Vec<usize>,
-    cursors: Vec<Cursor>,
     ctl: Vec<f32x8>,
 }
 
@@ -208,7 +204,6 @@ impl LooseState {
             ease_from: vec![0.0; lanes],
             ease_to: vec![0.0; lanes],
             seg: vec![usize::MAX; lanes],
-            cursors: vec![Cursor::default(); lanes],
             ctl: vec![f32x8::ZERO; loose.blocks * CTL],
         }
     }
@@ -249,16 +244,12 @@ impl LooseState {
     fn segment_for(lane: &LooseLane, current: usize, tm: f64) -> usize {
         let t = &lane.grid.times;
         let n = t.len();
-        let next = current.wrapping_add(1);
-        if (1..n - 1).contains(&next) && t[next - 1] <= tm && tm < t[next] {
-            return next;
-        }
         if tm < t[0] {
             0
         } else if tm >= t[n - 1] {
             n
         } else {
-            t.partition_point(|&x| x <= tm).clamp(1, n - 1)
+            segment_from(t, tm, current.wrapping_sub(1)) + 1
         }
     }
 }
@@ -334,7 +325,7 @@ fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4) -> Rows {
     }
 }
 
-/// Rows for block `b` at a finite `time`, refreshing lanes that left their window.
+/// Rows for block `b` at `time` (any f64), refreshing lanes that left their window.
 fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
     let t = f64x4::splat(time);
     let inside = |i: usize| (t.simd_ge(loose.t0[i]) & t.simd_lt(loose.tn[i])).all();
@@ -350,27 +341,18 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
     let mut dt = [zero; 2];
     for h in 0..2 {
         let i = 2 * b + h;
-        let (t0, tn, len) = (loose.t0[i], loose.tn[i], loose.len[i]);
-        let before = t.simd_lt(t0);
-        let after = t.simd_gt(tn);
-        let outside = before | after;
-        let mode = before.select(loose.pre[i], loose.post[i]);
-        let rel = t - t0;
-        let m = (rel / len).floor();
-        let r = (rel - m * len).max(zero).min(len);
-        let odd = (m - (m * f64x4::splat(0.5)).floor() * f64x4::splat(2.0)).simd_eq(one);
-        let is = |c: f64| mode.simd_eq(f64x4::splat(c));
-        let wraps = is(2.0) | is(3.0) | is(4.0);
-        let back = outside & is(3.0) & odd;
-        let wrapped = back.select(tn - r, t0 + r);
-        let beyond = before.select(f64x4::splat(-f64::MAX), f64x4::splat(f64::MAX));
-        out_tm[h] = outside.select(wraps.select(wrapped, beyond), t);
-        dir[h] = back.select(-one, one);
-        cycles[h] = (outside & is(4.0)).select(m, zero);
-        dt[h] = before.select(t - t0, t - tn);
-        line[h] = outside & is(5.0);
-        reset[h] = outside & is(1.0);
-        hold[h] = outside & is(0.0);
+        let m = map_lanes(t, loose.t0[i], loose.tn[i], &loose.pre[i], &loose.post[i]);
+        // Lanes outside the keys read a sentinel: 0 before, n after.
+        let beyond = m
+            .last
+            .select(f64x4::splat(f64::MAX), f64x4::splat(-f64::MAX));
+        out_tm[h] = m.inside.select(m.time, beyond);
+        dir[h] = m.direction;
+        cycles[h] = m.cycles;
+        dt[h] = m.dt;
+        line[h] = m.line;
+        reset[h] = m.reset;
+        hold[h] = m.hold;
     }
     for (h, &tm) in out_tm.iter().enumerate() {
         refresh(loose, st, 2 * b + h, tm);
@@ -430,53 +412,6 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
     }
 }
 
-/// [`tcb_core::ease::SegmentEase::apply`] across lanes (`a + e <= 1`).
-fn ease(u: f64x4, a: f64x4, e: f64x4) -> (f64x4, f64x4) {
-    let (zero, one, two) = (f64x4::ZERO, f64x4::ONE, f64x4::splat(2.0));
-    let none = a.simd_eq(zero) & e.simd_eq(zero);
-    let k = one / (two - a - e);
-    let w = one - u;
-    let first = u.simd_lt(a);
-    let last = e.simd_gt(zero) & u.simd_ge(one - e);
-    let s = first.select(
-        k * u * u / a,
-        last.select(one - k * w * w / e, k * (two * u - a)),
-    );
-    let d = first.select(two * k * u / a, last.select(two * k * w / e, two * k));
-    (none.select(u, s), none.select(one, d))
-}
-
-/// Rows for block `b` from the scalar [`TimeGrid::frame`] of each lane.
-fn rows_scalar(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
-    let mut h = [[0.0f32; 8]; 4];
-    let mut dh = [[0.0f32; 8]; 4];
-    let mut rate = [0.0f32; 8];
-    let mut cycles = [0.0f32; 8];
-    for i in 0..8 {
-        let l = 8 * b + i;
-        let Some(lane) = loose.lanes.get(l) else {
-            continue;
-        };
-        let f: FrameBasis = lane.grid.frame(time, &mut st.cursors[l]);
-        if st.seg[l] != f.segment {
-            st.load(loose, l, f.segment);
-        }
-        for j in 0..4 {
-            h[j][i] = f.h[j];
-            dh[j][i] = f.dh[j];
-        }
-        rate[i] = f.rate;
-        cycles[i] = f.cycles;
-    }
-    Rows {
-        h: h.map(f32x8::new),
-        dh: dh.map(f32x8::new),
-        rate: f32x8::new(rate),
-        any_cycles: cycles.iter().any(|&c| c != 0.0),
-        cycles: f32x8::new(cycles),
-    }
-}
-
 /// Sample every loose track at `time` into its pose planes.
 pub(crate) fn sample(
     loose: &Loose,
@@ -486,11 +421,7 @@ pub(crate) fn sample(
     mut velocities: Option<&mut [f32x8]>,
 ) {
     for b in 0..loose.blocks {
-        let rows = if time.is_finite() {
-            rows_simd(loose, st, b, time)
-        } else {
-            rows_scalar(loose, st, b, time)
-        };
+        let rows = rows_simd(loose, st, b, time);
         let ctl = &st.ctl[b * CTL..(b + 1) * CTL];
         let out = loose.out + 4 * b;
         for c in 0..loose.dims[b] {

@@ -1,0 +1,200 @@
+//! Lanes: the arithmetic every per-sample formula is written in, once.
+//!
+//! [`Lane`] extends [`Real`] with division, comparisons, selects and a few
+//! functions. It is implemented for `f32` and `f64` (one lane: the scalar
+//! reference) and for `wide::f32x8` and `wide::f64x4` (the runtime's
+//! kernels), so time mapping, ease, normalization and the Hermite basis run
+//! the same operations in the same order on one lane and on eight (as
+//! ultraviolet and wide do). Branches become selects: every side of a
+//! choice is computed and the mask picks, so a formula has no branch that
+//! depends on a lane's data.
+
+use crate::basis::Real;
+use std::ops::{BitAnd, BitOr, Div, Not};
+
+/// Per-lane booleans of a [`Lane`] type.
+pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {
+    /// Whether any lane is set.
+    fn any(self) -> bool;
+    /// Whether every lane is set.
+    fn all(self) -> bool;
+}
+
+impl Mask for bool {
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+}
+
+/// A lane of arithmetic with comparisons and selects (see the module docs).
+pub trait Lane: Real + Div<Output = Self> {
+    /// Its per-lane booleans.
+    type Mask: Mask;
+    /// Every lane set to `x` (rounded to the lane's precision).
+    fn of(x: f64) -> Self;
+    /// `self < o` per lane.
+    fn lt(self, o: Self) -> Self::Mask;
+    /// `self <= o` per lane.
+    fn le(self, o: Self) -> Self::Mask;
+    /// `self == o` per lane (NaN is equal to nothing).
+    fn eq(self, o: Self) -> Self::Mask;
+    /// `m ? a : b` per lane.
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Round down.
+    fn floor(self) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+
+    /// `self > o` per lane.
+    #[inline(always)]
+    fn gt(self, o: Self) -> Self::Mask {
+        o.lt(self)
+    }
+    /// `self >= o` per lane.
+    #[inline(always)]
+    fn ge(self, o: Self) -> Self::Mask {
+        o.le(self)
+    }
+    /// `self` limited to `[lo, hi]` (a select each side, so NaN stays NaN
+    /// and `lo <= hi` is not required to avoid a panic).
+    #[inline(always)]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        let x = Self::select(self.lt(lo), lo, self);
+        Self::select(x.gt(hi), hi, x)
+    }
+}
+
+/// `floor`, `sqrt` and `abs`, forwarded to the type's own.
+macro_rules! functions {
+    ($t:ty) => {
+        #[inline(always)]
+        fn floor(self) -> Self {
+            <$t>::floor(self)
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            <$t>::sqrt(self)
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            <$t>::abs(self)
+        }
+    };
+}
+
+macro_rules! scalar_lane {
+    ($t:ty) => {
+        impl Lane for $t {
+            type Mask = bool;
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                x as $t
+            }
+            #[inline(always)]
+            fn lt(self, o: Self) -> bool {
+                self < o
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> bool {
+                self <= o
+            }
+            #[inline(always)]
+            fn eq(self, o: Self) -> bool {
+                self == o
+            }
+            #[inline(always)]
+            fn select(m: bool, a: Self, b: Self) -> Self {
+                if m { a } else { b }
+            }
+            functions!($t);
+        }
+    };
+}
+
+scalar_lane!(f32);
+scalar_lane!(f64);
+
+macro_rules! simd_lane {
+    ($t:ty, $e:ty) => {
+        impl Mask for $t {
+            #[inline(always)]
+            fn any(self) -> bool {
+                <$t>::any(self)
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                <$t>::all(self)
+            }
+        }
+
+        impl Lane for $t {
+            type Mask = $t;
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                <$t>::splat(x as $e)
+            }
+            #[inline(always)]
+            fn lt(self, o: Self) -> Self {
+                self.simd_lt(o)
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> Self {
+                self.simd_le(o)
+            }
+            #[inline(always)]
+            fn eq(self, o: Self) -> Self {
+                self.simd_eq(o)
+            }
+            #[inline(always)]
+            fn select(m: Self, a: Self, b: Self) -> Self {
+                m.select(a, b)
+            }
+            functions!($t);
+        }
+    };
+}
+
+simd_lane!(wide::f32x8, f32);
+simd_lane!(wide::f64x4, f64);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wide::{f32x8, f64x4};
+
+    /// Each lane of a SIMD select, compare and function equals the scalar one.
+    #[test]
+    fn simd_lanes_agree_with_scalar_lanes() {
+        let xs = [-2.5, -0.0, 0.0, 0.5, 1.0, 3.75, 1e300, f64::NAN];
+        let ys = [1.0, 0.0, -0.0, 0.5, 2.0, -3.0, 1.0, 0.0];
+        for h in 0..2 {
+            let a: [f64; 4] = std::array::from_fn(|i| xs[4 * h + i]);
+            let b: [f64; 4] = std::array::from_fn(|i| ys[4 * h + i]);
+            let (va, vb) = (f64x4::new(a), f64x4::new(b));
+            let sel = f64x4::select(va.lt(vb), va.floor(), vb.abs()).to_array();
+            let clamp = va.clamp_to(f64x4::ZERO, vb.abs()).to_array();
+            for i in 0..4 {
+                let want = f64::select(a[i].lt(b[i]), a[i].floor(), b[i].abs());
+                assert_eq!(sel[i].to_bits(), want.to_bits());
+                let want = a[i].clamp_to(0.0, b[i].abs());
+                assert!(
+                    clamp[i].to_bits() == want.to_bits() || (want.is_nan() && clamp[i].is_nan())
+                );
+            }
+        }
+        let a: [f32; 8] = std::array::from_fn(|i| xs[i] as f32);
+        let v = f32x8::new(a);
+        let got = (v / f32x8::of(3.0)).sqrt().to_array();
+        for i in 0..8 {
+            let want = (a[i] / 3.0).sqrt();
+            assert!(got[i].to_bits() == want.to_bits() || (want.is_nan() && got[i].is_nan()));
+        }
+    }
+}

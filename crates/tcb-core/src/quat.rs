@@ -1,0 +1,41 @@
+//! Quaternion formulas over [`Lane`]s, planes `[x, y, z, w]`: the one copy
+//! the reference (`f64`) and the runtime's kernels (`f32x8`, `f64x4`) share.
+//!
+//! ```text
+//! a b   Hamilton product
+//! q = p / |p|              q' = (p' - q (q . p')) / |p|      normalize, with velocity
+//! ```
+
+use crate::basis::Real;
+use crate::lane::Lane;
+
+/// The Hamilton product `a b`.
+#[inline(always)]
+pub fn mul<R: Real>(a: &[R; 4], b: &[R; 4]) -> [R; 4] {
+    [
+        a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+        a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+        a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
+    ]
+}
+
+/// `p / |p|` and, given `p'`, its derivative `(p' - q (q . p')) / |p|`
+/// (a curve `p` through 4-space, normalized: `hermite` rotations).
+///
+/// ```
+/// let (q, v) = tcb_core::quat::normalize([0.0f64, 0.0, 0.0, 2.0], Some([1.0, 0.0, 0.0, 1.0]));
+/// assert_eq!(q, [0.0, 0.0, 0.0, 1.0]);
+/// assert_eq!(v, Some([0.5, 0.0, 0.0, 0.0])); // only the part across q, over |p|
+/// ```
+#[inline(always)]
+pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 4]>) {
+    let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
+    let inv = L::of(1.0) / len;
+    let q = p.map(|x| x * inv);
+    let qv = dp.map(|dp| {
+        let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
+        std::array::from_fn(|i| (dp[i] - q[i] * qd) * inv)
+    });
+    (q, qv)
+}
