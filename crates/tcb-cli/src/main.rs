@@ -466,18 +466,17 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     }
     writeln!(
         out,
-        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation(s) on the scalar reference, {} squad velocity fallback(s)",
+        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation segment(s) evaluated exactly (f64 squad)",
         stats.grids.len(),
         stats.loose_vector_tracks,
         stats.loose_rotation_tracks,
-        stats.reference_rotations,
-        stats.squad_velocity_fallbacks
+        stats.exact_segments
     )?;
     for (i, g) in stats.grids.iter().enumerate() {
         writeln!(
             out,
-            "  grid {i}: {} keys, {} vector channels, {} hermite rotations, {} squad rotations",
-            g.keys, g.vector_channels, g.hermite_rotations, g.squad_rotations
+            "  grid {i}: {} keys, {} vector channels, {} rotations",
+            g.keys, g.vector_channels, g.rotations
         )?;
     }
     writeln!(

@@ -55,6 +55,9 @@ impl SegmentEase {
     /// assert_eq!(e.apply(1.0).0, 1.0);
     /// ```
     pub fn apply(&self, u: f64) -> (f64, f64) {
+        if self.is_none() {
+            return (u, 1.0); // what `ease` selects for no ease, without the rest
+        }
         ease(u, self.from, self.to)
     }
 }

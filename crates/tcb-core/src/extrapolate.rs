@@ -65,6 +65,15 @@ pub enum Mapped {
 /// assert_eq!(m, Mapped::Inside { time: 0.5, direction: -1.0, cycles: 0.0 });
 /// ```
 pub fn map_time(time: f64, t0: f64, tn: f64, pre: Extrapolation, post: Extrapolation) -> Mapped {
+    // Inside the keys `map_lanes` passes the time through unchanged; say so
+    // without computing every mode's answer (one lane has nothing to share).
+    if (t0..=tn).contains(&time) {
+        return Mapped::Inside {
+            time,
+            direction: 1.0,
+            cycles: 0.0,
+        };
+    }
     let l = map_lanes(time, t0, tn, &ModeLanes::of(pre), &ModeLanes::of(post));
     if l.inside {
         Mapped::Inside {

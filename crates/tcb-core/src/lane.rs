@@ -10,7 +10,7 @@
 //! depends on a lane's data.
 
 use crate::basis::Real;
-use std::ops::{BitAnd, BitOr, Div, Not};
+use std::ops::{BitAnd, BitOr, Div, Neg, Not};
 
 /// Per-lane booleans of a [`Lane`] type.
 pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {
@@ -32,7 +32,7 @@ impl Mask for bool {
 }
 
 /// A lane of arithmetic with comparisons and selects (see the module docs).
-pub trait Lane: Real + Div<Output = Self> {
+pub trait Lane: Real + Div<Output = Self> + Neg<Output = Self> {
     /// Its per-lane booleans.
     type Mask: Mask;
     /// Every lane set to `x` (rounded to the lane's precision).
@@ -51,6 +51,10 @@ pub trait Lane: Real + Div<Output = Self> {
     fn sqrt(self) -> Self;
     /// Absolute value.
     fn abs(self) -> Self;
+    /// `(sin, cos)`.
+    fn sin_cos(self) -> (Self, Self);
+    /// The angle of `(x, self)`, as `f64::atan2`.
+    fn atan2(self, x: Self) -> Self;
 
     /// `self > o` per lane.
     #[inline(always)]
@@ -71,7 +75,7 @@ pub trait Lane: Real + Div<Output = Self> {
     }
 }
 
-/// `floor`, `sqrt` and `abs`, forwarded to the type's own.
+/// `floor`, `sqrt`, `abs`, `sin_cos` and `atan2`, forwarded to the type's own.
 macro_rules! functions {
     ($t:ty) => {
         #[inline(always)]
@@ -85,6 +89,14 @@ macro_rules! functions {
         #[inline(always)]
         fn abs(self) -> Self {
             <$t>::abs(self)
+        }
+        #[inline(always)]
+        fn sin_cos(self) -> (Self, Self) {
+            <$t>::sin_cos(self)
+        }
+        #[inline(always)]
+        fn atan2(self, x: Self) -> Self {
+            <$t>::atan2(self, x)
         }
     };
 }

@@ -57,6 +57,7 @@ pub mod quat;
 pub mod rotation;
 pub mod sample_times;
 pub mod skeleton;
+pub mod squad;
 pub mod tangent;
 pub mod track;
 pub mod vector;

@@ -27,8 +27,8 @@
 //!
 //! In both modes `interp: linear` is slerp and `step` holds. The reference
 //! works in f64 and returns f32 quaternions. Velocities are d/dt of the
-//! output quaternion's components; for `squad` segments they are taken by a
-//! five-point difference of the f64 segment function (error about 1e-10).
+//! output quaternion's components, from the analytic derivative of the
+//! power form ([`crate::squad`]).
 
 use crate::ease::SegmentEase;
 use crate::error::TrackError;
@@ -61,30 +61,26 @@ pub fn quat_exp(v: DVec3) -> DQuat {
     DQuat::from_xyzw(xyz.x, xyz.y, xyz.z, th.cos())
 }
 
-/// Spherical linear interpolation without hemisphere correction:
-/// `p sin((1-s) th)/sin th + q sin(s th)/sin th`, th the angle between `p`
-/// and `q` as 4-vectors. Any `s` is allowed (it extrapolates along the arc).
+/// Spherical linear interpolation without hemisphere correction,
+/// `p exp(s log(p^-1 q))` ([`crate::squad::slerp_power`]). Any `s` is
+/// allowed (it extrapolates along the arc).
 pub fn slerp(p: DQuat, q: DQuat, s: f64) -> DQuat {
-    let (pv, qv) = (DVec4::from(p), DVec4::from(q));
-    // Stable angle: th = 2 atan2(|p - q|, |p + q|).
-    let th = 2.0 * (pv - qv).length().atan2((pv + qv).length());
-    let sin = th.sin();
-    let r = if sin < 1e-9 {
-        let l = pv * (1.0 - s) + qv * s;
-        if l.length() < 1e-12 {
-            pv
-        } else {
-            l.normalize()
-        }
-    } else {
-        pv * (((1.0 - s) * th).sin() / sin) + qv * ((s * th).sin() / sin)
-    };
-    DQuat::from_vec4(r)
+    let c = crate::squad::slerp_controls(p, q);
+    DQuat::from_array(crate::squad::slerp_power(
+        &[c[0], c[1], c[2], c[3]],
+        &[c[4], c[5], c[6]],
+        c[7],
+        s,
+    ))
 }
 
-/// Shoemake's squad with inner points `a` (after `q0`) and `b` (before `q1`).
+/// `squad(q0, q1, a, b, s) = slerp(slerp(q0, q1, s), slerp(a, b, s), 2s(1-s))`
+/// ([`crate::squad::squad`]).
 pub fn squad(q0: DQuat, q1: DQuat, a: DQuat, b: DQuat, s: f64) -> DQuat {
-    slerp(slerp(q0, q1, s), slerp(a, b, s), 2.0 * s * (1.0 - s))
+    DQuat::from_array(crate::squad::squad(
+        &crate::squad::controls(q0, q1, a, b),
+        s,
+    ))
 }
 
 /// One `squad` segment: `squad(q0, q1, a, b, s)`.
@@ -105,10 +101,31 @@ pub struct SquadSegment {
 }
 
 impl SquadSegment {
+    /// Its power-form controls ([`crate::squad::controls`]).
+    pub fn controls(&self) -> [f64; crate::squad::CONTROLS] {
+        crate::squad::controls(self.q0, self.q1, self.a, self.b)
+    }
+
     /// The segment at `s`.
     pub fn at(&self, s: f64) -> DQuat {
-        squad(self.q0, self.q1, self.a, self.b, s)
+        DQuat::from_array(crate::squad::squad(&self.controls(), s))
     }
+
+    /// The unit rotation at `s` and its derivative with respect to `s`.
+    pub fn with_derivative(&self, s: f64) -> (DQuat, DVec4) {
+        unit_with_derivative(&self.controls(), s)
+    }
+}
+
+/// Squad (or slerp, as squad with `a = q0`, `b = q1`) at `s`, normalized, and
+/// the derivative of the normalized curve with respect to `s`.
+fn unit_with_derivative(c: &[f64; crate::squad::CONTROLS], s: f64) -> (DQuat, DVec4) {
+    let (q, dq) = crate::squad::squad_with_derivative(c, s);
+    let (q, dq) = crate::quat::normalize(q, Some(dq));
+    (
+        DQuat::from_array(q),
+        DVec4::from_array(dq.expect("asked for")),
+    )
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -335,17 +352,13 @@ impl RotationTrack {
         match (self.interps[k], &self.shape) {
             (Interp::Step, _) => (self.keys[k], DVec4::ZERO),
             (_, Shape::Squad(segs)) => {
-                let seg = &segs[k];
-                let q = seg.at(s).normalize();
-                (q, derivative(|s| DVec4::from(seg.at(s)), s) * rate)
+                let (q, d) = segs[k].with_derivative(s);
+                (q, d * rate)
             }
             (Interp::Linear, Shape::Hermite(_)) => {
                 let (q0, q1) = (self.keys[k], self.keys[k + 1]);
-                let q = slerp(q0, q1, s);
-                // d/ds slerp(q0, q1, s) = slerp(s) * log(q0^-1 q1), as a quaternion product.
-                let w = quat_log(q0.conjugate() * q1);
-                let d = q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0);
-                (q, DVec4::from(d) * rate)
+                let (q, d) = unit_with_derivative(&crate::squad::controls(q0, q1, q0, q1), s);
+                (q, d * rate)
             }
             (_, Shape::Hermite(track)) => {
                 let (p, dp) = track.sample_with_velocity(time);
@@ -361,12 +374,6 @@ impl RotationTrack {
             }
         }
     }
-}
-
-/// Five-point central difference of `f` at `s` (h = 1e-3).
-fn derivative(f: impl Fn(f64) -> DVec4, s: f64) -> DVec4 {
-    let h = 1e-3;
-    (f(s - 2.0 * h) - f(s + 2.0 * h) + (f(s + h) - f(s - h)) * 8.0) / (12.0 * h)
 }
 
 fn squad_segments(

@@ -28,10 +28,11 @@
 //! multiplies scales); the two agree at weights 0 and 1 on a unit reference.
 
 use crate::clip::{Clip, TrackId};
-use crate::kernel::{normalize, quat_mul};
+use crate::kernel::normalize;
 use crate::pose::{Pose, PoseLayout};
 use std::fmt;
 use std::sync::Arc;
+use tcb_core::quat::mul as quat_mul;
 use wide::f32x8;
 
 /// Per-track weights of one layer, expanded to the pose's lanes once so that
@@ -135,13 +136,12 @@ fn same_layout(a: &Arc<PoseLayout>, b: &Arc<PoseLayout>) -> bool {
     Arc::ptr_eq(a, b) || **a == **b
 }
 
-/// Whether pose block `b` is one of the x/y/z/w planes of 8 rotations, or
-/// holds reference-sampled rotations (four consecutive floats).
+/// Whether pose block `b` is one of the x/y/z/w planes of 8 rotations.
 #[inline]
 fn rotation_block(layout: &PoseLayout, b: usize) -> bool {
     let q = &layout.quat_blocks;
     let i = q.partition_point(|&s| s <= b);
-    (i > 0 && b < q[i - 1] + 4) || layout.loose_quats.first().is_some_and(|&f| b >= f / 8)
+    i > 0 && b < q[i - 1] + 4
 }
 
 /// Blend `layers` (pose, weight) into `out`, with an optional mask per layer.
@@ -201,11 +201,10 @@ pub fn blend(
             out.velocities.as_mut().expect("checked")[b] = none.select(v, vacc * inv);
         }
     }
-    // Rotations: nlerp with hemisphere correction against the first layer,
-    // in planes of 8, and the reference-sampled ones (4 consecutive floats)
-    // through the same code in lane 0.
-    let nlerp = |at: &dyn Fn(usize) -> (usize, usize), block: usize, out: &mut Pose| {
-        let get = |d: &[f32x8], c: usize| lane_get(d, at(c));
+    // Rotations in planes of 8: nlerp with hemisphere correction against
+    // the first layer.
+    for &block in &layout.quat_blocks {
+        let get = |d: &[f32x8], c: usize| d[block + c];
         let q0: [f32x8; 4] = std::array::from_fn(|c| get(&base.values, c));
         let mut acc = [f32x8::ZERO; 4];
         let mut vacc = [f32x8::ZERO; 4];
@@ -228,46 +227,15 @@ pub fn blend(
         let inv = keep.select(f32x8::ZERO, f32x8::ONE / len);
         let inv_sum = keep.select(f32x8::ZERO, f32x8::ONE / sum);
         for c in 0..4 {
-            lane_put(&mut out.values, at(c), keep.select(q0[c], acc[c] * inv));
+            out.values[block + c] = keep.select(q0[c], acc[c] * inv);
             if with_velocity {
                 let v0 = get(base.velocities.as_ref().expect("checked"), c);
-                let v = keep.select(v0, vacc[c] * inv_sum);
-                lane_put(out.velocities.as_mut().expect("checked"), at(c), v);
+                out.velocities.as_mut().expect("checked")[block + c] =
+                    keep.select(v0, vacc[c] * inv_sum);
             }
         }
-    };
-    for &q in &layout.quat_blocks {
-        nlerp(&|c| (q + c, WHOLE), q, out);
-    }
-    for &f in &layout.loose_quats {
-        nlerp(&|c| ((f + c) / 8, (f + c) % 8), f / 8, out);
     }
     Ok(())
-}
-
-/// `lane` of [`lane_get`]/[`lane_put`] meaning the whole block.
-const WHOLE: usize = usize::MAX;
-
-/// Block `at.0` of `d`, or, for a single lane `at.1`, that lane splat.
-#[inline(always)]
-fn lane_get(d: &[f32x8], at: (usize, usize)) -> f32x8 {
-    match at.1 {
-        WHOLE => d[at.0],
-        l => f32x8::splat(d[at.0].to_array()[l]),
-    }
-}
-
-/// Write block `at.0` of `d`, or only lane `at.1` of it (from lane 0 of `v`).
-#[inline(always)]
-fn lane_put(d: &mut [f32x8], at: (usize, usize), v: f32x8) {
-    match at.1 {
-        WHOLE => d[at.0] = v,
-        l => {
-            let mut a = d[at.0].to_array();
-            a[l] = v.to_array()[0];
-            d[at.0] = f32x8::new(a);
-        }
-    }
 }
 
 /// Add an additive layer in place: `pose` ⊕ `weight` (`layer` ⊖ `reference`),
@@ -326,8 +294,8 @@ pub fn add(
         }
     }
     let conj = |q: [f32x8; 4]| [-q[0], -q[1], -q[2], q[3]];
-    let rotate = |at: &dyn Fn(usize) -> (usize, usize), block: usize, pose: &mut Pose| {
-        let planes = |d: &[f32x8]| -> [f32x8; 4] { std::array::from_fn(|c| lane_get(d, at(c))) };
+    for &block in &layout.quat_blocks {
+        let planes = |d: &[f32x8]| -> [f32x8; 4] { std::array::from_fn(|c| d[block + c]) };
         let w = w_at(block);
         let (l, r, base) = (
             planes(&layer.values),
@@ -350,22 +318,14 @@ pub fn add(
         });
         let (n, dn) = normalize(p, dp);
         let out = quat_mul(&n, &base);
-        for (c, o) in out.into_iter().enumerate() {
-            lane_put(&mut pose.values, at(c), o);
-        }
+        pose.values[block..block + 4].copy_from_slice(&out);
         if let (Some(dn), Some(v)) = (dn, pose.velocities.as_mut()) {
             let a = quat_mul(&dn, &base);
             let b = quat_mul(&n, &planes(v));
             for c in 0..4 {
-                lane_put(v, at(c), a[c] + b[c]);
+                v[block + c] = a[c] + b[c];
             }
         }
-    };
-    for &q in &layout.quat_blocks {
-        rotate(&|c| (q + c, WHOLE), q, pose);
-    }
-    for &f in &layout.loose_quats {
-        rotate(&|c| ((f + c) / 8, (f + c) % 8), f / 8, pose);
     }
     Ok(())
 }

@@ -4,19 +4,23 @@
 //! modes; a group's channels share one [`FrameBasis`](crate::grid::FrameBasis)
 //! per frame. Per group, per stored segment (see [`crate::grid`]), per block
 //! of 8 channels, the Hermite controls are stored lane-contiguous as
-//! `wide::f32x8` (32-byte aligned, zero-padded; squad in `f64x4`):
+//! `wide::f32x8` (32-byte aligned, zero-padded):
 //!
 //! ```text
-//! vectors   [segment][block][P0 P1 M0 M1]                       4 x f32x8
-//! hermite   [segment][block][P0 P1 M0 M1][x y z w]             16 x f32x8
-//! squad     [segment][half block][q0 n01 alpha01 a n_ab alpha_ab]   16 x f64x4
+//! vectors     [segment][block][P0 P1 M0 M1]                 4 x f32x8
+//! rotations   [segment][block][P0 P1 M0 M1][x y z w]       16 x f32x8, normalized after
+//! exact       per (segment, block) where needed: squad in power form, 2 x 16 x f64x4
 //! ```
 //!
 //! `linear` and `step` segments and explicit tangents are folded into the
-//! same controls, so the kernels have no per-channel branches. A `hermite`
-//! rotation whose segments are all `linear`/`step` is stored as squad (where
-//! slerp is exact); one that mixes slerp with curve segments, and squad
-//! velocities, are taken from the scalar reference (documented, rare).
+//! same controls, so the kernels have no per-channel branches. Every
+//! rotation mode compiles to the same cubic form: `hermite` curves as they
+//! are, squad and slerp segments as the cubic through their ends with
+//! their end derivatives, checked against the f64 formula when the clip is
+//! compiled (see [`rotation_controls`]); the few segments where that cubic
+//! would miss (large turns between keys) are evaluated exactly, lane by
+//! lane under a mask, from [`tcb_core::squad`] in `f64x4`. Nothing falls
+//! back to the scalar reference.
 
 use crate::grid::TimeGrid;
 use crate::kernel::{HQ_STRIDE, SQ_STRIDE, VEC_STRIDE};
@@ -52,10 +56,8 @@ pub struct GridStats {
     pub keys: usize,
     /// Vector channels on it (a vec3 counts 3).
     pub vector_channels: usize,
-    /// `hermite` rotations on it.
-    pub hermite_rotations: usize,
-    /// `squad` (and all-slerp) rotations on it.
-    pub squad_rotations: usize,
+    /// Rotations on it (any mode).
+    pub rotations: usize,
 }
 
 /// The layout and size of a compiled clip (see [`Clip::stats`]).
@@ -67,10 +69,9 @@ pub struct ClipStats {
     pub loose_vector_tracks: usize,
     /// `hermite` rotations on key times of their own (loose lanes).
     pub loose_rotation_tracks: usize,
-    /// Rotations the scalar reference samples (`hermite` mixing slerp and curve keys).
-    pub reference_rotations: usize,
-    /// Squad rotations whose velocity the scalar reference gives.
-    pub squad_velocity_fallbacks: usize,
+    /// Rotation segments (per track) evaluated exactly, in f64 squad,
+    /// because the compiled cubic would miss the reference there.
+    pub exact_segments: usize,
     /// [`Clip::memory_bytes`].
     pub bytes: usize,
     /// [`Clip::memory_bytes_compiled`].
@@ -79,19 +80,11 @@ pub struct ClipStats {
     pub bytes_per_frame: usize,
 }
 
-/// How a rotation track is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum RotLayout {
-    Hermite,
-    Squad,
-    Reference,
-}
-
 /// Channels sharing one time grid.
 #[derive(Clone, Debug)]
 pub(crate) struct Group {
     pub grid: TimeGrid,
-    /// Vector channels, hermite and squad rotations (lanes in use).
+    /// Vector channels and rotations (lanes in use), exact entries.
     pub lanes: [usize; 3],
     pub vec_blocks: usize,
     pub vec: Vec<f32x8>,
@@ -101,10 +94,57 @@ pub(crate) struct Group {
     pub hq_blocks: usize,
     pub hq: Vec<f32x8>,
     pub hq_out: usize,
-    pub sq_blocks: usize,
-    /// Two halves of 4 lanes per output block of 8.
-    pub sq: Vec<f64x4>,
-    pub sq_out: usize,
+    /// Per stored segment `k`, its entries of `exact`: `exact_at[k]..exact_at[k + 1]`.
+    pub exact_at: Vec<u32>,
+    /// Rotation blocks evaluated exactly (squad in f64) on some segment.
+    pub exact: Vec<Exact>,
+}
+
+/// One rotation block on one stored segment, evaluated exactly: the lanes
+/// of `mask` take squad in f64 from `controls` (two halves of 4 lanes; the
+/// other lanes hold the identity and are not used).
+#[derive(Clone, Debug)]
+pub(crate) struct Exact {
+    pub block: usize,
+    pub mask: f32x8,
+    pub controls: [f64x4; 2 * SQ_STRIDE],
+}
+
+/// The exact entries of one group's rotations, per stored segment.
+fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>, Vec<Exact>) {
+    let identity = {
+        let mut c = [0.0; SQ_STRIDE];
+        c[3] = 1.0;
+        c[11] = 1.0;
+        c
+    };
+    let mut at = Vec::with_capacity(segments + 1);
+    let mut out = Vec::new();
+    for seg in 0..segments {
+        at.push(out.len() as u32);
+        for (b, block) in rows.chunks(8).enumerate() {
+            if block.iter().all(|r| r.1.exact[seg].is_none()) {
+                continue;
+            }
+            let lane = |l: usize| block.get(l).and_then(|r| r.1.exact[seg]);
+            let mask = f32x8::new(std::array::from_fn(|l| {
+                f32::from_bits(if lane(l).is_some() { u32::MAX } else { 0 })
+            }));
+            let controls = std::array::from_fn(|k| {
+                let (half, j) = (k / SQ_STRIDE, k % SQ_STRIDE);
+                f64x4::new(std::array::from_fn(|l| {
+                    lane(4 * half + l).unwrap_or(identity)[j]
+                }))
+            });
+            out.push(Exact {
+                block: b,
+                mask,
+                controls,
+            });
+        }
+    }
+    at.push(out.len() as u32);
+    (at, out)
 }
 
 /// A compiled clip: immutable, `Send + Sync`, shared between instances by `Arc`.
@@ -121,10 +161,6 @@ pub struct Clip {
     pub(crate) loose_rot: Loose,
     /// Real tracks among `loose_rot`'s lanes (the rest are padding).
     pub(crate) loose_rot_tracks: usize,
-    /// Tracks the scalar reference samples (value and velocity).
-    pub(crate) reference: Vec<TrackId>,
-    /// Squad tracks, whose velocity the scalar reference gives.
-    pub(crate) squad_velocity: Vec<TrackId>,
     pub(crate) source: tcb_core::Clip,
 }
 
@@ -213,59 +249,96 @@ fn grid_key(g: &TimeGrid) -> GridKey {
     )
 }
 
-fn rot_layout(t: &RotationTrack) -> RotLayout {
-    if t.squad_segments().is_some() {
-        return RotLayout::Squad;
-    }
-    let interps = &t.interps()[..t.interps().len() - 1];
-    let slerp = interps.contains(&Interp::Linear);
-    let curve = interps.contains(&Interp::Curve);
-    match (slerp, curve) {
-        (false, _) => RotLayout::Hermite,
-        (true, false) => RotLayout::Squad,
-        (true, true) => RotLayout::Reference,
-    }
+/// A rotation's hermite controls per component over the stored segments
+/// `0..=n`, and per stored segment the exact squad controls where the cubic
+/// misses the reference (`None` where it holds).
+struct RotationControls {
+    comps: Vec<Controls>,
+    exact: Vec<Option<[f64; SQ_STRIDE]>>,
 }
 
-/// `p` followed by the unit axis and angle of `log(p^-1 q)`, so that
-/// `slerp(p, q, s) = p exp(s angle axis)` (plain slerp, no hemisphere flip).
-fn slerp_controls(p: DQuat, q: DQuat) -> [f64; 8] {
-    let v = tcb_core::rotation::quat_log(p.conjugate() * q);
-    let alpha = v.length();
-    let n = if alpha > 0.0 {
-        v / alpha
-    } else {
-        glam::DVec3::ZERO
-    };
-    [p.x, p.y, p.z, p.w, n.x, n.y, n.z, alpha]
-}
+/// Largest rotation component error the compiled cubic may have (the
+/// runtime is held to 1e-6; this leaves room between check points).
+const CUBIC_VALUE_TOL: f32 = 4e-7;
+/// Largest velocity error of the cubic, relative to `max(1, |velocity|)`
+/// (half the 1e-4 the runtime is held to; f32 cancellation in `6 (P1 - P0)`
+/// alone reaches about 1e-5 on dense motion capture).
+const CUBIC_VELOCITY_TOL: f32 = 5e-5;
 
-/// Squad controls over stored segments `0..=n` (see [`slerp_controls`]).
-fn squad_controls(t: &RotationTrack) -> Vec<[f64; SQ_STRIDE]> {
+/// Every rotation as hermite controls (normalized after, like `hermite`
+/// rotations): curve segments of a `hermite` track as they are; squad and
+/// slerp segments as the cubic through their ends with their end
+/// derivatives, checked at 17 points of the segment in the kernel's own f32
+/// arithmetic against the f64 formula (value and velocity). Segments where
+/// the cubic misses keep their squad controls, and the kernel evaluates
+/// those lanes exactly ([`kernel::exact_quats`]).
+fn rotation_controls(t: &RotationTrack) -> RotationControls {
     let keys: Vec<DQuat> = t.values().iter().map(|q| q.as_dquat()).collect();
     let n = keys.len();
-    let quads: Vec<[DQuat; 4]> = match t.squad_segments() {
-        Some(segs) => segs.iter().map(|s| [s.q0, s.q1, s.a, s.b]).collect(),
-        None => (0..n - 1)
-            .map(|k| match t.interps()[k] {
-                Interp::Step => [keys[k]; 4],
-                _ => [keys[k], keys[k + 1], keys[k], keys[k + 1]],
-            })
-            .collect(),
+    let interps = t.interps();
+    let mut comps = match t.hermite_track() {
+        Some(h) => vector_controls(h),
+        None => vec![vec![[0.0; 4]; n + 1]; 4],
     };
-    let mut out = Vec::with_capacity(n + 1);
-    let mut push = |q: [DQuat; 4]| {
-        let mut c = [0.0f64; SQ_STRIDE];
-        c[..8].copy_from_slice(&slerp_controls(q[0], q[1]));
-        c[8..].copy_from_slice(&slerp_controls(q[2], q[3]));
-        out.push(c);
-    };
-    push([keys[0]; 4]);
-    for q in quads {
-        push(q);
+    let mut exact = vec![None; n + 1];
+    let squad = t.squad_segments();
+    for k in 0..n - 1 {
+        let c = match squad {
+            Some(segs) => segs[k].controls(),
+            None if interps[k] == Interp::Linear => {
+                tcb_core::squad::controls(keys[k], keys[k + 1], keys[k], keys[k + 1])
+            }
+            None => continue, // a hermite curve or step segment: exact as it is
+        };
+        let (q0, d0) = tcb_core::squad::squad_with_derivative(&c, 0.0);
+        let (q1, d1) = tcb_core::squad::squad_with_derivative(&c, 1.0);
+        let ctl: [[f32; 4]; 4] =
+            std::array::from_fn(|i| [q0[i], q1[i], d0[i], d1[i]].map(|x| x as f32));
+        for (i, comp) in comps.iter_mut().enumerate() {
+            comp[k + 1] = ctl[i];
+        }
+        let max_rate = 2.0 / (t.times()[k + 1] - t.times()[k]);
+        if !cubic_holds(&c, &ctl, max_rate) {
+            exact[k + 1] = Some(c);
+        }
     }
-    push([keys[n - 1]; 4]);
-    out
+    // Sentinels: hold the end keys; the post one carries the velocity
+    // arriving at the last key (as `vector_controls` does).
+    let (first, last) = (keys[0].to_array(), keys[n - 1].to_array());
+    let d = t.times()[n - 1] - t.times()[n - 2];
+    let end_rate = (t.eases()[n - 2].apply(1.0).1 / d) as f32;
+    for (i, comp) in comps.iter_mut().enumerate() {
+        comp[0] = [first[i] as f32, first[i] as f32, 0.0, 0.0];
+        let arrive = comp[n - 1][3] * end_rate;
+        comp[n] = [last[i] as f32, last[i] as f32, 0.0, arrive];
+    }
+    RotationControls { comps, exact }
+}
+
+/// Whether the normalized cubic `ctl` (per component `[P0, P1, M0, M1]`,
+/// evaluated as the kernel does, in f32) follows the squad `c` within
+/// [`CUBIC_VALUE_TOL`] and [`CUBIC_VELOCITY_TOL`] at 17 points.
+fn cubic_holds(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4], max_rate: f64) -> bool {
+    use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
+    (0..=16).all(|j| {
+        let s = j as f64 / 16.0;
+        let (q, dq) = tcb_core::squad::squad_with_derivative(c, s);
+        let (q, dq) = tcb_core::quat::normalize(q, Some(dq));
+        let dq = dq.expect("asked for");
+        let (h, dh) = (hermite_basis(s as f32), hermite_basis_derivative(s as f32));
+        let p = ctl.map(|k| hermite(&h, k[0], k[1], k[2], k[3]));
+        let dp = ctl.map(|k| hermite(&dh, k[0], k[1], k[2], k[3]));
+        let (a, da) = tcb_core::quat::normalize(p, Some(dp));
+        let da = da.expect("asked for");
+        let rate = max_rate as f32;
+        let speed = (0..4)
+            .map(|i| (dq[i] as f32 * rate).abs())
+            .fold(1.0f32, f32::max);
+        (0..4).all(|i| {
+            (a[i] - q[i] as f32).abs() <= CUBIC_VALUE_TOL
+                && ((da[i] - dq[i] as f32) * rate).abs() <= CUBIC_VELOCITY_TOL * speed
+        })
+    })
 }
 
 /// Lay per-lane control rows into blocks of `N` lanes (`f32x8`: 8,
@@ -297,11 +370,6 @@ fn pack<const W: usize>(rows: &[Vec<[f32; W]>], segments: usize, pad: [f32; W]) 
     pack_lanes(rows, segments, rows.len().div_ceil(8), pad, f32x8::new)
 }
 
-/// [`pack_lanes`] into `f64x4` half blocks, two per block of 8 channels.
-fn pack_f64<const W: usize>(rows: &[Vec<[f64; W]>], segments: usize, pad: [f64; W]) -> Vec<f64x4> {
-    pack_lanes(rows, segments, 2 * rows.len().div_ceil(8), pad, f64x4::new)
-}
-
 /// Controls of an unused rotation lane: the identity, so that padding lanes
 /// normalize to a finite value, not 0/0. `w` sits at index 3 of the first and
 /// of the second quaternion of a row (P0 and P1 for hermite, q0 and a for squad).
@@ -325,26 +393,15 @@ impl Clip {
     pub fn compile(source: &tcb_core::Clip) -> Self {
         let mut group_of: HashMap<GridKey, usize> = HashMap::new();
         let mut grids: Vec<TimeGrid> = Vec::new();
-        // Per group: vector channel rows (track, component), hermite rows, squad rows.
+        // Per group: vector channel rows (track, component) and rotation rows.
         let mut vec_rows: Vec<Vec<(usize, usize, Controls)>> = Vec::new();
-        // Hermite rotations: per component (x, y, z, w), as vectors keep them.
-        let mut hq_rows: Vec<Vec<(usize, Vec<Controls>)>> = Vec::new();
-        let mut sq_rows: Vec<Vec<(usize, Vec<[f64; SQ_STRIDE]>)>> = Vec::new();
-        let mut reference = Vec::new();
-        let mut squad_velocity = Vec::new();
+        let mut hq_rows: Vec<Vec<(usize, RotationControls)>> = Vec::new();
         for (i, t) in source.tracks.iter().enumerate() {
-            if let TrackData::Quat(r) = &t.data
-                && rot_layout(r) == RotLayout::Reference
-            {
-                reference.push(TrackId(i));
-                continue;
-            }
             let grid = grid_of(&t.data);
             let g = *group_of.entry(grid_key(&grid)).or_insert_with(|| {
                 grids.push(grid);
                 vec_rows.push(Vec::new());
                 hq_rows.push(Vec::new());
-                sq_rows.push(Vec::new());
                 grids.len() - 1
             });
             let mut vectors = |ctl: Vec<Controls>| {
@@ -357,16 +414,7 @@ impl Clip {
                 TrackData::Vec2(v) => vectors(vector_controls(v)),
                 TrackData::Vec3(v) => vectors(vector_controls(v)),
                 TrackData::Vec4(v) => vectors(vector_controls(v)),
-                TrackData::Quat(r) => match rot_layout(r) {
-                    RotLayout::Hermite => {
-                        let comps = vector_controls(r.hermite_track().expect("hermite"));
-                        hq_rows[g].push((i, comps));
-                    }
-                    _ => {
-                        squad_velocity.push(TrackId(i));
-                        sq_rows[g].push((i, squad_controls(r)));
-                    }
-                },
+                TrackData::Quat(r) => hq_rows[g].push((i, rotation_controls(r))),
             }
         }
 
@@ -377,21 +425,25 @@ impl Clip {
         for g in 0..grids.len() {
             // Small groups of hermite rotations only (reset, which gives the
             // identity rather than zero, stays on the group path).
+            // Rotations with exact segments stay there too (see `rotation_controls`).
             let resets = [grids[g].pre, grids[g].post].contains(&Extrapolation::Reset);
+            let exact = hq_rows[g]
+                .iter()
+                .any(|r| r.1.exact.iter().any(Option::is_some));
             if vec_rows[g].is_empty()
-                && sq_rows[g].is_empty()
                 && !hq_rows[g].is_empty()
                 && hq_rows[g].len() < 8
                 && !resets
+                && !exact
             {
                 keep[g] = false;
-                for (track, comps) in &hq_rows[g] {
-                    let comps: Vec<&Controls> = comps.iter().collect();
+                for (track, rot) in &hq_rows[g] {
+                    let comps: Vec<&Controls> = rot.comps.iter().collect();
                     loose_rots.push((*track, LooseLane::new(grids[g].clone(), &comps)));
                 }
                 continue;
             }
-            if hq_rows[g].is_empty() && sq_rows[g].is_empty() && vec_rows[g].len() < 8 {
+            if hq_rows[g].is_empty() && vec_rows[g].len() < 8 {
                 keep[g] = false;
                 let mut by_track: Vec<(usize, Vec<&Controls>)> = Vec::new();
                 for (track, _, rows) in &vec_rows[g] {
@@ -456,20 +508,20 @@ impl Clip {
             };
             let ids: Vec<usize> = hq_rows[g].iter().map(|r| r.0).collect();
             let (hq_blocks, hq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
-            let ids: Vec<usize> = sq_rows[g].iter().map(|r| r.0).collect();
-            let (sq_blocks, sq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
             // [P0 P1 M0 M1] x [x y z w] per stored segment.
             let hrows: Vec<Vec<[f32; HQ_STRIDE]>> = hq_rows[g]
                 .iter()
-                .map(|(_, comps)| {
-                    (0..comps[0].len())
-                        .map(|seg| std::array::from_fn(|k| comps[k % 4][seg][k / 4]))
+                .map(|(_, rot)| {
+                    (0..rot.comps[0].len())
+                        .map(|seg| std::array::from_fn(|k| rot.comps[k % 4][seg][k / 4]))
                         .collect()
                 })
                 .collect();
-            let srows: Vec<_> = sq_rows[g].iter().map(|r| r.1.clone()).collect();
+            let (exact_at, exact) = exact_table(&hq_rows[g], segments);
             groups.push(Group {
-                lanes: [vrows.len(), hq_rows[g].len(), sq_rows[g].len()],
+                lanes: [vrows.len(), hq_rows[g].len(), exact.len()],
+                exact_at,
+                exact,
                 vec: pack(&vrows, segments, [0.0; VEC_STRIDE]),
                 delta,
                 vec_blocks,
@@ -477,9 +529,6 @@ impl Clip {
                 hq: pack(&hrows, segments, identity_pad(7)),
                 hq_blocks,
                 hq_out,
-                sq: pack_f64(&srows, segments, identity_pad(11).map(f64::from)),
-                sq_blocks,
-                sq_out,
                 grid,
             });
         }
@@ -503,16 +552,6 @@ impl Clip {
             quat_blocks.push(at + 4 * b);
         }
         at += 4 * loose_rot.blocks;
-        // Reference-sampled rotations: four consecutive floats each.
-        let mut loose_quats = Vec::new();
-        if !reference.is_empty() {
-            for (j, id) in reference.iter().enumerate() {
-                let base = at * 8 + 4 * j;
-                slots[id.0].index = [base, base + 1, base + 2, base + 3];
-                loose_quats.push(base);
-            }
-            at += (4 * reference.len()).div_ceil(8);
-        }
         Clip {
             name: source.name.clone(),
             groups,
@@ -520,13 +559,10 @@ impl Clip {
                 slots,
                 blocks: at,
                 quat_blocks,
-                loose_quats,
             }),
             loose,
             loose_rot,
             loose_rot_tracks,
-            reference,
-            squad_velocity,
             source: source.clone(),
         }
     }
@@ -593,7 +629,8 @@ impl Clip {
                     + size_of_val(g.vec.as_slice())
                     + size_of_val(g.delta.as_slice())
                     + size_of_val(g.hq.as_slice())
-                    + size_of_val(g.sq.as_slice())
+                    + size_of_val(g.exact_at.as_slice())
+                    + size_of_val(g.exact.as_slice())
             })
             .sum();
         let loose = self.loose.heap_bytes() + self.loose_rot.heap_bytes();
@@ -603,14 +640,8 @@ impl Clip {
             .iter()
             .map(|s| size_of::<TrackSlot>() + s.name.len())
             .sum::<usize>()
-            + size_of_val(self.layout.quat_blocks.as_slice())
-            + size_of_val(self.layout.loose_quats.as_slice());
-        self.name.len()
-            + groups
-            + loose
-            + layout
-            + size_of_val(self.reference.as_slice())
-            + size_of_val(self.squad_velocity.as_slice())
+            + size_of_val(self.layout.quat_blocks.as_slice());
+        self.name.len() + groups + loose + layout
     }
 
     /// How the clip was laid out: its shared grids, loose tracks and
@@ -623,14 +654,17 @@ impl Clip {
                 .map(|g| GridStats {
                     keys: g.grid.keys(),
                     vector_channels: g.lanes[0],
-                    hermite_rotations: g.lanes[1],
-                    squad_rotations: g.lanes[2],
+                    rotations: g.lanes[1],
                 })
                 .collect(),
             loose_vector_tracks: self.loose.lanes.len(),
             loose_rotation_tracks: self.loose_rot_tracks,
-            reference_rotations: self.reference.len(),
-            squad_velocity_fallbacks: self.squad_velocity.len(),
+            exact_segments: self
+                .groups
+                .iter()
+                .flat_map(|g| &g.exact)
+                .map(|e| e.mask.to_bitmask().count_ones() as usize)
+                .sum(),
             bytes: self.memory_bytes(),
             bytes_compiled: self.memory_bytes_compiled(),
             bytes_per_frame: self.bytes_per_frame(),
@@ -642,10 +676,7 @@ impl Clip {
     pub fn bytes_per_frame(&self) -> usize {
         self.groups
             .iter()
-            .map(|g| {
-                (g.vec_blocks * VEC_STRIDE + g.hq_blocks * HQ_STRIDE + g.sq_blocks * 2 * SQ_STRIDE)
-                    * 32
-            })
+            .map(|g| (g.vec_blocks * VEC_STRIDE + g.hq_blocks * HQ_STRIDE) * 32)
             .sum()
     }
 }

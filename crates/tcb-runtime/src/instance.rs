@@ -1,14 +1,13 @@
 //! Per-instance playback: cursors and a pose, sampled without allocating.
 
 use crate::BlendMask;
-use crate::clip::{Clip, TrackId};
+use crate::clip::Clip;
 use crate::grid::Cursor;
 use crate::kernel;
 use crate::loose::LooseState;
 use crate::pose::Pose;
 use crate::rig::{Rig, RigError, RigMap};
 use std::sync::Arc;
-use tcb_core::TrackData;
 use wide::f32x8;
 
 /// One playing copy of a clip: a cursor per group and the output pose.
@@ -145,15 +144,17 @@ pub(crate) fn sample_into(
                     &mut values[range.clone()],
                     velocities.as_deref_mut().map(|v| &mut v[range]),
                 );
-            }
-        }
-        if g.sq_blocks > 0 {
-            let n = 2 * g.sq_blocks * kernel::SQ_STRIDE;
-            let out = &mut values[g.sq_out..g.sq_out + 4 * g.sq_blocks];
-            if f.reset {
-                kernel::identity(out);
-            } else {
-                kernel::squad_quats(&g.sq[seg * n..(seg + 1) * n], f.s, out);
+                let exact = g.exact_at[seg] as usize..g.exact_at[seg + 1] as usize;
+                for e in &g.exact[exact] {
+                    let planes = g.hq_out + 4 * e.block..g.hq_out + 4 * e.block + 4;
+                    kernel::exact_quats(
+                        e,
+                        f.s,
+                        f.rate,
+                        &mut values[planes.clone()],
+                        velocities.as_deref_mut().map(|v| &mut v[planes]),
+                    );
+                }
             }
         }
     }
@@ -168,23 +169,5 @@ pub(crate) fn sample_into(
             &mut values[planes.clone()],
             velocities.as_deref_mut().map(|v| &mut v[planes]),
         );
-    }
-    let want_velocity = pose.velocities.is_some();
-    for &id in &clip.reference {
-        let (q, d) = rotation(clip, id).sample_with_velocity(time);
-        pose.set(id, Some(q.to_array()), Some(d.to_array()));
-    }
-    if want_velocity {
-        for &id in &clip.squad_velocity {
-            let (_, d) = rotation(clip, id).sample_with_velocity(time);
-            pose.set(id, None, Some(d.to_array()));
-        }
-    }
-}
-
-fn rotation(clip: &Clip, id: TrackId) -> &tcb_core::RotationTrack {
-    match &clip.source.tracks[id.0].data {
-        TrackData::Quat(r) => r,
-        _ => unreachable!("only rotation tracks are sampled by the reference"),
     }
 }

@@ -9,9 +9,9 @@ pub(crate) const VEC_STRIDE: usize = 4;
 /// `[P0, P1, M0, M1]` x `[x, y, z, w]` of 8 quaternions.
 pub(crate) const HQ_STRIDE: usize = 16;
 /// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
-/// of 4 quaternions in f64: the two outer slerps of squad as start point, log
-/// axis and log angle.
-pub(crate) const SQ_STRIDE: usize = 16;
+/// of 4 quaternions in f64 ([`tcb_core::squad::CONTROLS`]): the two outer
+/// slerps of squad as start point, log axis and log angle.
+pub(crate) const SQ_STRIDE: usize = tcb_core::squad::CONTROLS;
 
 #[inline(always)]
 pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
@@ -86,66 +86,52 @@ pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8
     }
 }
 
-pub(crate) use tcb_core::quat::mul as quat_mul;
-
-/// `p exp(s alpha n)`: slerp from `p` along unit axis `n` (log-space angle
-/// `alpha`). No division by `sin`, so well conditioned for any angle.
-#[inline(always)]
-fn slerp_power(p: &[f64x4; 4], n: &[f64x4], alpha: f64x4, s: f64x4) -> [f64x4; 4] {
-    let (sin, cos) = (s * alpha).sin_cos();
-    quat_mul(p, &[n[0] * sin, n[1] * sin, n[2] * sin, cos])
-}
-
-/// Squad of four lanes, in f64: `slerp(slerp(q0, q1, s), slerp(a, b, s),
-/// 2s(1-s))`, normalized.
-#[inline(always)]
-fn squad4(c: &[f64x4], s: f64x4, g: f64x4) -> [f64x4; 4] {
-    let q0 = [c[0], c[1], c[2], c[3]];
-    let a = [c[8], c[9], c[10], c[11]];
-    let p = slerp_power(&q0, &c[4..7], c[7], s);
-    let q = slerp_power(&a, &c[12..15], c[15], s);
-    // log(p^-1 q) = n alpha, alpha = atan2(|v|, w)
-    let r = quat_mul(&[-p[0], -p[1], -p[2], p[3]], &q);
-    let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-    let alpha = len.atan2(r[3]);
-    let none = len.simd_eq(f64x4::ZERO);
-    let inv = none.select(f64x4::ZERO, f64x4::ONE / len);
-    let n = [r[0] * inv, r[1] * inv, r[2] * inv];
-    let v = slerp_power(&p, &n, alpha, g);
-    let il = f64x4::ONE / (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
-    v.map(|x| x * il)
-}
-
-/// Squad rotations. Each slerp is written `p exp(s log(p^-1 q))`; the logs of
-/// the two outer ones are stored with the segment (axis and angle), the inner
-/// one is taken per frame.
+/// The lanes of `e.mask` in one rotation block (4 planes), exactly: squad
+/// in f64 ([`tcb_core::squad`]) at `s`, normalized, velocity times `rate`.
 ///
-/// This runs in f64 (four lanes per [`f64x4`], two halves per output block):
-/// the inner slerp between nearly opposite quaternions amplifies its inputs'
-/// errors by about `1 / sin(angle)`, and f32 controls and arithmetic put the
-/// result up to 6e-6 from the reference on such segments.
+/// This runs in f64 (four lanes per [`f64x4`], two halves per block): the
+/// inner slerp between nearly opposite quaternions amplifies its inputs'
+/// errors by about `1 / sin(angle)`, and in f32 such segments miss 1e-6.
 #[inline]
-pub(crate) fn squad_quats(coeffs: &[f64x4], s: f64, out: &mut [f32x8]) {
-    let g = f64x4::splat(2.0 * s * (1.0 - s));
+pub(crate) fn exact_quats(
+    e: &crate::clip::Exact,
+    s: f64,
+    rate: f32,
+    out: &mut [f32x8],
+    vel: Option<&mut [f32x8]>,
+) {
+    use tcb_core::squad::{CONTROLS, squad, squad_with_derivative};
     let s = f64x4::splat(s);
-    for (c, o) in coeffs
-        .chunks_exact(2 * SQ_STRIDE)
-        .zip(out.chunks_exact_mut(4))
-    {
-        let lo = squad4(&c[..SQ_STRIDE], s, g);
-        let hi = squad4(&c[SQ_STRIDE..], s, g);
+    let rate = f64x4::splat(f64::from(rate));
+    let want_v = vel.is_some();
+    let mut q = [[0.0f32; 8]; 4];
+    let mut dq = [[0.0f32; 8]; 4];
+    for h in 0..2 {
+        let c: &[f64x4; CONTROLS] = e.controls[h * CONTROLS..(h + 1) * CONTROLS]
+            .try_into()
+            .expect("16 controls");
+        let (v, d) = if want_v {
+            let (v, d) = squad_with_derivative(c, s);
+            (v, Some(d.map(|x| x * rate)))
+        } else {
+            (squad(c, s), None)
+        };
+        let (v, d) = normalize(v, d);
         for i in 0..4 {
-            let (l, h) = (lo[i].to_array(), hi[i].to_array());
-            o[i] = f32x8::new([
-                l[0] as f32,
-                l[1] as f32,
-                l[2] as f32,
-                l[3] as f32,
-                h[0] as f32,
-                h[1] as f32,
-                h[2] as f32,
-                h[3] as f32,
-            ]);
+            let a = v[i].to_array();
+            let b = d.map_or([0.0; 4], |d| d[i].to_array());
+            for l in 0..4 {
+                q[i][4 * h + l] = a[l] as f32;
+                dq[i][4 * h + l] = b[l] as f32;
+            }
+        }
+    }
+    for i in 0..4 {
+        out[i] = e.mask.select(f32x8::new(q[i]), out[i]);
+    }
+    if let Some(vel) = vel {
+        for i in 0..4 {
+            vel[i] = e.mask.select(f32x8::new(dq[i]), vel[i]);
         }
     }
 }

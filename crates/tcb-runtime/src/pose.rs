@@ -12,8 +12,6 @@ pub struct PoseLayout {
     pub blocks: usize,
     /// First block of each group of 4 blocks holding x, y, z, w planes of 8 rotations.
     pub quat_blocks: Vec<usize>,
-    /// Flat index of each rotation stored as 4 consecutive floats.
-    pub loose_quats: Vec<usize>,
 }
 impl PoseLayout {
     /// The track called `name`.
@@ -139,29 +137,6 @@ impl Pose {
             .flat_map(|s| &s.index[..s.kind.dim()]);
         for (o, &i) in out.iter_mut().zip(indices) {
             *o = flat[i];
-        }
-    }
-
-    /// Write a track's value and/or velocity (the scalar reference fallbacks).
-    pub(crate) fn set(
-        &mut self,
-        track: TrackId,
-        value: Option<[f32; 4]>,
-        velocity: Option<[f32; 4]>,
-    ) {
-        let slot = &self.layout.slots[track.0];
-        let idx = &slot.index[..slot.kind.dim()];
-        let write = |data: &mut [f32x8], v: [f32; 4]| {
-            let flat: &mut [f32] = bytemuck::cast_slice_mut(data);
-            for (c, &i) in idx.iter().enumerate() {
-                flat[i] = v[c];
-            }
-        };
-        if let Some(v) = value {
-            write(&mut self.values, v);
-        }
-        if let (Some(v), Some(data)) = (velocity, self.velocities.as_mut()) {
-            write(data, v);
         }
     }
 }

@@ -164,7 +164,6 @@ impl Rig {
                 slots,
                 blocks: vec_blocks + rot_blocks,
                 quat_blocks,
-                loose_quats: Vec::new(),
             }),
             tracks,
             rest,

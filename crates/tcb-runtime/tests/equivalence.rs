@@ -374,6 +374,7 @@ fn edge_channel_counts() {
 #[test]
 fn wild_rotations_stay_within_1e_6() {
     let mut worst = 0.0f32;
+    let (mut exact_segments, mut cubic_segments) = (0, 0);
     for seed in 0..300u64 {
         let mut rng = Rng(seed * 7919 + 1);
         let t = times(&mut rng, 6);
@@ -399,18 +400,38 @@ fn wild_rotations_stay_within_1e_6() {
                 data: TrackData::Quat(track),
             }],
         };
-        let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+        let compiled = Arc::new(Clip::compile(&clip));
+        let exact = compiled.stats().exact_segments;
+        exact_segments += exact;
+        cubic_segments += 5 - exact;
+        let mut inst = Instance::new(compiled, true);
         let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
+        let (mut got_v, mut want_v) = ([0.0f32; 4], [0.0f32; 4]);
         for i in 0..200 {
             let time = t[0] - 1.0 + (t[5] - t[0] + 2.0) * i as f64 / 200.0;
-            inst.sample(time).write_row(&mut got, None);
-            clip.sample_into(time, &mut want, None);
+            inst.sample(time).write_row(&mut got, Some(&mut got_v));
+            clip.sample_into(time, &mut want, Some(&mut want_v));
             let d = (0..4).map(|c| (got[c] - want[c]).abs()).fold(0.0, f32::max);
             let e = (0..4).map(|c| (got[c] + want[c]).abs()).fold(0.0, f32::max);
             worst = worst.max(d.min(e));
+            let sign = if d <= e { 1.0 } else { -1.0 };
+            for c in 0..4 {
+                let tol = 1e-4 * want_v[c].abs().max(1.0);
+                assert!(
+                    (got_v[c] - sign * want_v[c]).abs() <= tol,
+                    "seed {seed} t={time} velocity {c}: {} vs {}",
+                    got_v[c],
+                    sign * want_v[c]
+                );
+            }
         }
     }
     assert!(worst < 1e-6, "worst difference {worst}");
+    // Both the compiled cubic and the exact f64 path were exercised.
+    assert!(
+        exact_segments > 100 && cubic_segments > 100,
+        "exact {exact_segments}, cubic {cubic_segments}"
+    );
 }
 
 /// Hermite rotations that each have their own key times (what `tcb reduce`
