@@ -94,7 +94,8 @@ pub(crate) struct Group {
     pub hq_blocks: usize,
     pub hq: Vec<f32x8>,
     pub hq_out: usize,
-    /// Per stored segment `k`, its entries of `exact`: `exact_at[k]..exact_at[k + 1]`.
+    /// Per stored segment `k`, its entries of `exact`: `exact_at[k]..exact_at[k + 1]`
+    /// (empty when `exact` is).
     pub exact_at: Vec<u32>,
     /// Rotation blocks evaluated exactly (squad in f64) on some segment.
     pub exact: Vec<Exact>,
@@ -144,6 +145,9 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
         }
     }
     at.push(out.len() as u32);
+    if out.is_empty() {
+        at = Vec::new(); // nothing exact: no table to keep
+    }
     (at, out)
 }
 

@@ -144,8 +144,11 @@ pub(crate) fn sample_into(
                     &mut values[range.clone()],
                     velocities.as_deref_mut().map(|v| &mut v[range]),
                 );
-                let exact = g.exact_at[seg] as usize..g.exact_at[seg + 1] as usize;
-                for e in &g.exact[exact] {
+                let exact = match g.exact_at.get(seg..seg + 2) {
+                    Some(at) => &g.exact[at[0] as usize..at[1] as usize],
+                    None => &[],
+                };
+                for e in exact {
                     let planes = g.hq_out + 4 * e.block..g.hq_out + 4 * e.block + 4;
                     kernel::exact_quats(
                         e,
