@@ -24,7 +24,7 @@ pub fn check_times(clip: &Clip) -> Vec<f64> {
 /// A compiled clip played by the runtime (as `tcb sample` plays it) at
 /// `times`: one row of [`Clip::channel_count`] values per time, concatenated.
 pub fn play(clip: &Arc<tcb_runtime::Clip>, times: &[f64]) -> Vec<f32> {
-    let channels = clip.source().channel_count();
+    let channels = clip.channel_count();
     let mut instance = Instance::new(clip.clone(), false);
     let mut rows = vec![0.0f32; times.len() * channels];
     for (row, &t) in rows.chunks_exact_mut(channels.max(1)).zip(times) {

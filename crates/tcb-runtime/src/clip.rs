@@ -74,8 +74,6 @@ pub struct ClipStats {
     pub exact_segments: usize,
     /// [`Clip::memory_bytes`].
     pub bytes: usize,
-    /// [`Clip::memory_bytes_compiled`].
-    pub bytes_compiled: usize,
     /// [`Clip::bytes_per_frame`].
     pub bytes_per_frame: usize,
 }
@@ -165,7 +163,7 @@ pub struct Clip {
     pub(crate) loose_rot: Loose,
     /// Real tracks among `loose_rot`'s lanes (the rest are padding).
     pub(crate) loose_rot_tracks: usize,
-    pub(crate) source: tcb_core::Clip,
+    pub(crate) time_range: Option<(f64, f64)>,
 }
 
 /// Flat pose indices of component planes x..w of `lane` in blocks of 8
@@ -567,7 +565,7 @@ impl Clip {
             loose,
             loose_rot,
             loose_rot_tracks,
-            source: source.clone(),
+            time_range: source.time_range(),
         }
     }
 
@@ -602,26 +600,20 @@ impl Clip {
         self.loose.lanes.len() + self.loose_rot_tracks
     }
 
-    /// The validated clip this was compiled from.
-    pub fn source(&self) -> &tcb_core::Clip {
-        &self.source
-    }
-
     /// First and last key time over all tracks.
     pub fn time_range(&self) -> Option<(f64, f64)> {
-        self.source.time_range()
+        self.time_range
+    }
+
+    /// Values per sample, as [`tcb_core::Clip::channel_count`] (a rotation counts 4).
+    pub fn channel_count(&self) -> usize {
+        self.layout.slots.iter().map(|s| s.kind.dim()).sum()
     }
 
     /// Heap bytes of the compiled clip, counted from its buffers' lengths:
-    /// the kernels' controls, the time grids, the pose layout, and the copy
-    /// of the validated source clip it keeps (see
-    /// [`memory_bytes_compiled`](Self::memory_bytes_compiled) without it).
+    /// the kernels' controls, the time grids and the pose layout. It keeps
+    /// no copy of the source clip.
     pub fn memory_bytes(&self) -> usize {
-        self.memory_bytes_compiled() + self.source.heap_bytes()
-    }
-
-    /// [`memory_bytes`](Self::memory_bytes) without the source clip's copy.
-    pub fn memory_bytes_compiled(&self) -> usize {
         use std::mem::{size_of, size_of_val};
         let grid = |g: &TimeGrid| size_of_val(g.times.as_slice()) + size_of_val(g.eases.as_slice());
         let groups: usize = self
@@ -670,7 +662,6 @@ impl Clip {
                 .map(|e| e.mask.to_bitmask().count_ones() as usize)
                 .sum(),
             bytes: self.memory_bytes(),
-            bytes_compiled: self.memory_bytes_compiled(),
             bytes_per_frame: self.bytes_per_frame(),
         }
     }

@@ -200,14 +200,14 @@ impl Rig {
 
     /// The tracks of `clip`, in file order, resting at zero (rotations at
     /// the identity).
-    pub fn from_clip(clip: &tcb_core::Clip) -> Self {
+    pub fn from_clip(clip: &Clip) -> Self {
         let tracks = clip
-            .tracks
+            .tracks()
             .iter()
             .map(|t| RigTrack {
                 name: t.name.clone(),
-                kind: t.data.kind(),
-                rest: if t.data.kind() == TrackKind::Quat {
+                kind: t.kind,
+                rest: if t.kind == TrackKind::Quat {
                     [0.0, 0.0, 0.0, 1.0]
                 } else {
                     [0.0; 4]

@@ -66,7 +66,7 @@ fn steady_playback_and_blending_allocate_nothing() {
         let mut out = a.pose().clone();
         let mask = tcb_runtime::BlendMask::new(&clip, |t| if t.0 % 2 == 0 { 1.0 } else { 0.25 });
         // Through a rig (every track, plus one the clip lacks).
-        let mut tracks = tcb_runtime::Rig::from_clip(clip.source()).tracks().to_vec();
+        let mut tracks = tcb_runtime::Rig::from_clip(&clip).tracks().to_vec();
         tracks.push(tcb_runtime::RigTrack {
             name: "extra".into(),
             kind: tcb_core::TrackKind::Quat,
