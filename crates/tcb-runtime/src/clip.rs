@@ -23,7 +23,7 @@
 //! back to the scalar reference.
 
 use crate::grid::TimeGrid;
-use crate::kernel::{HQ_STRIDE, SQ_STRIDE, VEC_STRIDE};
+use crate::kernel::{HQ_STRIDE, KEY_STRIDE, SQ_STRIDE};
 use crate::loose::{Loose, LooseLane};
 use crate::pose::PoseLayout;
 use glam::DQuat;
@@ -180,6 +180,7 @@ fn identity_lane() -> LooseLane {
         grid: TimeGrid {
             times: vec![0.0, 1.0],
             eases: vec![SegmentEase::default()],
+            steps: vec![false],
             pre: Extrapolation::Constant,
             post: Extrapolation::Constant,
         },
@@ -219,36 +220,94 @@ fn vector_controls<V: Value>(t: &Track<V>) -> Vec<Controls> {
 }
 
 fn grid_of(data: &TrackData) -> TimeGrid {
-    fn eases<V: Value>(t: &Track<V>) -> Vec<SegmentEase> {
-        t.segments().iter().map(|s| s.ease).collect()
+    fn segs<V: Value>(t: &Track<V>) -> (Vec<SegmentEase>, Vec<bool>) {
+        let s = t.segments();
+        (
+            s.iter().map(|s| s.ease).collect(),
+            s.iter().map(|s| s.interp == Interp::Step).collect(),
+        )
     }
-    let (eases, settings) = match data {
-        TrackData::Scalar(t) => (eases(t), *t.settings()),
-        TrackData::Vec2(t) => (eases(t), *t.settings()),
-        TrackData::Vec3(t) => (eases(t), *t.settings()),
-        TrackData::Vec4(t) => (eases(t), *t.settings()),
-        TrackData::Quat(t) => (t.eases().to_vec(), *t.settings()),
+    let ((eases, steps), settings) = match data {
+        TrackData::Scalar(t) => (segs(t), *t.settings()),
+        TrackData::Vec2(t) => (segs(t), *t.settings()),
+        TrackData::Vec3(t) => (segs(t), *t.settings()),
+        TrackData::Vec4(t) => (segs(t), *t.settings()),
+        TrackData::Quat(t) => {
+            let n = t.times().len();
+            let steps = t.interps()[..n - 1]
+                .iter()
+                .map(|i| *i == Interp::Step)
+                .collect();
+            ((t.eases().to_vec(), steps), *t.settings())
+        }
     };
     TimeGrid {
         times: data.times().to_vec(),
         eases,
+        steps,
         pre: settings.pre,
         post: settings.post,
     }
 }
 
-type GridKey = (Vec<u64>, Vec<(u64, u64)>, Extrapolation, Extrapolation);
+type GridKey = (
+    Vec<u64>,
+    Vec<(u64, u64, bool)>,
+    Extrapolation,
+    Extrapolation,
+);
 
 fn grid_key(g: &TimeGrid) -> GridKey {
     (
         g.times.iter().map(|t| t.to_bits()).collect(),
         g.eases
             .iter()
-            .map(|e| (e.from.to_bits(), e.to.to_bits()))
+            .zip(&g.steps)
+            .map(|(e, &step)| (e.from.to_bits(), e.to.to_bits(), step))
             .collect(),
         g.pre,
         g.post,
     )
+}
+
+/// A channel's controls per key, `[P, TO, TI]` (`TO_k` = `M0` of segment
+/// k, `TI_k` = `M1` of segment k-1; nothing is stored twice), for the n
+/// keys, then the sentinels as four pseudo-keys `pre_a pre_b post_a post_b`
+/// that give back `[P0, P1, M0, M1]` of stored segments 0 and n the same
+/// way (see [`key_pair`]).
+fn per_key(rows: &Controls) -> Vec<[f32; KEY_STRIDE]> {
+    let n = rows.len() - 1;
+    let mut out: Vec<[f32; KEY_STRIDE]> = (0..n)
+        .map(|k| {
+            let p = if k < n - 1 {
+                rows[k + 1][0]
+            } else {
+                rows[n][0]
+            };
+            let to = if k < n - 1 { rows[k + 1][2] } else { 0.0 };
+            let ti = if k > 0 { rows[k][3] } else { 0.0 };
+            [p, to, ti]
+        })
+        .collect();
+    for r in [rows[0], rows[n]] {
+        out.push([r[0], r[2], 0.0]);
+        out.push([r[1], 0.0, r[3]]);
+    }
+    out
+}
+
+/// The two keys stored segment `seg` of `grid` reads: `(a, b)` with
+/// `P0 = a.P, M0 = a.TO, P1 = b.P, M1 = b.TI` (a `step` segment reads its
+/// first key twice; its tangents are zero).
+#[inline]
+pub(crate) fn key_pair(grid: &TimeGrid, seg: usize) -> (usize, usize) {
+    let n = grid.times.len();
+    match seg {
+        0 => (n, n + 1),
+        s if s == n => (n + 2, n + 3),
+        s if grid.steps[s - 1] => (s - 1, s - 1),
+        s => (s - 1, s),
+    }
 }
 
 /// A rotation's hermite controls per component over the stored segments
@@ -292,8 +351,11 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
             }
             None => continue, // a hermite curve or step segment: exact as it is
         };
-        let (q0, d0) = tcb_core::squad::squad_with_derivative(&c, 0.0);
-        let (q1, d1) = tcb_core::squad::squad_with_derivative(&c, 1.0);
+        // The ends are the keys themselves (stored once per key, see `per_key`).
+        let (_, d0) = tcb_core::squad::squad_with_derivative(&c, 0.0);
+        let (_, d1) = tcb_core::squad::squad_with_derivative(&c, 1.0);
+        let next = if interps[k] == Interp::Step { k } else { k + 1 };
+        let (q0, q1) = (keys[k].to_array(), keys[next].to_array());
         let ctl: [[f32; 4]; 4] =
             std::array::from_fn(|i| [q0[i], q1[i], d0[i], d1[i]].map(|x| x as f32));
         for (i, comp) in comps.iter_mut().enumerate() {
@@ -372,15 +434,13 @@ fn pack<const W: usize>(rows: &[Vec<[f32; W]>], segments: usize, pad: [f32; W]) 
     pack_lanes(rows, segments, rows.len().div_ceil(8), pad, f32x8::new)
 }
 
-/// Controls of an unused rotation lane: the identity, so that padding lanes
-/// normalize to a finite value, not 0/0. `w` sits at index 3 of the first and
-/// of the second quaternion of a row (P0 and P1 for hermite, q0 and a for squad).
-fn identity_pad(second_w: usize) -> [f32; 16] {
-    let mut pad = [0.0; 16];
+/// Controls of an unused rotation lane: the identity (`P.w = 1`), so that
+/// padding lanes normalize to a finite value, not 0/0.
+const IDENTITY_PAD: [f32; HQ_STRIDE] = {
+    let mut pad = [0.0; HQ_STRIDE];
     pad[3] = 1.0;
-    pad[second_w] = 1.0;
     pad
-}
+};
 
 impl Clip {
     /// Compile a validated clip.
@@ -510,25 +570,28 @@ impl Clip {
             };
             let ids: Vec<usize> = hq_rows[g].iter().map(|r| r.0).collect();
             let (hq_blocks, hq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
-            // [P0 P1 M0 M1] x [x y z w] per stored segment.
+            // [P TO TI] x [x y z w] per key (and sentinel pseudo-key).
             let hrows: Vec<Vec<[f32; HQ_STRIDE]>> = hq_rows[g]
                 .iter()
                 .map(|(_, rot)| {
-                    (0..rot.comps[0].len())
-                        .map(|seg| std::array::from_fn(|k| rot.comps[k % 4][seg][k / 4]))
+                    let keys: Vec<Vec<[f32; KEY_STRIDE]>> = rot.comps.iter().map(per_key).collect();
+                    (0..keys[0].len())
+                        .map(|k| std::array::from_fn(|j| keys[j % 4][k][j / 4]))
                         .collect()
                 })
                 .collect();
+            let vkeys: Vec<Vec<[f32; KEY_STRIDE]>> = vrows.iter().map(per_key).collect();
+            let keys = grid.times.len() + 4;
             let (exact_at, exact) = exact_table(&hq_rows[g], segments);
             groups.push(Group {
                 lanes: [vrows.len(), hq_rows[g].len(), exact.len()],
                 exact_at,
                 exact,
-                vec: pack(&vrows, segments, [0.0; VEC_STRIDE]),
+                vec: pack(&vkeys, keys, [0.0; KEY_STRIDE]),
                 delta,
                 vec_blocks,
                 vec_out,
-                hq: pack(&hrows, segments, identity_pad(7)),
+                hq: pack(&hrows, keys, IDENTITY_PAD),
                 hq_blocks,
                 hq_out,
                 grid,
@@ -671,7 +734,7 @@ impl Clip {
     pub fn bytes_per_frame(&self) -> usize {
         self.groups
             .iter()
-            .map(|g| (g.vec_blocks * VEC_STRIDE + g.hq_blocks * HQ_STRIDE) * 32)
+            .map(|g| 2 * (g.vec_blocks * KEY_STRIDE + g.hq_blocks * HQ_STRIDE) * 32)
             .sum()
     }
 }

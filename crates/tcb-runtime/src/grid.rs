@@ -36,6 +36,9 @@ pub struct TimeGrid {
     pub times: Vec<f64>,
     /// Ease of each of the n-1 segments.
     pub eases: Vec<SegmentEase>,
+    /// Whether each of the n-1 segments is `step` in every channel of the
+    /// group (they hold the segment's first key: the kernels read it twice).
+    pub steps: Vec<bool>,
     /// Before the first key.
     pub pre: Extrapolation,
     /// After the last key.
@@ -115,11 +118,19 @@ impl TimeGrid {
                     let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
                     let (s, ds_du) = self.eases[k].apply(u);
                     let s32 = s as f32;
+                    let (mut h, mut dh) = (hermite_basis(s32), hermite_basis_derivative(s32));
+                    if self.steps[k] {
+                        // A step segment reads its first key twice (see
+                        // `clip::key_pair`); that key's TI belongs to the
+                        // segment before, so its weight is zero here.
+                        h[3] = 0.0;
+                        dh[3] = 0.0;
+                    }
                     FrameBasis {
                         segment: k + 1,
                         s,
-                        h: hermite_basis(s32),
-                        dh: hermite_basis_derivative(s32),
+                        h,
+                        dh,
                         rate: (ds_du / d) as f32,
                         cycles: 0.0,
                         reset: false,
@@ -157,6 +168,7 @@ mod tests {
         TimeGrid {
             times: vec![0.0, 1.0, 3.0, 4.0],
             eases: vec![SegmentEase::default(); 3],
+            steps: vec![false; 3],
             pre,
             post,
         }

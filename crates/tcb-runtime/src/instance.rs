@@ -110,17 +110,19 @@ pub(crate) fn sample_into(
         let dh = kernel::splat4(f.dh);
         let rate = f32x8::splat(f.rate);
         let seg = f.segment;
+        let (ka, kb) = crate::clip::key_pair(&g.grid, seg);
         if g.vec_blocks > 0 {
-            let n = g.vec_blocks * kernel::VEC_STRIDE;
-            let coeffs = &g.vec[seg * n..(seg + 1) * n];
+            let n = g.vec_blocks * kernel::KEY_STRIDE;
+            let (a, b) = (&g.vec[ka * n..(ka + 1) * n], &g.vec[kb * n..(kb + 1) * n]);
             let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
-            kernel::vectors(coeffs, &h, out);
+            kernel::vectors(a, b, &h, out);
             if f.cycles != 0.0 && !g.delta.is_empty() {
                 kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
             }
             if let Some(v) = velocities.as_deref_mut() {
                 kernel::vector_velocities(
-                    coeffs,
+                    a,
+                    b,
                     &dh,
                     rate,
                     &mut v[g.vec_out..g.vec_out + g.vec_blocks],
@@ -137,7 +139,8 @@ pub(crate) fn sample_into(
                 }
             } else {
                 kernel::hermite_quats(
-                    &g.hq[seg * n..(seg + 1) * n],
+                    &g.hq[ka * n..(ka + 1) * n],
+                    &g.hq[kb * n..(kb + 1) * n],
                     &h,
                     &dh,
                     rate,

@@ -4,10 +4,11 @@
 use tcb_core::basis::hermite;
 use wide::{f32x8, f64x4};
 
-/// `[P0, P1, M0, M1]` of 8 channels.
-pub(crate) const VEC_STRIDE: usize = 4;
-/// `[P0, P1, M0, M1]` x `[x, y, z, w]` of 8 quaternions.
-pub(crate) const HQ_STRIDE: usize = 16;
+/// `[P, TO, TI]` of 8 channels at one key (`P0 = a.P, M0 = a.TO` and
+/// `P1 = b.P, M1 = b.TI` for a segment from key a to key b).
+pub(crate) const KEY_STRIDE: usize = 3;
+/// `[P, TO, TI]` x `[x, y, z, w]` of 8 rotations at one key.
+pub(crate) const HQ_STRIDE: usize = 12;
 /// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
 /// of 4 quaternions in f64 ([`tcb_core::squad::CONTROLS`]): the two outer
 /// slerps of squad as start point, log axis and log angle.
@@ -18,20 +19,29 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
     r.map(f32x8::splat)
 }
 
-/// Values of vector channels: `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula
-/// of [`tcb_core::basis::hermite`] itself.
+/// Values of vector channels between keys `a` and `b`:
+/// `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula of
+/// [`tcb_core::basis::hermite`] itself.
 #[inline]
-pub(crate) fn vectors(coeffs: &[f32x8], h: &[f32x8; 4], out: &mut [f32x8]) {
-    for (c, o) in coeffs.chunks_exact(VEC_STRIDE).zip(out) {
-        *o = hermite(h, c[0], c[1], c[2], c[3]);
+pub(crate) fn vectors(a: &[f32x8], b: &[f32x8], h: &[f32x8; 4], out: &mut [f32x8]) {
+    let keys = a.chunks_exact(KEY_STRIDE).zip(b.chunks_exact(KEY_STRIDE));
+    for ((a, b), o) in keys.zip(out) {
+        *o = hermite(h, a[0], b[0], a[1], b[2]);
     }
 }
 
 /// Velocities of vector channels: `rate (dh . controls)`.
 #[inline]
-pub(crate) fn vector_velocities(coeffs: &[f32x8], dh: &[f32x8; 4], rate: f32x8, out: &mut [f32x8]) {
-    for (c, o) in coeffs.chunks_exact(VEC_STRIDE).zip(out) {
-        *o = hermite(dh, c[0], c[1], c[2], c[3]) * rate;
+pub(crate) fn vector_velocities(
+    a: &[f32x8],
+    b: &[f32x8],
+    dh: &[f32x8; 4],
+    rate: f32x8,
+    out: &mut [f32x8],
+) {
+    let keys = a.chunks_exact(KEY_STRIDE).zip(b.chunks_exact(KEY_STRIDE));
+    for ((a, b), o) in keys.zip(out) {
+        *o = hermite(dh, a[0], b[0], a[1], b[2]) * rate;
     }
 }
 
@@ -43,27 +53,28 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
     }
 }
 
-/// Hermite rotations: four components, then normalized; `vel` gets
-/// `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
+/// Rotations between keys `a` and `b`: four components, then normalized;
+/// `vel` gets `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
 #[inline]
 pub(crate) fn hermite_quats(
-    coeffs: &[f32x8],
+    a: &[f32x8],
+    b: &[f32x8],
     h: &[f32x8; 4],
     dh: &[f32x8; 4],
     rate: f32x8,
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
-    for (b, c) in coeffs.chunks_exact(HQ_STRIDE).enumerate() {
-        let p: [f32x8; 4] =
-            std::array::from_fn(|i| hermite(h, c[i], c[4 + i], c[8 + i], c[12 + i]));
-        let dp = vel.is_some().then(|| {
-            std::array::from_fn(|i| hermite(dh, c[i], c[4 + i], c[8 + i], c[12 + i]) * rate)
-        });
+    let keys = a.chunks_exact(HQ_STRIDE).zip(b.chunks_exact(HQ_STRIDE));
+    for (i, (a, b)) in keys.enumerate() {
+        let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, a[c], b[c], a[4 + c], b[8 + c]));
+        let dp = vel
+            .is_some()
+            .then(|| std::array::from_fn(|c| hermite(dh, a[c], b[c], a[4 + c], b[8 + c]) * rate));
         let (q, qv) = normalize(p, dp);
-        out[4 * b..4 * b + 4].copy_from_slice(&q);
+        out[4 * i..4 * i + 4].copy_from_slice(&q);
         if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
-            vel[4 * b..4 * b + 4].copy_from_slice(&qv);
+            vel[4 * i..4 * i + 4].copy_from_slice(&qv);
         }
     }
 }
