@@ -74,21 +74,27 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
-    let mut all = if args.clip.is_empty() {
-        scenarios::all(&args.bvh)?
+    let names: Option<Vec<&str>> = args
+        .only
+        .as_ref()
+        .map(|o| o.split(',').map(str::trim).collect());
+    if let Some(names) = &names
+        && let Some(bad) = names.iter().find(|n| !scenarios::NAMES.contains(n))
+    {
+        return Err(format!(
+            "--only {bad}: no such scenario (one of {})",
+            scenarios::NAMES.join(", ")
+        )
+        .into());
+    }
+    let all = if args.clip.is_empty() {
+        scenarios::named(&args.bvh, |n| names.as_ref().is_none_or(|w| w.contains(&n)))?
     } else {
         args.clip
             .iter()
             .map(|p| scenarios::file(p))
             .collect::<Result<_, _>>()?
     };
-    if let Some(only) = &args.only {
-        let names: Vec<&str> = only.split(',').map(str::trim).collect();
-        all.retain(|s| names.contains(&s.name.as_str()));
-        if all.is_empty() {
-            return Err(format!("--only {only}: no such scenario").into());
-        }
-    }
     let slice = Duration::from_millis(args.slice_ms.max(1));
     let mut rows: Vec<_> = all
         .iter()

@@ -389,13 +389,34 @@ pub fn sparse() -> Scenario {
 
 /// Every scenario, in report order.
 pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
-    Ok(vec![
-        character(bvh, RotationMode::Hermite)?,
-        character(bvh, RotationMode::Squad)?,
-        crowd(bvh)?,
-        wide(),
-        sparse(),
-        seek(bvh)?,
-        character_reduced(bvh)?,
-    ])
+    named(bvh, |_| true)
+}
+
+/// The scenario names, in report order.
+pub const NAMES: [&str; 7] = [
+    "character-hermite",
+    "character-squad",
+    "crowd",
+    "wide",
+    "sparse",
+    "seek",
+    "character-reduced",
+];
+
+/// The scenarios whose name `want` accepts, built only if wanted (the
+/// reduced character runs `tcb reduce` first).
+pub fn named(bvh: &Path, want: impl Fn(&str) -> bool) -> Result<Vec<Scenario>, tcb_io::Error> {
+    let mut out = Vec::new();
+    for name in NAMES.into_iter().filter(|n| want(n)) {
+        out.push(match name {
+            "character-hermite" => character(bvh, RotationMode::Hermite)?,
+            "character-squad" => character(bvh, RotationMode::Squad)?,
+            "crowd" => crowd(bvh)?,
+            "wide" => wide(),
+            "sparse" => sparse(),
+            "seek" => seek(bvh)?,
+            _ => character_reduced(bvh)?,
+        });
+    }
+    Ok(out)
 }

@@ -172,19 +172,25 @@ impl Loose {
 /// four lanes at a time.
 #[derive(Clone, Debug)]
 pub(crate) struct LooseState {
-    ws: Vec<f64>,
-    we: Vec<f64>,
-    ease_from: Vec<f64>,
-    ease_to: Vec<f64>,
+    /// Per half block (4 lanes): window start and end, ease from and to.
+    ws: Vec<f64x4>,
+    we: Vec<f64x4>,
+    ease_from: Vec<f64x4>,
+    ease_to: Vec<f64x4>,
     seg: Vec<usize>,
     ctl: Vec<f32x8>,
 }
 
 /// Lanes `4i .. 4i+4` of `v` as one vector.
 #[inline(always)]
-fn quad(v: &[f64], i: usize) -> f64x4 {
-    let q: [f64; 4] = v[4 * i..4 * i + 4].try_into().expect("4 lanes");
-    f64x4::new(q)
+fn quad(v: &[f64x4], i: usize) -> f64x4 {
+    v[i]
+}
+
+/// Set lane `l` of half blocks `v`.
+#[inline(always)]
+fn set_lane(v: &mut [f64x4], l: usize, x: f64) {
+    bytemuck::cast_slice_mut::<f64x4, f64>(v)[l] = x;
 }
 
 impl LooseState {
@@ -193,16 +199,20 @@ impl LooseState {
         // Real lanes start with an empty window (refreshed on first use);
         // padding lanes with one spanning all time and zero controls.
         let real = loose.lanes.len();
-        let fill = |inside: f64, pad: f64| -> Vec<f64> {
-            (0..lanes)
-                .map(|l| if l < real { inside } else { pad })
+        let fill = |inside: f64, pad: f64| -> Vec<f64x4> {
+            (0..lanes / 4)
+                .map(|h| {
+                    f64x4::new(std::array::from_fn(|i| {
+                        if 4 * h + i < real { inside } else { pad }
+                    }))
+                })
                 .collect()
         };
         LooseState {
             ws: fill(f64::INFINITY, -PAD_SPAN),
             we: fill(f64::NEG_INFINITY, PAD_SPAN),
-            ease_from: vec![0.0; lanes],
-            ease_to: vec![0.0; lanes],
+            ease_from: vec![f64x4::ZERO; lanes / 4],
+            ease_to: vec![f64x4::ZERO; lanes / 4],
             seg: vec![usize::MAX; lanes],
             ctl: vec![f32x8::ZERO; loose.blocks * CTL],
         }
@@ -223,15 +233,16 @@ impl LooseState {
         } else {
             Default::default()
         };
-        self.ws[l] = ws;
-        self.we[l] = we;
-        self.ease_from[l] = ease.from;
-        self.ease_to[l] = ease.to;
+        set_lane(&mut self.ws, l, ws);
+        set_lane(&mut self.we, l, we);
+        set_lane(&mut self.ease_from, l, ease.from);
+        set_lane(&mut self.ease_to, l, ease.to);
         self.seg[l] = seg;
         let (b, i) = (l / 8, l % 8);
         let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl[b * CTL..(b + 1) * CTL]);
         let src = &lane.controls[seg];
-        for c in 0..4 {
+        // Only the components the track has (the rest stay zero).
+        for c in 0..lane.dim {
             for j in 0..4 {
                 ctl[(4 * c + j) * 8 + i] = src[c][j];
             }
@@ -254,6 +265,16 @@ impl LooseState {
     }
 }
 
+/// The derivative rows, only when velocities are wanted.
+#[inline(always)]
+fn derivative_rows(s: f32x8, velocity: bool) -> [f32x8; 4] {
+    if velocity {
+        hermite_basis_derivative(s)
+    } else {
+        [f32x8::ZERO; 4]
+    }
+}
+
 /// Rows of one block, per lane.
 struct Rows {
     h: [f32x8; 4],
@@ -263,6 +284,7 @@ struct Rows {
     any_cycles: bool,
 }
 
+#[inline(always)]
 fn f32x8_of(a: f64x4, b: f64x4) -> f32x8 {
     let (a, b) = (a.to_array(), b.to_array());
     f32x8::new(std::array::from_fn(|i| {
@@ -279,10 +301,19 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
 
 /// Refresh the lanes of half block `i` whose window does not hold `tm`
 /// (forward playback: a lane at a time, when it crosses a key).
-#[inline]
+#[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
     let ok = quad(&st.ws, i).simd_le(tm) & tm.simd_lt(quad(&st.we, i));
-    let mut stale = !ok.to_bitmask() & 0xf;
+    let stale = !ok.to_bitmask() & 0xf;
+    if stale != 0 {
+        load_stale(loose, st, i, tm, stale);
+    }
+}
+
+/// Load the lanes of half block `i` set in `stale` (out of line: most
+/// frames cross no key).
+#[inline(never)]
+fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale: u32) {
     while stale != 0 {
         let k = stale.trailing_zeros() as usize;
         stale &= stale - 1;
@@ -296,8 +327,8 @@ fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
 
 /// Rows for block `b` when every lane is inside its keys, `t_0 <= time < t_{n-1}`:
 /// no extrapolation and no sentinel, just `u`, ease and the basis.
-#[inline]
-fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4) -> Rows {
+#[inline(always)]
+fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4, velocity: bool) -> Rows {
     let one = f64x4::ONE;
     let mut s = [f64x4::ZERO; 2];
     let mut rate = [f64x4::ZERO; 2];
@@ -318,7 +349,7 @@ fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4) -> Rows {
     let s32 = f32x8_of(s[0], s[1]);
     Rows {
         h: hermite_basis(s32),
-        dh: hermite_basis_derivative(s32),
+        dh: derivative_rows(s32, velocity),
         rate: f32x8_of(rate[0], rate[1]),
         cycles: f32x8::ZERO,
         any_cycles: false,
@@ -326,11 +357,12 @@ fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4) -> Rows {
 }
 
 /// Rows for block `b` at `time` (any f64), refreshing lanes that left their window.
-fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
+#[inline(always)]
+fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: bool) -> Rows {
     let t = f64x4::splat(time);
     let inside = |i: usize| (t.simd_ge(loose.t0[i]) & t.simd_lt(loose.tn[i])).all();
     if inside(2 * b) && inside(2 * b + 1) {
-        return rows_inside(loose, st, b, t);
+        return rows_inside(loose, st, b, t, velocity);
     }
     let zero = f64x4::ZERO;
     let one = f64x4::ONE;
@@ -385,7 +417,7 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64) -> Rows {
     let at_end = !(realm | line | reset | hold);
     let s32 = f32x8_of(s[0], s[1]);
     let hb = hermite_basis(s32);
-    let db = hermite_basis_derivative(s32);
+    let db = derivative_rows(s32, velocity);
     let (z, o) = (f32x8::ZERO, f32x8::ONE);
     let dt = f32x8_of(dt[0], dt[1]);
     let dirs = f32x8_of(dir[0], dir[1]);
@@ -421,7 +453,7 @@ pub(crate) fn sample(
     mut velocities: Option<&mut [f32x8]>,
 ) {
     for b in 0..loose.blocks {
-        let rows = rows_simd(loose, st, b, time);
+        let rows = rows_simd(loose, st, b, time, velocities.is_some());
         let ctl = &st.ctl[b * CTL..(b + 1) * CTL];
         let out = loose.out + 4 * b;
         for c in 0..loose.dims[b] {
