@@ -251,6 +251,8 @@ pub struct FileOptions {
     pub instances: usize,
     /// Import options (BVH rotation mode, glTF animation).
     pub import: tcb_io::ImportOptions,
+    /// How the runtime compiles it (quantization).
+    pub compile: tcb_runtime::CompileOptions,
 }
 
 impl Default for FileOptions {
@@ -259,6 +261,7 @@ impl Default for FileOptions {
             fps: 60.0,
             instances: 1,
             import: Default::default(),
+            compile: Default::default(),
         }
     }
 }
@@ -289,6 +292,7 @@ pub fn file_with(path: &Path, options: &FileOptions) -> Result<Scenario, tcb_io:
         .file_stem()
         .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
     let mut s = Scenario::new(name, loaded.clip, times);
+    s.clip = Arc::new(tcb_runtime::Clip::compile_with(&s.source, &options.compile));
     s.joints = Some(joints);
     if options.instances > 1 {
         let mut rng = Rng(0xf11e);

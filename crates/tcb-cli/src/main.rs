@@ -58,6 +58,9 @@ enum Command {
 struct InfoArgs {
     /// The clip: clip JSON, BVH, glTF or GLB.
     clip: PathBuf,
+    /// Compile with 16-bit controls (and print each track's error bound).
+    #[arg(long)]
+    quantize: bool,
     /// BVH: rotation mode of its rotation tracks, as `tcb import`.
     #[arg(long, value_name = "squad|hermite")]
     rotation: Option<tcb_core::RotationMode>,
@@ -70,6 +73,9 @@ struct InfoArgs {
 struct BenchArgs {
     /// The clip: clip JSON, BVH, glTF or GLB.
     clip: PathBuf,
+    /// Compile with 16-bit controls.
+    #[arg(long)]
+    quantize: bool,
     /// Frames per second of playback.
     #[arg(long, value_name = "FPS", default_value_t = 60.0)]
     fps: f64,
@@ -414,7 +420,10 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     let loaded = tcb_io::load_with(&args.clip, &options)?;
     warn(&loaded.warnings);
     let clip = &loaded.clip;
-    let runtime = tcb_runtime::Clip::compile(clip);
+    let options = tcb_runtime::CompileOptions {
+        quantize: args.quantize,
+    };
+    let runtime = tcb_runtime::Clip::compile_with(clip, &options);
     let stats = runtime.stats();
     let keys: usize = clip.tracks.iter().map(|t| t.data.times().len()).sum();
     let mut out = String::new();
@@ -443,7 +452,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
         "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
         "name", "kind", "keys", "first", "last"
     )?;
-    for t in &clip.tracks {
+    for (i, t) in clip.tracks.iter().enumerate() {
         let times = t.data.times();
         let (mode, settings) = match &t.data {
             tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
@@ -463,6 +472,10 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
             settings.pre.name(),
             settings.post.name()
         )?;
+        if args.quantize {
+            let e = runtime.quantization_error(tcb_runtime::TrackId(i));
+            writeln!(out, "    quantization error at most {e:e}")?;
+        }
     }
     writeln!(
         out,
@@ -503,6 +516,9 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
         fps: args.fps,
         instances: args.instances,
         import: import_options(&args.clip, args.rotation, args.animation.as_ref())?,
+        compile: tcb_runtime::CompileOptions {
+            quantize: args.quantize,
+        },
     };
     let scenario = tcb_bench::scenarios::file_with(&args.clip, &options)?;
     if scenario.source.tracks.is_empty() {

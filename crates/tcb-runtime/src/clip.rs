@@ -26,6 +26,7 @@ use crate::grid::TimeGrid;
 use crate::kernel::{HQ_STRIDE, KEY_STRIDE, SQ_STRIDE};
 use crate::loose::{Loose, LooseLane};
 use crate::pose::PoseLayout;
+use crate::quant::Quantized;
 use glam::DQuat;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -92,6 +93,9 @@ pub(crate) struct Group {
     pub hq_blocks: usize,
     pub hq: Vec<f32x8>,
     pub hq_out: usize,
+    /// With quantization: `vec` and `hq` in 16 bits (then those are empty).
+    pub qvec: Option<Quantized>,
+    pub qhq: Option<Quantized>,
     /// Per stored segment `k`, its entries of `exact`: `exact_at[k]..exact_at[k + 1]`
     /// (empty when `exact` is).
     pub exact_at: Vec<u32>,
@@ -164,6 +168,20 @@ pub struct Clip {
     /// Real tracks among `loose_rot`'s lanes (the rest are padding).
     pub(crate) loose_rot_tracks: usize,
     pub(crate) time_range: Option<(f64, f64)>,
+    /// Per track: the bound on the error quantization adds (0 without).
+    pub(crate) quant_error: Vec<f32>,
+    /// f32x8 vectors of scratch an instance needs to expand quantized keys.
+    pub(crate) scratch: usize,
+}
+
+/// Choices made when a clip is compiled.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CompileOptions {
+    /// Store the controls of tracks on shared key grids in 16 bits per
+    /// component with a per-channel range (see [`crate::quant`] for the
+    /// error bound, [`Clip::quantization_error`] for each track's).
+    /// Tracks on their own key times stay in f32.
+    pub quantize: bool,
 }
 
 /// Flat pose indices of component planes x..w of `lane` in blocks of 8
@@ -453,6 +471,22 @@ impl Clip {
     /// assert_eq!(clip.track("x").map(|t| t.0), Some(0));
     /// ```
     pub fn compile(source: &tcb_core::Clip) -> Self {
+        Clip::compile_with(source, &CompileOptions::default())
+    }
+
+    /// [`compile`](Self::compile) with options (quantization).
+    ///
+    /// ```
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
+    /// let plain = tcb_runtime::Clip::compile(&source);
+    /// let options = tcb_runtime::CompileOptions { quantize: true };
+    /// let small = tcb_runtime::Clip::compile_with(&source, &options);
+    /// assert!(small.memory_bytes() * 3 < plain.memory_bytes() * 2);
+    /// let hips = small.track("Hips.translation").unwrap();
+    /// assert!(small.quantization_error(hips) < 1e-3); // in the clip's units
+    /// ```
+    pub fn compile_with(source: &tcb_core::Clip, options: &CompileOptions) -> Self {
         let mut group_of: HashMap<GridKey, usize> = HashMap::new();
         let mut grids: Vec<TimeGrid> = Vec::new();
         // Per group: vector channel rows (track, component) and rotation rows.
@@ -530,6 +564,8 @@ impl Clip {
             })
             .collect();
         let mut groups = Vec::with_capacity(grids.len());
+        let mut quant_error = vec![0.0f32; source.tracks.len()];
+        let mut scratch = 0usize;
         let mut quat_blocks = Vec::new();
         let mut at = 0usize; // pose block
         for (g, grid) in grids.into_iter().enumerate() {
@@ -583,17 +619,42 @@ impl Clip {
             let vkeys: Vec<Vec<[f32; KEY_STRIDE]>> = vrows.iter().map(per_key).collect();
             let keys = grid.times.len() + 4;
             let (exact_at, exact) = exact_table(&hq_rows[g], segments);
+            let mut vec = pack(&vkeys, keys, [0.0; KEY_STRIDE]);
+            let mut hq = pack(&hrows, keys, IDENTITY_PAD);
+            let (mut qvec, mut qhq) = (None, None);
+            if options.quantize {
+                let (q, err) = Quantized::new(&vec, keys, vec_blocks, KEY_STRIDE);
+                for (lane, (track, _, _)) in vec_rows[g].iter().enumerate() {
+                    let e = |j: usize| err[(lane / 8) * KEY_STRIDE + j][lane % 8];
+                    let bound = e(0) + 4.0 / 27.0 * (e(1) + e(2));
+                    quant_error[*track] = quant_error[*track].max(bound);
+                }
+                let (qr, err) = Quantized::new(&hq, keys, hq_blocks, HQ_STRIDE);
+                for (lane, (track, _)) in hq_rows[g].iter().enumerate() {
+                    let e = |j: usize| err[(lane / 8) * HQ_STRIDE + j][lane % 8];
+                    let bound = (0..4)
+                        .map(|c| e(c) + 4.0 / 27.0 * (e(4 + c) + e(8 + c)))
+                        .fold(0.0f32, f32::max);
+                    quant_error[*track] = quant_error[*track].max(2.0 * bound);
+                }
+                scratch = scratch.max(2 * (vec_blocks * KEY_STRIDE).max(hq_blocks * HQ_STRIDE));
+                (qvec, qhq) = (Some(q), Some(qr));
+                vec = Vec::new();
+                hq = Vec::new();
+            }
             groups.push(Group {
                 lanes: [vrows.len(), hq_rows[g].len(), exact.len()],
                 exact_at,
                 exact,
-                vec: pack(&vkeys, keys, [0.0; KEY_STRIDE]),
+                vec,
                 delta,
                 vec_blocks,
                 vec_out,
-                hq: pack(&hrows, keys, IDENTITY_PAD),
+                hq,
                 hq_blocks,
                 hq_out,
+                qvec,
+                qhq,
                 grid,
             });
         }
@@ -629,6 +690,8 @@ impl Clip {
             loose_rot,
             loose_rot_tracks,
             time_range: source.time_range(),
+            quant_error,
+            scratch,
         }
     }
 
@@ -663,6 +726,14 @@ impl Clip {
         self.loose.lanes.len() + self.loose_rot_tracks
     }
 
+    /// The bound on what quantization moves `track`'s samples inside its
+    /// keys, in the track's units (0 for a clip compiled without it, and
+    /// for tracks on their own key times, which are not quantized); see
+    /// [`crate::quant`].
+    pub fn quantization_error(&self, track: TrackId) -> f32 {
+        self.quant_error.get(track.0).copied().unwrap_or(0.0)
+    }
+
     /// First and last key time over all tracks.
     pub fn time_range(&self) -> Option<(f64, f64)> {
         self.time_range
@@ -688,6 +759,8 @@ impl Clip {
                     + size_of_val(g.vec.as_slice())
                     + size_of_val(g.delta.as_slice())
                     + size_of_val(g.hq.as_slice())
+                    + g.qvec.as_ref().map_or(0, Quantized::heap_bytes)
+                    + g.qhq.as_ref().map_or(0, Quantized::heap_bytes)
                     + size_of_val(g.exact_at.as_slice())
                     + size_of_val(g.exact.as_slice())
             })

@@ -6,6 +6,7 @@ use crate::grid::Cursor;
 use crate::kernel;
 use crate::loose::LooseState;
 use crate::pose::Pose;
+use crate::quant::Quantized;
 use crate::rig::{Rig, RigError, RigMap};
 use std::sync::Arc;
 use wide::f32x8;
@@ -19,6 +20,8 @@ pub struct Instance {
     loose: LooseState,
     loose_rot: LooseState,
     pose: Pose,
+    /// Expanded quantized keys (see `crate::quant`).
+    scratch: Vec<f32x8>,
     /// With a rig: the map into its layout and the pose in it.
     rig: Option<Box<(RigMap, Pose)>>,
 }
@@ -31,6 +34,7 @@ impl Instance {
             loose: LooseState::new(&clip.loose),
             loose_rot: LooseState::new(&clip.loose_rot),
             pose: Pose::new(&clip, velocities),
+            scratch: vec![f32x8::ZERO; clip.scratch],
             clip,
             rig: None,
         }
@@ -81,6 +85,7 @@ impl Instance {
             &mut self.loose,
             &mut self.loose_rot,
             &mut self.pose,
+            &mut self.scratch,
         );
         match self.rig.as_deref_mut() {
             Some((map, out)) => {
@@ -100,6 +105,7 @@ pub(crate) fn sample_into(
     loose: &mut LooseState,
     loose_rot: &mut LooseState,
     pose: &mut Pose,
+    scratch: &mut [f32x8],
 ) {
     let Pose {
         values, velocities, ..
@@ -113,7 +119,7 @@ pub(crate) fn sample_into(
         let (ka, kb) = crate::clip::key_pair(&g.grid, seg);
         if g.vec_blocks > 0 {
             let n = g.vec_blocks * kernel::KEY_STRIDE;
-            let (a, b) = (&g.vec[ka * n..(ka + 1) * n], &g.vec[kb * n..(kb + 1) * n]);
+            let (a, b) = keys(&g.vec, g.qvec.as_ref(), n, ka, kb, scratch);
             let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
             kernel::vectors(a, b, &h, out);
             if f.cycles != 0.0 && !g.delta.is_empty() {
@@ -138,9 +144,10 @@ pub(crate) fn sample_into(
                     v[range].fill(f32x8::ZERO);
                 }
             } else {
+                let (a, b) = keys(&g.hq, g.qhq.as_ref(), n, ka, kb, scratch);
                 kernel::hermite_quats(
-                    &g.hq[ka * n..(ka + 1) * n],
-                    &g.hq[kb * n..(kb + 1) * n],
+                    a,
+                    b,
                     &h,
                     &dh,
                     rate,
@@ -175,5 +182,27 @@ pub(crate) fn sample_into(
             &mut values[planes.clone()],
             velocities.as_deref_mut().map(|v| &mut v[planes]),
         );
+    }
+}
+
+/// Keys `ka` and `kb` (`n` vectors each) of a group's controls: slices of
+/// the f32 storage, or, when quantized, expanded into `scratch`.
+#[inline]
+fn keys<'a>(
+    plain: &'a [f32x8],
+    quantized: Option<&Quantized>,
+    n: usize,
+    ka: usize,
+    kb: usize,
+    scratch: &'a mut [f32x8],
+) -> (&'a [f32x8], &'a [f32x8]) {
+    match quantized {
+        None => (&plain[ka * n..(ka + 1) * n], &plain[kb * n..(kb + 1) * n]),
+        Some(q) => {
+            let (a, b) = scratch[..2 * n].split_at_mut(n);
+            q.expand(ka, a);
+            q.expand(kb, b);
+            (a, b)
+        }
     }
 }

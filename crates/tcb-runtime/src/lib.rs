@@ -41,6 +41,7 @@ mod instance;
 mod kernel;
 mod loose;
 pub mod pose;
+pub mod quant;
 pub mod rig;
 pub mod skeleton;
 
@@ -48,7 +49,7 @@ pub mod skeleton;
 pub mod batch;
 
 pub use blend::{BlendMask, blend};
-pub use clip::{Clip, ClipStats, GridStats, TrackId, TrackSlot};
+pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
 pub use instance::Instance;
 pub use pose::Pose;
 pub use rig::{Rig, RigError, RigTrack};

@@ -583,3 +583,66 @@ fn batch_equals_sequential() {
         }
     }
 }
+
+/// Quantized clips stay within the bound each track reports, against the
+/// same clip compiled in f32, inside each track's keys: every kind, mode,
+/// ease and channel count; and the bound is not vacuous.
+#[test]
+fn quantized_clips_stay_within_their_stated_bound() {
+    let options = tcb_runtime::CompileOptions { quantize: true };
+    let mut bounded = 0;
+    for (seed, channels) in (0..60u64).zip([0, 1, 7, 8, 9, 63, 64, 65].into_iter().cycle()) {
+        let clip = random_clip(seed + 1000, channels);
+        let plain = Arc::new(Clip::compile(&clip));
+        let small = Arc::new(Clip::compile_with(&clip, &options));
+        assert!(
+            small.memory_bytes() <= plain.memory_bytes() || clip.tracks.is_empty() || channels < 8
+        );
+        let (mut a, mut b) = (
+            Instance::new(plain, false),
+            Instance::new(small.clone(), false),
+        );
+        let n = clip.channel_count();
+        let (mut got, mut want) = (vec![0.0; n], vec![0.0; n]);
+        let mut rng = Rng(seed | 1);
+        for _ in 0..200 {
+            let Some((t0, tn)) = clip.time_range() else {
+                break;
+            };
+            let time = rng.f(t0, tn);
+            b.sample(time).write_row(&mut got, None);
+            a.sample(time).write_row(&mut want, None);
+            let mut at = 0;
+            for (i, t) in clip.tracks.iter().enumerate() {
+                let dim = t.data.kind().dim();
+                let (lo, hi) = (t.data.times()[0], *t.data.times().last().unwrap());
+                let bound = small.quantization_error(tcb_runtime::TrackId(i));
+                if bound > 0.0 {
+                    bounded += 1;
+                }
+                if (lo..=hi).contains(&time) {
+                    let (g, w) = (&got[at..at + dim], &want[at..at + dim]);
+                    let sign = if matches!(t.data, TrackData::Quat(_))
+                        && g.iter().zip(w).map(|(x, y)| x * y).sum::<f32>() < 0.0
+                    {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    for c in 0..dim {
+                        let e = (g[c] - sign * w[c]).abs();
+                        assert!(
+                            e <= bound + 2e-6 * w[c].abs().max(1.0),
+                            "seed {seed} {} t={time} component {c}: {} vs {} (bound {bound})",
+                            t.name,
+                            g[c],
+                            w[c]
+                        );
+                    }
+                }
+                at += dim;
+            }
+        }
+    }
+    assert!(bounded > 1000);
+}
