@@ -170,8 +170,6 @@ pub struct Clip {
     pub(crate) time_range: Option<(f64, f64)>,
     /// Per track: the bound on the error quantization adds (0 without).
     pub(crate) quant_error: Vec<f32>,
-    /// f32x8 vectors of scratch an instance needs to expand quantized keys.
-    pub(crate) scratch: usize,
 }
 
 /// Choices made when a clip is compiled.
@@ -565,7 +563,6 @@ impl Clip {
             .collect();
         let mut groups = Vec::with_capacity(grids.len());
         let mut quant_error = vec![0.0f32; source.tracks.len()];
-        let mut scratch = 0usize;
         let mut quat_blocks = Vec::new();
         let mut at = 0usize; // pose block
         for (g, grid) in grids.into_iter().enumerate() {
@@ -637,7 +634,6 @@ impl Clip {
                         .fold(0.0f32, f32::max);
                     quant_error[*track] = quant_error[*track].max(2.0 * bound);
                 }
-                scratch = scratch.max(2 * (vec_blocks * KEY_STRIDE).max(hq_blocks * HQ_STRIDE));
                 (qvec, qhq) = (Some(q), Some(qr));
                 vec = Vec::new();
                 hq = Vec::new();
@@ -691,7 +687,6 @@ impl Clip {
             loose_rot_tracks,
             time_range: source.time_range(),
             quant_error,
-            scratch,
         }
     }
 

@@ -20,8 +20,8 @@ pub struct Instance {
     loose: LooseState,
     loose_rot: LooseState,
     pose: Pose,
-    /// Expanded quantized keys (see `crate::quant`).
-    scratch: Vec<f32x8>,
+    /// Per group: expanded quantized keys, vectors then rotations (see `crate::quant`).
+    caches: Vec<[KeyCache; 2]>,
     /// With a rig: the map into its layout and the pose in it.
     rig: Option<Box<(RigMap, Pose)>>,
 }
@@ -34,7 +34,17 @@ impl Instance {
             loose: LooseState::new(&clip.loose),
             loose_rot: LooseState::new(&clip.loose_rot),
             pose: Pose::new(&clip, velocities),
-            scratch: vec![f32x8::ZERO; clip.scratch],
+            caches: clip
+                .groups
+                .iter()
+                .map(|g| {
+                    let n = |q: bool, x: usize| if q { x } else { 0 };
+                    [
+                        KeyCache::new(n(g.qvec.is_some(), g.vec_blocks * kernel::KEY_STRIDE)),
+                        KeyCache::new(n(g.qhq.is_some(), g.hq_blocks * kernel::HQ_STRIDE)),
+                    ]
+                })
+                .collect(),
             clip,
             rig: None,
         }
@@ -85,7 +95,7 @@ impl Instance {
             &mut self.loose,
             &mut self.loose_rot,
             &mut self.pose,
-            &mut self.scratch,
+            &mut self.caches,
         );
         match self.rig.as_deref_mut() {
             Some((map, out)) => {
@@ -105,12 +115,12 @@ pub(crate) fn sample_into(
     loose: &mut LooseState,
     loose_rot: &mut LooseState,
     pose: &mut Pose,
-    scratch: &mut [f32x8],
+    caches: &mut [[KeyCache; 2]],
 ) {
     let Pose {
         values, velocities, ..
     } = pose;
-    for (g, cursor) in clip.groups.iter().zip(cursors.iter_mut()) {
+    for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
         let f = g.grid.frame(time, cursor);
         let h = kernel::splat4(f.h);
         let dh = kernel::splat4(f.dh);
@@ -119,7 +129,7 @@ pub(crate) fn sample_into(
         let (ka, kb) = crate::clip::key_pair(&g.grid, seg);
         if g.vec_blocks > 0 {
             let n = g.vec_blocks * kernel::KEY_STRIDE;
-            let (a, b) = keys(&g.vec, g.qvec.as_ref(), n, ka, kb, scratch);
+            let (a, b) = keys(&g.vec, g.qvec.as_ref(), n, ka, kb, &mut cache[0]);
             let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
             kernel::vectors(a, b, &h, out);
             if f.cycles != 0.0 && !g.delta.is_empty() {
@@ -144,7 +154,7 @@ pub(crate) fn sample_into(
                     v[range].fill(f32x8::ZERO);
                 }
             } else {
-                let (a, b) = keys(&g.hq, g.qhq.as_ref(), n, ka, kb, scratch);
+                let (a, b) = keys(&g.hq, g.qhq.as_ref(), n, ka, kb, &mut cache[1]);
                 kernel::hermite_quats(
                     a,
                     b,
@@ -185,8 +195,26 @@ pub(crate) fn sample_into(
     }
 }
 
+/// Expanded quantized keys of one group, two slots (forward playback
+/// reuses the previous frame's second key as this one's first).
+#[derive(Clone, Debug)]
+pub(crate) struct KeyCache {
+    keys: [usize; 2],
+    data: Vec<f32x8>,
+}
+
+impl KeyCache {
+    pub fn new(n: usize) -> Self {
+        KeyCache {
+            keys: [usize::MAX; 2],
+            data: vec![f32x8::ZERO; 2 * n],
+        }
+    }
+}
+
 /// Keys `ka` and `kb` (`n` vectors each) of a group's controls: slices of
-/// the f32 storage, or, when quantized, expanded into `scratch`.
+/// the f32 storage, or, when quantized, expanded into the cache (only the
+/// keys it does not hold yet).
 #[inline]
 fn keys<'a>(
     plain: &'a [f32x8],
@@ -194,15 +222,22 @@ fn keys<'a>(
     n: usize,
     ka: usize,
     kb: usize,
-    scratch: &'a mut [f32x8],
+    cache: &'a mut KeyCache,
 ) -> (&'a [f32x8], &'a [f32x8]) {
-    match quantized {
-        None => (&plain[ka * n..(ka + 1) * n], &plain[kb * n..(kb + 1) * n]),
-        Some(q) => {
-            let (a, b) = scratch[..2 * n].split_at_mut(n);
-            q.expand(ka, a);
-            q.expand(kb, b);
-            (a, b)
+    let Some(q) = quantized else {
+        return (&plain[ka * n..(ka + 1) * n], &plain[kb * n..(kb + 1) * n]);
+    };
+    let mut slot_of = |k: usize, keep: usize| -> usize {
+        if let Some(s) = cache.keys.iter().position(|&c| c == k) {
+            return s;
         }
-    }
+        let s = if cache.keys[0] == keep { 1 } else { 0 };
+        q.expand(k, &mut cache.data[s * n..(s + 1) * n]);
+        cache.keys[s] = k;
+        s
+    };
+    let sa = slot_of(ka, kb);
+    let sb = slot_of(kb, ka);
+    let d = &cache.data;
+    (&d[sa * n..(sa + 1) * n], &d[sb * n..(sb + 1) * n])
 }

@@ -646,3 +646,22 @@ fn quantized_clips_stay_within_their_stated_bound() {
     }
     assert!(bounded > 1000);
 }
+
+/// Quantized playback forward (keys expanded once and reused) equals
+/// random access (a fresh instance per time), bit for bit.
+#[test]
+fn quantized_forward_playback_equals_random_access() {
+    let options = tcb_runtime::CompileOptions { quantize: true };
+    for seed in 0..20u64 {
+        let clip = random_clip(seed + 77, 9 + seed as usize);
+        let small = Arc::new(Clip::compile_with(&clip, &options));
+        let mut playing = Instance::new(small.clone(), true);
+        let (t0, tn) = clip.time_range().unwrap();
+        for i in 0..300 {
+            let t = t0 - 0.5 + (tn - t0 + 1.0) * i as f64 / 300.0;
+            let mut fresh = Instance::new(small.clone(), true);
+            let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
+            assert_eq!(p.as_slice(), q.as_slice(), "seed {seed} t={t}");
+        }
+    }
+}
