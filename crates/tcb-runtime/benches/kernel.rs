@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 use std::hint::black_box;
 use std::sync::Arc;
 use tcb_core::{NamedTrack, RotationMode, RotationTrack, Track, TrackData, TrackSettings};
-use tcb_runtime::{Clip, Instance};
+use tcb_runtime::{Clip, CompileOptions, Instance, Rig, blend};
 
 fn times(n: usize, seed: u64) -> Vec<f64> {
     let mut x = seed;
@@ -42,7 +42,44 @@ fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::Clip {
     }
 }
 
+/// `count` rotations, each on key times of its own.
+fn sparse_rotations(count: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
+    let s = TrackSettings {
+        rotation: mode,
+        ..Default::default()
+    };
+    let tracks = (0..count)
+        .map(|i| {
+            let t = times(keys, i as u64 + 1);
+            let q = (0..keys)
+                .map(|k| {
+                    Quat::from_euler(
+                        glam::EulerRot::ZXY,
+                        (k + i) as f32 * 0.05,
+                        k as f32 * 0.03,
+                        0.2,
+                    )
+                })
+                .collect();
+            NamedTrack {
+                name: format!("r{i}"),
+                data: TrackData::Quat(RotationTrack::new(t, q, vec![], &s).unwrap()),
+            }
+        })
+        .collect();
+    tcb_core::Clip {
+        name: "sparse-rotations".into(),
+        tracks,
+    }
+}
+
 fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
+    skeleton_turning(joints, keys, mode, 1.0)
+}
+
+/// As `skeleton`, the rotation between keys `turn` times larger (large
+/// turns put squad segments on the exact f64 path).
+fn skeleton_turning(joints: usize, keys: usize, mode: RotationMode, turn: f32) -> tcb_core::Clip {
     let s = TrackSettings {
         rotation: mode,
         ..Default::default()
@@ -67,8 +104,8 @@ fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
             .map(|k| {
                 Quat::from_euler(
                     glam::EulerRot::ZXY,
-                    (k + j) as f32 * 0.05,
-                    k as f32 * 0.03,
+                    (k + j) as f32 * 0.05 * turn,
+                    k as f32 * 0.03 * turn,
                     0.2,
                 )
             })
@@ -85,7 +122,17 @@ fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
 }
 
 fn play(c: &mut Criterion, group: &str, clip: &tcb_core::Clip, channels: u64) {
-    let compiled = Arc::new(Clip::compile(clip));
+    play_with(c, group, clip, channels, &CompileOptions::default());
+}
+
+fn play_with(
+    c: &mut Criterion,
+    group: &str,
+    clip: &tcb_core::Clip,
+    channels: u64,
+    options: &CompileOptions,
+) {
+    let compiled = Arc::new(Clip::compile_with(clip, options));
     let (a, b) = clip.time_range().unwrap();
     let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(channels));
@@ -125,6 +172,70 @@ fn benches(c: &mut Criterion) {
         &skeleton(31, 200, RotationMode::Squad),
         31,
     );
+    // Squad with large turns between keys: the exact f64 lanes.
+    let turning = skeleton_turning(31, 200, RotationMode::Squad, 30.0);
+    assert!(Clip::compile(&turning).stats().exact_segments > 1000);
+    play(c, "skeleton_squad_exact", &turning, 31);
+    let quantize = CompileOptions { quantize: true };
+    play_with(
+        c,
+        "skeleton_hermite_quantized",
+        &skeleton(31, 200, RotationMode::Hermite),
+        31,
+        &quantize,
+    );
+    play_with(
+        c,
+        "wide_quantized",
+        &scalar_tracks(10_000, 64, true),
+        10_000,
+        &quantize,
+    );
+    for (name, mode) in [
+        ("sparse_rotations_hermite", RotationMode::Hermite),
+        ("sparse_rotations_squad", RotationMode::Squad),
+    ] {
+        play(c, name, &sparse_rotations(64, 64, mode), 64);
+    }
+    rig_and_blend(c);
+}
+
+/// Sampling through a rig (the copy into rig order), blending two rig
+/// poses and adding an additive layer.
+fn rig_and_blend(c: &mut Criterion) {
+    let clip = skeleton(31, 200, RotationMode::Hermite);
+    let compiled = Arc::new(Clip::compile(&clip));
+    let rig = Arc::new(Rig::from_clip(&compiled));
+    let mut g = c.benchmark_group("rig");
+    g.throughput(Throughput::Elements(31));
+    let (mut a, mut b) = (
+        Instance::with_rig(compiled.clone(), &rig, false).unwrap(),
+        Instance::with_rig(compiled.clone(), &rig, false).unwrap(),
+    );
+    let mut plain = Instance::new(compiled, false);
+    let mut frame = 0u64;
+    g.bench_function("sample_plain", |bench| {
+        bench.iter(|| {
+            frame += 1;
+            black_box(plain.sample(black_box(frame as f64 / 600.0 % 9.0)));
+        })
+    });
+    g.bench_function("sample_through_rig", |bench| {
+        bench.iter(|| {
+            frame += 1;
+            black_box(a.sample(black_box(frame as f64 / 600.0 % 9.0)));
+        })
+    });
+    a.sample(1.0);
+    b.sample(2.0);
+    let mut out = rig.rest_pose(false);
+    g.bench_function("blend_two", |bench| {
+        bench.iter(|| blend(&mut out, &[(a.pose(), 0.3), (b.pose(), 0.7)], None).unwrap())
+    });
+    g.bench_function("add_layer", |bench| {
+        bench.iter(|| tcb_runtime::blend::add(&mut out, a.pose(), b.pose(), 0.5, None).unwrap())
+    });
+    g.finish();
 }
 
 criterion_group!(kernel, benches);
