@@ -59,6 +59,31 @@ fn info_names_tracks_grids_and_bytes() {
         "{out}"
     );
     assert!(out.contains("3 vector channels, 31 rotations"), "{out}");
+    // Quantized: smaller, and every track states its error bound.
+    let q = tcb(&[
+        "info",
+        &file("data/cmu-01_01.bvh"),
+        "--rotation",
+        "hermite",
+        "--quantize",
+    ]);
+    assert!(q.status.success(), "{}", text(&q.stderr));
+    let qout = text(&q.stdout);
+    assert_eq!(
+        qout.matches("quantization error at most").count(),
+        32,
+        "{qout}"
+    );
+    let mb = |s: &str| -> f64 {
+        let line = s.lines().find(|l| l.starts_with("bytes: ")).unwrap();
+        line["bytes: ".len()..]
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert!(mb(&qout) * 1.5 < mb(&out), "{} vs {}", mb(&qout), mb(&out));
 }
 
 #[test]
@@ -74,6 +99,7 @@ fn bench_reports_ns_per_joint_bytes_and_flags() {
         "3",
         "--threads",
         "2",
+        "--quantize",
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
