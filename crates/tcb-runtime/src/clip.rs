@@ -191,18 +191,16 @@ pub(crate) fn plane_slots(out: usize, lane: usize) -> [usize; 4] {
 
 /// A padding lane of loose rotations: the identity at all times.
 fn identity_lane() -> LooseLane {
-    let w = [1.0, 1.0, 0.0, 0.0];
-    LooseLane {
-        grid: TimeGrid {
-            times: vec![0.0, 1.0],
-            eases: vec![SegmentEase::default()],
-            steps: vec![false],
-            pre: Extrapolation::Constant,
-            post: Extrapolation::Constant,
-        },
-        dim: 4,
-        controls: vec![[[0.0; 4], [0.0; 4], [0.0; 4], w]; 3],
-    }
+    let grid = TimeGrid {
+        times: vec![0.0, 1.0],
+        eases: vec![SegmentEase::default()],
+        steps: vec![false],
+        pre: Extrapolation::Constant,
+        post: Extrapolation::Constant,
+    };
+    let zero: Controls = vec![[0.0; 4]; 3];
+    let w: Controls = vec![[1.0, 1.0, 0.0, 0.0]; 3];
+    LooseLane::new(grid, &[&zero, &zero, &zero, &w])
 }
 
 /// Channel controls over the stored segments `0..=n`.
@@ -264,11 +262,13 @@ fn grid_of(data: &TrackData) -> TimeGrid {
         pre: settings.pre,
         post: settings.post,
     }
+    .compact()
 }
 
 type GridKey = (
     Vec<u64>,
-    Vec<(u64, u64, bool)>,
+    Vec<(u64, u64)>,
+    Vec<bool>,
     Extrapolation,
     Extrapolation,
 );
@@ -278,9 +278,9 @@ fn grid_key(g: &TimeGrid) -> GridKey {
         g.times.iter().map(|t| t.to_bits()).collect(),
         g.eases
             .iter()
-            .zip(&g.steps)
-            .map(|(e, &step)| (e.from.to_bits(), e.to.to_bits(), step))
+            .map(|e| (e.from.to_bits(), e.to.to_bits()))
             .collect(),
+        g.steps.clone(),
         g.pre,
         g.post,
     )
@@ -291,7 +291,7 @@ fn grid_key(g: &TimeGrid) -> GridKey {
 /// keys, then the sentinels as four pseudo-keys `pre_a pre_b post_a post_b`
 /// that give back `[P0, P1, M0, M1]` of stored segments 0 and n the same
 /// way (see [`key_pair`]).
-fn per_key(rows: &Controls) -> Vec<[f32; KEY_STRIDE]> {
+pub(crate) fn per_key(rows: &Controls) -> Vec<[f32; KEY_STRIDE]> {
     let n = rows.len() - 1;
     let mut out: Vec<[f32; KEY_STRIDE]> = (0..n)
         .map(|k| {
@@ -321,7 +321,7 @@ pub(crate) fn key_pair(grid: &TimeGrid, seg: usize) -> (usize, usize) {
     match seg {
         0 => (n, n + 1),
         s if s == n => (n + 2, n + 3),
-        s if grid.steps[s - 1] => (s - 1, s - 1),
+        s if grid.is_step(s - 1) => (s - 1, s - 1),
         s => (s - 1, s),
     }
 }
@@ -744,7 +744,11 @@ impl Clip {
     /// no copy of the source clip.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::{size_of, size_of_val};
-        let grid = |g: &TimeGrid| size_of_val(g.times.as_slice()) + size_of_val(g.eases.as_slice());
+        let grid = |g: &TimeGrid| {
+            size_of_val(g.times.as_slice())
+                + size_of_val(g.eases.as_slice())
+                + size_of_val(g.steps.as_slice())
+        };
         let groups: usize = self
             .groups
             .iter()

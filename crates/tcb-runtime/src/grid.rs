@@ -34,10 +34,11 @@ use tcb_core::track::segment_from;
 pub struct TimeGrid {
     /// Key times (n >= 2, strictly increasing).
     pub times: Vec<f64>,
-    /// Ease of each of the n-1 segments.
+    /// Ease of each of the n-1 segments, or empty when no segment eases.
     pub eases: Vec<SegmentEase>,
     /// Whether each of the n-1 segments is `step` in every channel of the
-    /// group (they hold the segment's first key: the kernels read it twice).
+    /// group (they hold the segment's first key: the kernels read it
+    /// twice), or empty when none is.
     pub steps: Vec<bool>,
     /// Before the first key.
     pub pre: Extrapolation,
@@ -91,6 +92,29 @@ impl TimeGrid {
         self.times.len()
     }
 
+    /// The ease of segment `k`.
+    #[inline]
+    pub fn ease(&self, k: usize) -> SegmentEase {
+        self.eases.get(k).copied().unwrap_or_default()
+    }
+
+    /// Whether segment `k` is `step`.
+    #[inline]
+    pub fn is_step(&self, k: usize) -> bool {
+        self.steps.get(k).copied().unwrap_or(false)
+    }
+
+    /// The same grid with `eases` and `steps` emptied where they say nothing.
+    pub fn compact(mut self) -> Self {
+        if self.eases.iter().all(SegmentEase::is_none) {
+            self.eases = Vec::new();
+        }
+        if !self.steps.contains(&true) {
+            self.steps = Vec::new();
+        }
+        self
+    }
+
     /// Segment k with `times[k] <= time < times[k+1]`, starting from the
     /// cursor ([`tcb_core::track::segment_from`]).
     #[inline]
@@ -116,10 +140,10 @@ impl TimeGrid {
                     let k = self.locate(time, cursor);
                     let d = self.times[k + 1] - self.times[k];
                     let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
-                    let (s, ds_du) = self.eases[k].apply(u);
+                    let (s, ds_du) = self.ease(k).apply(u);
                     let s32 = s as f32;
                     let (mut h, mut dh) = (hermite_basis(s32), hermite_basis_derivative(s32));
-                    if self.steps[k] {
+                    if self.is_step(k) {
                         // A step segment reads its first key twice (see
                         // `clip::key_pair`); that key's TI belongs to the
                         // segment before, so its weight is zero here.

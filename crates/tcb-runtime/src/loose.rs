@@ -18,7 +18,9 @@
 //! The stored segments and sentinel rows are those of [`crate::grid`]; the
 //! time mapping is [`tcb_core::extrapolate::map_lanes`], the reference's own.
 
+use crate::clip::{key_pair, per_key};
 use crate::grid::TimeGrid;
+use crate::kernel::KEY_STRIDE;
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::ease;
@@ -39,22 +41,41 @@ pub(crate) struct LooseLane {
     pub grid: TimeGrid,
     /// Components used (1 to 4).
     pub dim: usize,
-    /// Per stored segment `0..=n`, per component: `[P0, P1, M0, M1]`.
-    pub controls: Vec<[[f32; 4]; 4]>,
+    /// Per key (and sentinel pseudo-key, see `clip::per_key`), per
+    /// component: `[P, TO, TI]`, at `keys[key * dim + c]`.
+    pub keys: Vec<[f32; KEY_STRIDE]>,
 }
 
 impl LooseLane {
     /// A lane on `grid` from its components' controls per stored segment
-    /// (`[P0, P1, M0, M1]` each, as `clip.rs` builds them for every track).
+    /// (`[P0, P1, M0, M1]` each, as `clip.rs` builds them for every track),
+    /// stored per key.
     pub fn new(grid: TimeGrid, comps: &[&Vec<[f32; 4]>]) -> Self {
-        let controls = (0..comps[0].len())
-            .map(|seg| std::array::from_fn(|c| comps.get(c).map_or([0.0; 4], |r| r[seg])))
+        let per: Vec<Vec<[f32; KEY_STRIDE]>> = comps.iter().map(|r| per_key(r)).collect();
+        let dim = comps.len();
+        let keys = (0..per[0].len() * dim)
+            .map(|i| per[i % dim][i / dim])
             .collect();
-        LooseLane {
-            grid,
-            dim: comps.len(),
-            controls,
-        }
+        LooseLane { grid, dim, keys }
+    }
+
+    /// `[P0, P1, M0, M1]` of every component on stored segment `seg`
+    /// (components past `dim` zero).
+    #[inline]
+    fn segment(&self, seg: usize) -> [[f32; 4]; 4] {
+        let (ka, kb) = key_pair(&self.grid, seg);
+        let n = self.grid.times.len();
+        // A step segment reads its first key twice; that key's TI belongs
+        // to the segment before.
+        let step = (1..n).contains(&seg) && self.grid.is_step(seg - 1);
+        let (a, b) = (&self.keys[ka * self.dim..], &self.keys[kb * self.dim..]);
+        std::array::from_fn(|c| {
+            if c < self.dim {
+                [a[c][0], b[c][0], a[c][1], if step { 0.0 } else { b[c][2] }]
+            } else {
+                [0.0; 4]
+            }
+        })
     }
 }
 
@@ -89,7 +110,8 @@ impl Loose {
                 size_of::<LooseLane>()
                     + size_of_val(l.grid.times.as_slice())
                     + size_of_val(l.grid.eases.as_slice())
-                    + size_of_val(l.controls.as_slice())
+                    + size_of_val(l.grid.steps.as_slice())
+                    + size_of_val(l.keys.as_slice())
             })
             .sum();
         lanes
@@ -130,8 +152,11 @@ impl Loose {
             for c in 0..4 {
                 delta[4 * b + c] = f32x8::new(std::array::from_fn(|l| {
                     lane(8 * b + l).map_or(0.0, |x| {
-                        let n = x.controls.len();
-                        x.controls[n - 1][c][0] - x.controls[0][c][0]
+                        if c >= x.dim {
+                            return 0.0;
+                        }
+                        let n = x.grid.times.len();
+                        x.keys[(n - 1) * x.dim + c][0] - x.keys[c][0]
                     })
                 }));
             }
@@ -229,7 +254,7 @@ impl LooseState {
             s => (t[s - 1], t[s]),
         };
         let ease = if (1..n).contains(&seg) {
-            lane.grid.eases[seg - 1]
+            lane.grid.ease(seg - 1)
         } else {
             Default::default()
         };
@@ -240,11 +265,11 @@ impl LooseState {
         self.seg[l] = seg;
         let (b, i) = (l / 8, l % 8);
         let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl[b * CTL..(b + 1) * CTL]);
-        let src = &lane.controls[seg];
+        let src = lane.segment(seg);
         // Only the components the track has (the rest stay zero).
-        for c in 0..lane.dim {
+        for (c, src) in src.iter().enumerate().take(lane.dim) {
             for j in 0..4 {
-                ctl[(4 * c + j) * 8 + i] = src[c][j];
+                ctl[(4 * c + j) * 8 + i] = src[j];
             }
         }
     }
