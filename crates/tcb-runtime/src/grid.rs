@@ -27,6 +27,7 @@ use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::SegmentEase;
 use tcb_core::extrapolate::{Mapped, map_time};
+use tcb_core::lane::Lane;
 use tcb_core::track::segment_from;
 
 /// Key times, segment eases and extrapolation shared by a group of channels.
@@ -64,20 +65,6 @@ pub struct FrameBasis {
     pub cycles: f32,
     /// `reset` extrapolation: zero, identity for rotations.
     pub reset: bool,
-}
-
-impl FrameBasis {
-    fn fixed(segment: usize, h: [f32; 4], dh: [f32; 4], rate: f32) -> Self {
-        FrameBasis {
-            segment,
-            s: 0.0,
-            h,
-            dh,
-            rate,
-            cycles: 0.0,
-            reset: false,
-        }
-    }
 }
 
 /// Where a group's playback is: the last real segment found. Forward
@@ -128,60 +115,101 @@ impl TimeGrid {
     pub fn frame(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
         let n = self.times.len();
         let (t0, tn) = (self.times[0], self.times[n - 1]);
-        match map_time(time, t0, tn, self.pre, self.post) {
+        // Which row of the table (module docs), and the stored segment.
+        let (mut real, mut line, mut reset, mut hold, mut step) =
+            (false, false, false, false, false);
+        let (mut s, mut rate, mut dir, mut dt, mut cyc) = (0.0f64, 0.0f32, 1.0f32, 0.0f32, 0.0f32);
+        let segment = match map_time(time, t0, tn, self.pre, self.post) {
             Mapped::Inside {
                 time,
                 direction,
                 cycles,
             } => {
-                let mut f = if time >= tn {
-                    FrameBasis::fixed(n, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], 1.0)
+                dir = direction as f32;
+                cyc = cycles as f32;
+                if time >= tn {
+                    n
                 } else {
                     let k = self.locate(time, cursor);
                     let d = self.times[k + 1] - self.times[k];
                     let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
-                    let (s, ds_du) = self.ease(k).apply(u);
-                    let s32 = s as f32;
-                    let (mut h, mut dh) = (hermite_basis(s32), hermite_basis_derivative(s32));
-                    if self.is_step(k) {
-                        // A step segment reads its first key twice (see
-                        // `clip::key_pair`); that key's TI belongs to the
-                        // segment before, so its weight is zero here.
-                        h[3] = 0.0;
-                        dh[3] = 0.0;
-                    }
-                    FrameBasis {
-                        segment: k + 1,
-                        s,
-                        h,
-                        dh,
-                        rate: (ds_du / d) as f32,
-                        cycles: 0.0,
-                        reset: false,
-                    }
-                };
-                f.rate *= direction as f32;
-                f.cycles = cycles as f32;
-                f
+                    let (eased, ds_du) = self.ease(k).apply(u);
+                    (real, step, s) = (true, self.is_step(k), eased);
+                    rate = (ds_du / d) as f32 * dir;
+                    k + 1
+                }
             }
-            Mapped::Hold { last } => FrameBasis::fixed(
-                if last { n } else { 0 },
-                [1.0, 0.0, 0.0, 0.0],
-                [0.0; 4],
-                0.0,
-            ),
-            Mapped::Reset => FrameBasis {
-                reset: true,
-                ..FrameBasis::fixed(0, [0.0; 4], [0.0; 4], 0.0)
-            },
-            Mapped::Line { last, dt } => FrameBasis::fixed(
-                if last { n } else { 0 },
-                [1.0, 0.0, dt as f32, 0.0],
-                [0.0, 0.0, 1.0, 0.0],
-                1.0,
-            ),
+            Mapped::Hold { last } => {
+                hold = true;
+                if last { n } else { 0 }
+            }
+            Mapped::Reset => {
+                reset = true;
+                0
+            }
+            Mapped::Line { last, dt: d } => {
+                (line, dt) = (true, d as f32);
+                if last { n } else { 0 }
+            }
+        };
+        let (h, dh, rate) =
+            sentinel_rows(real, line, reset, hold, step, s as f32, rate, dir, dt, true);
+        FrameBasis {
+            segment,
+            s,
+            h,
+            dh,
+            rate,
+            cycles: cyc,
+            reset,
         }
     }
+}
+
+/// The rows of the table in the module docs, for any lane type: lanes in
+/// a `real` segment take the basis at `s` (its `h4`/`h4'` zero on `step`
+/// segments, whose first key is read twice) and `rate` (with the
+/// direction in it); `line`, `reset` and `hold` lanes their fixed rows; the
+/// rest are exactly at the last key (`dir` carries `oscillate`'s sign).
+/// The one copy for the per-group frame (`f32`) and the loose lanes (`f32x8`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn sentinel_rows<L: Lane>(
+    real: L::Mask,
+    line: L::Mask,
+    reset: L::Mask,
+    hold: L::Mask,
+    step: L::Mask,
+    s: L,
+    rate: L,
+    dir: L,
+    dt: L,
+    velocity: bool,
+) -> ([L; 4], [L; 4], L) {
+    let (z, o) = (L::of(0.0), L::of(1.0));
+    let at_end = !(real | line | reset | hold);
+    let curve = real & !step;
+    let hb = hermite_basis(s);
+    let db = if velocity {
+        hermite_basis_derivative(s)
+    } else {
+        [z; 4]
+    };
+    (
+        [
+            L::select(real, hb[0], L::select(reset, z, o)),
+            L::select(real, hb[1], z),
+            L::select(real, hb[2], L::select(line, dt, z)),
+            L::select(curve, hb[3], z),
+        ],
+        [
+            L::select(real, db[0], z),
+            L::select(real, db[1], z),
+            L::select(real, db[2], L::select(line, o, z)),
+            L::select(curve, db[3], L::select(at_end, o, z)),
+        ],
+        L::select(real, rate, L::select(line, o, L::select(at_end, dir, z))),
+    )
 }
 
 #[cfg(test)]

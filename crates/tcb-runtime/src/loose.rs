@@ -19,7 +19,7 @@
 //! time mapping is [`tcb_core::extrapolate::map_lanes`], the reference's own.
 
 use crate::clip::{key_pair, per_key};
-use crate::grid::TimeGrid;
+use crate::grid::{TimeGrid, sentinel_rows};
 use crate::kernel::KEY_STRIDE;
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
@@ -439,32 +439,26 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: 
     let line = mask_of(line[0], line[1]);
     let reset = mask_of(reset[0], reset[1]);
     let hold = mask_of(hold[0], hold[1]);
-    let at_end = !(realm | line | reset | hold);
     let s32 = f32x8_of(s[0], s[1]);
-    let hb = hermite_basis(s32);
-    let db = derivative_rows(s32, velocity);
-    let (z, o) = (f32x8::ZERO, f32x8::ONE);
-    let dt = f32x8_of(dt[0], dt[1]);
     let dirs = f32x8_of(dir[0], dir[1]);
     let cyc = f32x8_of(cycles[0], cycles[1]);
+    let (h, dh, rate) = sentinel_rows(
+        realm,
+        line,
+        reset,
+        hold,
+        f32x8::ZERO, // step segments: M1 is zero in the lane's cached controls
+        s32,
+        f32x8_of(rate[0], rate[1]),
+        dirs,
+        f32x8_of(dt[0], dt[1]),
+        velocity,
+    );
     Rows {
-        h: [
-            realm.select(hb[0], reset.select(z, o)),
-            realm.select(hb[1], z),
-            realm.select(hb[2], line.select(dt, z)),
-            realm.select(hb[3], z),
-        ],
-        dh: [
-            realm.select(db[0], z),
-            realm.select(db[1], z),
-            realm.select(db[2], line.select(o, z)),
-            realm.select(db[3], at_end.select(o, z)),
-        ],
-        rate: realm.select(
-            f32x8_of(rate[0], rate[1]),
-            line.select(o, at_end.select(dirs, z)),
-        ),
-        any_cycles: cyc.simd_ne(z).any(),
+        h,
+        dh,
+        rate,
+        any_cycles: cyc.simd_ne(f32x8::ZERO).any(),
         cycles: cyc,
     }
 }
