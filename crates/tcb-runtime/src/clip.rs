@@ -175,10 +175,10 @@ pub struct Clip {
 /// Choices made when a clip is compiled.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CompileOptions {
-    /// Store the controls of tracks on shared key grids in 16 bits per
-    /// component with a per-channel range (see [`crate::quant`] for the
-    /// error bound, [`Clip::quantization_error`] for each track's).
-    /// Tracks on their own key times stay in f32.
+    /// Store the controls in 16 bits per component with a per-channel
+    /// range (see [`crate::quant`] for the error bound,
+    /// [`Clip::quantization_error`] for each track's). Tracks on their own
+    /// key times are expanded only when they cross a key.
     pub quantize: bool,
 }
 
@@ -658,6 +658,23 @@ impl Clip {
         for (lane, (track, _)) in loose_lanes.iter().enumerate() {
             slots[*track].index = plane_slots(at, lane);
         }
+        // Quantized: loose lanes too (expanded only on key crossings).
+        let mut quantize_lane = |track: usize, lane: &mut LooseLane, rotation: bool| {
+            if options.quantize {
+                let bound = lane
+                    .quantize()
+                    .iter()
+                    .map(|e| e[0] + 4.0 / 27.0 * (e[1] + e[2]))
+                    .fold(0.0f32, f32::max);
+                quant_error[track] = if rotation { 2.0 * bound } else { bound };
+            }
+        };
+        for (track, lane) in &mut loose_lanes {
+            quantize_lane(*track, lane, false);
+        }
+        for (track, lane) in &mut loose_rots {
+            quantize_lane(*track, lane, true);
+        }
         let loose = Loose::new(loose_lanes.into_iter().map(|(_, l)| l).collect(), at);
         at += 4 * loose.blocks;
         // Loose rotations: planes of 8 lanes, blended as rotations.
@@ -722,8 +739,7 @@ impl Clip {
     }
 
     /// The bound on what quantization moves `track`'s samples inside its
-    /// keys, in the track's units (0 for a clip compiled without it, and
-    /// for tracks on their own key times, which are not quantized); see
+    /// keys, in the track's units (0 for a clip compiled without it); see
     /// [`crate::quant`].
     pub fn quantization_error(&self, track: TrackId) -> f32 {
         self.quant_error.get(track.0).copied().unwrap_or(0.0)

@@ -42,8 +42,20 @@ pub(crate) struct LooseLane {
     /// Components used (1 to 4).
     pub dim: usize,
     /// Per key (and sentinel pseudo-key, see `clip::per_key`), per
-    /// component: `[P, TO, TI]`, at `keys[key * dim + c]`.
-    pub keys: Vec<[f32; KEY_STRIDE]>,
+    /// component: `[P, TO, TI]`, at `key(key * dim + c)`.
+    keys: Keys,
+}
+
+/// A loose lane's keys, in f32 or in 16 bits with a range per component
+/// and control (see [`crate::quant`]; expanded only when a lane crosses a key).
+#[derive(Clone, Debug)]
+enum Keys {
+    F32(Vec<[f32; KEY_STRIDE]>),
+    U16 {
+        q: Vec<[u16; KEY_STRIDE]>,
+        min: Vec<[f32; KEY_STRIDE]>,
+        scale: Vec<[f32; KEY_STRIDE]>,
+    },
 }
 
 impl LooseLane {
@@ -56,7 +68,77 @@ impl LooseLane {
         let keys = (0..per[0].len() * dim)
             .map(|i| per[i % dim][i / dim])
             .collect();
-        LooseLane { grid, dim, keys }
+        LooseLane {
+            grid,
+            dim,
+            keys: Keys::F32(keys),
+        }
+    }
+
+    /// Entry `i` (`key * dim + c`) of the keys.
+    #[inline]
+    pub fn key(&self, i: usize) -> [f32; KEY_STRIDE] {
+        match &self.keys {
+            Keys::F32(k) => k[i],
+            Keys::U16 { q, min, scale } => {
+                let c = i % self.dim;
+                std::array::from_fn(|j| min[c][j] + f32::from(q[i][j]) * scale[c][j])
+            }
+        }
+    }
+
+    /// Heap bytes of the keys.
+    fn key_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        match &self.keys {
+            Keys::F32(k) => size_of_val(k.as_slice()),
+            Keys::U16 { q, min, scale } => {
+                size_of_val(q.as_slice())
+                    + size_of_val(min.as_slice())
+                    + size_of_val(scale.as_slice())
+            }
+        }
+    }
+
+    /// Store the keys in 16 bits (as [`crate::quant`] does for groups) and
+    /// return, per component, the largest error made on `[P, TO, TI]`.
+    pub fn quantize(&mut self) -> Vec<[f32; KEY_STRIDE]> {
+        let Keys::F32(keys) = &self.keys else {
+            return vec![[0.0; KEY_STRIDE]; self.dim];
+        };
+        let dim = self.dim;
+        let mut min = vec![[f32::INFINITY; KEY_STRIDE]; dim];
+        let mut max = vec![[f32::NEG_INFINITY; KEY_STRIDE]; dim];
+        for (i, k) in keys.iter().enumerate() {
+            for j in 0..KEY_STRIDE {
+                min[i % dim][j] = min[i % dim][j].min(k[j]);
+                max[i % dim][j] = max[i % dim][j].max(k[j]);
+            }
+        }
+        let scale: Vec<[f32; KEY_STRIDE]> = (0..dim)
+            .map(|c| std::array::from_fn(|j| (max[c][j] - min[c][j]) / 65535.0))
+            .collect();
+        let mut error = vec![[0.0f32; KEY_STRIDE]; dim];
+        let q = keys
+            .iter()
+            .enumerate()
+            .map(|(i, k)| {
+                let c = i % dim;
+                std::array::from_fn(|j| {
+                    let (lo, s) = (min[c][j], scale[c][j]);
+                    let q = if s > 0.0 {
+                        ((k[j] - lo) / s).round().clamp(0.0, 65535.0) as u16
+                    } else {
+                        0
+                    };
+                    let e = &mut error[c][j];
+                    *e = e.max((lo + f32::from(q) * s - k[j]).abs());
+                    q
+                })
+            })
+            .collect();
+        self.keys = Keys::U16 { q, min, scale };
+        error
     }
 
     /// `[P0, P1, M0, M1]` of every component on stored segment `seg`
@@ -68,10 +150,10 @@ impl LooseLane {
         // A step segment reads its first key twice; that key's TI belongs
         // to the segment before.
         let step = (1..n).contains(&seg) && self.grid.is_step(seg - 1);
-        let (a, b) = (&self.keys[ka * self.dim..], &self.keys[kb * self.dim..]);
         std::array::from_fn(|c| {
             if c < self.dim {
-                [a[c][0], b[c][0], a[c][1], if step { 0.0 } else { b[c][2] }]
+                let (a, b) = (self.key(ka * self.dim + c), self.key(kb * self.dim + c));
+                [a[0], b[0], a[1], if step { 0.0 } else { b[2] }]
             } else {
                 [0.0; 4]
             }
@@ -111,7 +193,7 @@ impl Loose {
                     + size_of_val(l.grid.times.as_slice())
                     + size_of_val(l.grid.eases.as_slice())
                     + size_of_val(l.grid.steps.as_slice())
-                    + size_of_val(l.keys.as_slice())
+                    + l.key_bytes()
             })
             .sum();
         lanes
@@ -156,7 +238,7 @@ impl Loose {
                             return 0.0;
                         }
                         let n = x.grid.times.len();
-                        x.keys[(n - 1) * x.dim + c][0] - x.keys[c][0]
+                        x.key((n - 1) * x.dim + c)[0] - x.key(c)[0]
                     })
                 }));
             }

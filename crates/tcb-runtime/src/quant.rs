@@ -15,8 +15,10 @@
 //! most `e_P + 4/27 (e_TO + e_TI)` (the bound [`crate::Clip::quantization_error`]
 //! reports; rotations are normalized after, which at most doubles it for
 //! curves within 1% of unit length). Linear extrapolation adds `|dt| e_TO`.
-//! The kernels themselves are unchanged: each frame the two keys a group
-//! reads are expanded into a scratch buffer in the instance.
+//! The kernels themselves are unchanged: an instance expands the two keys a
+//! group reads into a two-slot cache (forward playback expands one key per
+//! crossing), and a track on its own key times expands its segment into its
+//! lane's cached controls when it crosses a key (`loose.rs`).
 
 use wide::{f32x8, i32x8, u16x8};
 
