@@ -147,19 +147,24 @@ impl Scenario {
     }
 
     /// One pass of the read limit: per frame, the runtime's number of
-    /// coefficient bytes, at the frame's segment of an array of the clip's
-    /// size, summed (no arithmetic beyond the adds).
+    /// coefficient bytes (two neighbouring keys, which lie next to each
+    /// other in memory) of an array laid out per key like the clip's,
+    /// summed (no arithmetic beyond the adds).
     pub fn read_pass(&self) -> impl FnMut() + '_ {
         let per_frame = self.clip.bytes_per_frame() / 32;
+        let per_key = per_frame / 2;
         let keys = self.source.key_times();
-        let segments = keys.len() + 1;
-        let data: Vec<f32x8> = (0..segments * per_frame)
+        let n = keys.len().max(2);
+        let data: Vec<f32x8> = (0..(n + 4) * per_key)
             .map(|i| f32x8::splat(i as f32 * 1e-9))
             .collect();
         move || {
             for &t in &self.times {
-                let seg = keys.partition_point(|&k| k <= t).min(segments - 1);
-                let block = &data[seg * per_frame..(seg + 1) * per_frame];
+                let k = keys
+                    .partition_point(|&x| x <= t)
+                    .saturating_sub(1)
+                    .min(n - 2);
+                let block = &data[k * per_key..k * per_key + per_frame];
                 let mut acc = [f32x8::ZERO; 4];
                 for c in block.chunks_exact(4) {
                     for i in 0..4 {

@@ -77,7 +77,12 @@ struct BenchArgs {
     #[arg(long)]
     quantize: bool,
     /// Frames per second of playback.
-    #[arg(long, value_name = "FPS", default_value_t = 60.0)]
+    #[arg(
+        long,
+        value_name = "FPS",
+        default_value_t = 60.0,
+        allow_hyphen_values = true
+    )]
     fps: f64,
     /// Instances at random phases (more than 1 also times them with rayon).
     #[arg(long, value_name = "N", default_value_t = 1)]

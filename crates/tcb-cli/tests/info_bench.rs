@@ -121,6 +121,7 @@ fn bench_and_info_refuse_bad_input() {
     for args in [
         vec!["bench", &bounce, "--fps", "0"],
         vec!["bench", &bounce, "--fps", "nan"],
+        vec!["bench", &bounce, "--fps", "-1"],
         vec!["bench", &bounce, "--instances", "0"],
         vec!["bench", &bounce, "--threads", "0"],
         vec!["bench", &bounce, "--rotation", "hermite"],

@@ -136,12 +136,15 @@ fn same_layout(a: &Arc<PoseLayout>, b: &Arc<PoseLayout>) -> bool {
     Arc::ptr_eq(a, b) || **a == **b
 }
 
-/// Whether pose block `b` is one of the x/y/z/w planes of 8 rotations.
+/// The pose blocks that are not x/y/z/w planes of rotations, walking
+/// `quat_blocks` (sorted) alongside: no search per block.
 #[inline]
-fn rotation_block(layout: &PoseLayout, b: usize) -> bool {
-    let q = &layout.quat_blocks;
-    let i = q.partition_point(|&s| s <= b);
-    i > 0 && b < q[i - 1] + 4
+fn vector_blocks(layout: &PoseLayout) -> impl Iterator<Item = usize> + '_ {
+    let mut q = layout.quat_blocks.iter().peekable();
+    (0..layout.blocks).filter(move |&b| {
+        while q.next_if(|&&s| b >= s + 4).is_some() {}
+        q.peek().is_none_or(|&&s| b < s)
+    })
 }
 
 /// Blend `layers` (pose, weight) into `out`, with an optional mask per layer.
@@ -181,7 +184,7 @@ pub fn blend(
     let with_velocity = out.velocities.is_some() && layers.iter().all(|l| l.0.velocities.is_some());
 
     // Vectors.
-    for b in (0..layout.blocks).filter(|&b| !rotation_block(&layout, b)) {
+    for b in vector_blocks(&layout) {
         let mut sum = f32x8::ZERO;
         let mut acc = f32x8::ZERO;
         let mut vacc = f32x8::ZERO;
@@ -286,7 +289,7 @@ pub fn add(
         Some(l) if pose.velocities.is_some() => Some((l, reference.velocities.as_ref())),
         _ => None,
     };
-    for b in (0..layout.blocks).filter(|&b| !rotation_block(&layout, b)) {
+    for b in vector_blocks(&layout) {
         let w = w_at(b);
         pose.values[b] += w * (layer.values[b] - reference.values[b]);
         if let (Some((l, r)), Some(v)) = (vel, pose.velocities.as_mut()) {

@@ -288,12 +288,6 @@ pub(crate) struct LooseState {
     ctl: Vec<f32x8>,
 }
 
-/// Lanes `4i .. 4i+4` of `v` as one vector.
-#[inline(always)]
-fn quad(v: &[f64x4], i: usize) -> f64x4 {
-    v[i]
-}
-
 /// Set lane `l` of half blocks `v`.
 #[inline(always)]
 fn set_lane(v: &mut [f64x4], l: usize, x: f64) {
@@ -410,7 +404,7 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
 /// (forward playback: a lane at a time, when it crosses a key).
 #[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
-    let ok = quad(&st.ws, i).simd_le(tm) & tm.simd_lt(quad(&st.we, i));
+    let ok = st.ws[i].simd_le(tm) & tm.simd_lt(st.we[i]);
     let stale = !ok.to_bitmask() & 0xf;
     if stale != 0 {
         load_stale(loose, st, i, tm, stale);
@@ -442,11 +436,11 @@ fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4, velocity:
     for h in 0..2 {
         let i = 2 * b + h;
         refresh(loose, st, i, t);
-        let (ws, we) = (quad(&st.ws, i), quad(&st.we, i));
+        let (ws, we) = (st.ws[i], st.we[i]);
         let d = we - ws;
         let u = ((t - ws) / d).max(f64x4::ZERO).min(one);
         let (ss, dsdu) = if loose.eased[b] {
-            ease(u, quad(&st.ease_from, i), quad(&st.ease_to, i))
+            ease(u, st.ease_from[i], st.ease_to[i])
         } else {
             (u, one)
         };
@@ -502,12 +496,12 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: 
     let mut real = [zero; 2];
     for h in 0..2 {
         let i = 2 * b + h;
-        let (ws, we) = (quad(&st.ws, i), quad(&st.we, i));
+        let (ws, we) = (st.ws[i], st.we[i]);
         let is_real =
             ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
         let d = is_real.select(we - ws, one);
         let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
-        let (a, e) = (quad(&st.ease_from, i), quad(&st.ease_to, i));
+        let (a, e) = (st.ease_from[i], st.ease_to[i]);
         let (ss, dsdu) = if loose.eased[b] {
             ease(u, a, e)
         } else {
