@@ -261,7 +261,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
             ));
         }
     }
-    for (n, limit) in [("character-hermite", 2.0), ("character-squad", 4.0)] {
+    for (n, limit) in [("character-hermite", 2.5), ("character-squad", 3.0)] {
         if let Some(j) = get(n).and_then(|r| r.ns_per_joint) {
             out.push((
                 format!("{n}: {j:.2} ns per joint per frame (target < {limit})"),
@@ -274,12 +274,12 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     {
         out.push((
             format!(
-                "character-reduced: {j:.2} ns per joint per frame (target <= 2), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
+                "character-reduced: {j:.2} ns per joint per frame (target <= 1.5), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
                 r.bytes as f64 / 1e6,
                 c.bytes as f64 / 1e6,
                 c.bytes as f64 / r.bytes as f64
             ),
-            j <= 2.0,
+            j <= 1.5,
         ));
     }
     if let (Some(s), Some(c)) = (get("seek"), get("character-hermite")) {
@@ -289,10 +289,10 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
         );
         out.push((
             format!(
-                "seek: {:.2}x the cost of forward playback (target <= 1.5x)",
+                "seek: {:.2}x the cost of forward playback (target <= 1.2x)",
                 a / b
             ),
-            a / b <= 1.5,
+            a / b <= 1.2,
         ));
     }
     if let Some(p) = get("crowd").and_then(|r| r.parallel_speedup) {
@@ -301,18 +301,20 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
             p >= 1.8,
         ));
     }
-    if let (Some(s), Some(w)) = (get("sparse"), get("wide")) {
-        let (a, b) = (
-            s.ns_of("runtime").unwrap_or(f64::NAN),
-            w.ns_of("runtime").unwrap_or(f64::NAN),
-        );
-        out.push((
-            format!(
-                "sparse: {:.1}x the per-channel cost of wide (target <= 3x)",
-                a / b
-            ),
-            a / b <= 3.0,
-        ));
+    for name in ["sparse", "sparse-rotations"] {
+        if let (Some(s), Some(w)) = (get(name), get("wide")) {
+            let (a, b) = (
+                s.ns_of("runtime").unwrap_or(f64::NAN),
+                w.ns_of("runtime").unwrap_or(f64::NAN),
+            );
+            out.push((
+                format!(
+                    "{name}: {:.1}x the per-channel cost of wide (target <= 1.5x)",
+                    a / b
+                ),
+                a / b <= 1.5,
+            ));
+        }
     }
     for r in rows {
         if let Some(x) = r.speedup_vs_splines {

@@ -6,6 +6,7 @@
 //! | `crowd` | 1,000 instances of it (hermite) at random phases, 60 frames |
 //! | `wide` | 10,000 scalar channels on one key grid (61 keys), 60 fps over 2 s |
 //! | `sparse` | 500 scalar tracks, each with its own random key times |
+//! | `sparse-rotations` | 128 rotations (64 `hermite`, 64 `squad`), each with its own random key times |
 //! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
 //! | `character-reduced` | the CMU clip (hermite) reduced by `tcb reduce` at the default shell tolerance, as `character` |
 
@@ -377,12 +378,7 @@ pub fn sparse() -> Scenario {
     let mut rng = Rng(0x5ba5e);
     let tracks = (0..500)
         .map(|i| {
-            let n = 10 + (rng.next_f64() * 31.0) as usize;
-            let mut times: Vec<f64> = (0..n).map(|_| rng.range(0.0, 2.0)).collect();
-            times.sort_by(f64::total_cmp);
-            times.dedup();
-            times[0] = 0.0;
-            *times.last_mut().expect("10 or more") = 2.0;
+            let times = own_times(&mut rng);
             NamedTrack {
                 name: format!("s{i}"),
                 ..scalar_track(times, &mut rng)
@@ -396,18 +392,83 @@ pub fn sparse() -> Scenario {
     Scenario::new("sparse", clip, frames(2.0, 60.0))
 }
 
+/// 10 to 40 random key times in [0, 2] s, the first at 0 and the last at 2.
+fn own_times(rng: &mut Rng) -> Vec<f64> {
+    let n = 10 + (rng.next_f64() * 31.0) as usize;
+    let mut times: Vec<f64> = (0..n).map(|_| rng.range(0.0, 2.0)).collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times[0] = 0.0;
+    *times.last_mut().expect("10 or more") = 2.0;
+    times
+}
+
+/// `sparse-rotations`: 128 rotations, half `hermite` and half `squad`, each
+/// on 10 to 40 random key times of its own in [0, 2] s, turning up to 0.5
+/// rad between keys (a smooth joint; channels count 4 per rotation).
+pub fn sparse_rotations() -> Scenario {
+    use glam::{Quat, Vec3};
+    let mut rng = Rng(0x5ba5e4);
+    let tracks = (0..128)
+        .map(|i| {
+            let times = own_times(&mut rng);
+            let mut q = Quat::IDENTITY;
+            let values: Vec<Quat> = times
+                .iter()
+                .map(|_| {
+                    let axis = Vec3::new(
+                        rng.range(-1.0, 1.0) as f32,
+                        rng.range(-1.0, 1.0) as f32,
+                        rng.range(-1.0, 1.0) as f32,
+                    )
+                    .try_normalize()
+                    .unwrap_or(Vec3::Z);
+                    q = (q * Quat::from_axis_angle(axis, rng.range(0.0, 0.5) as f32)).normalize();
+                    q
+                })
+                .collect();
+            let settings = TrackSettings {
+                rotation: if i % 2 == 0 {
+                    RotationMode::Hermite
+                } else {
+                    RotationMode::Squad
+                },
+                ..TrackSettings::default()
+            };
+            let n = times.len();
+            let track = tcb_core::RotationTrack::new(
+                times,
+                values,
+                vec![KeyParams::default(); n],
+                &settings,
+            )
+            .expect("valid synthetic rotation keys");
+            NamedTrack {
+                name: format!("r{i}"),
+                data: TrackData::Quat(track),
+            }
+        })
+        .collect();
+    let clip = tcb_core::Clip {
+        name: "sparse-rotations".into(),
+        tracks,
+    };
+    Scenario::new("sparse-rotations", clip, frames(2.0, 60.0))
+}
+
 /// Every scenario, in report order.
 pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
     named(bvh, |_| true)
 }
 
 /// The scenario names, in report order.
-pub const NAMES: [&str; 7] = [
+pub const NAMES: [&str; 8] = [
     "character-hermite",
     "character-squad",
     "crowd",
     "wide",
     "sparse",
+    "sparse-rotations",
     "seek",
     "character-reduced",
 ];
@@ -423,6 +484,7 @@ pub fn named(bvh: &Path, want: impl Fn(&str) -> bool) -> Result<Vec<Scenario>, t
             "crowd" => crowd(bvh)?,
             "wide" => wide(),
             "sparse" => sparse(),
+            "sparse-rotations" => sparse_rotations(),
             "seek" => seek(bvh)?,
             _ => character_reduced(bvh)?,
         });

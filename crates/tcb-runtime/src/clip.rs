@@ -192,7 +192,7 @@ pub(crate) fn plane_slots(out: usize, lane: usize) -> [usize; 4] {
 /// A padding lane of loose rotations: the identity at all times.
 fn identity_lane() -> LooseLane {
     let grid = TimeGrid {
-        times: vec![0.0, 1.0],
+        times: vec![-crate::loose::PAD_SPAN, crate::loose::PAD_SPAN],
         eases: vec![SegmentEase::default()],
         steps: vec![false],
         pre: Extrapolation::Constant,
@@ -378,7 +378,7 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
             comp[k + 1] = ctl[i];
         }
         let max_rate = 2.0 / (t.times()[k + 1] - t.times()[k]);
-        if !cubic_holds(&c, &ctl, max_rate) {
+        if !cubic_holds(&c, &ctl, max_rate, (0.0, 1.0)) {
             exact[k + 1] = Some(c);
         }
     }
@@ -396,13 +396,19 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
 }
 
 /// Whether the normalized cubic `ctl` (per component `[P0, P1, M0, M1]`,
-/// evaluated as the kernel does, in f32) follows the squad `c` within
-/// [`CUBIC_VALUE_TOL`] and [`CUBIC_VELOCITY_TOL`] at 17 points.
-fn cubic_holds(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4], max_rate: f64) -> bool {
+/// evaluated as the kernel does, in f32) follows the squad `c` from `s = a`
+/// to `b` within [`CUBIC_VALUE_TOL`] and [`CUBIC_VELOCITY_TOL`] at 17 points.
+fn cubic_holds(
+    c: &[f64; SQ_STRIDE],
+    ctl: &[[f32; 4]; 4],
+    max_rate: f64,
+    (a, b): (f64, f64),
+) -> bool {
     use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
     (0..=16).all(|j| {
         let s = j as f64 / 16.0;
-        let (q, dq) = tcb_core::squad::squad_with_derivative(c, s);
+        let (q, dq) = tcb_core::squad::squad_with_derivative(c, a + (b - a) * s);
+        let dq = dq.map(|x| x * (b - a));
         let (q, dq) = tcb_core::quat::normalize(q, Some(dq));
         let dq = dq.expect("asked for");
         let (h, dh) = (hermite_basis(s as f32), hermite_basis_derivative(s as f32));
@@ -419,6 +425,88 @@ fn cubic_holds(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4], max_rate: f64) -> bool
                 && ((da[i] - dq[i] as f32) * rate).abs() <= CUBIC_VELOCITY_TOL * speed
         })
     })
+}
+
+/// A rotation on key times of its own whose segments the cubic misses
+/// (`exact`), as a lane of its own: each such segment split into 2, 4, 8 or
+/// 16 equal pieces, each the cubic through squad's values and derivatives at
+/// its ends, the fewest that pass [`cubic_holds`]. The keys of the result are
+/// the track's own plus the split points, so nothing is evaluated in f64 per
+/// frame. `None` where that cannot be done: an eased or step segment among
+/// them, a segment too short to split, or 16 pieces still missing.
+fn split_rotation(grid: &TimeGrid, rot: &RotationControls) -> Option<(TimeGrid, Vec<Controls>)> {
+    let n = grid.times.len();
+    let mut times = vec![grid.times[0]];
+    let (mut eases, mut steps) = (Vec::new(), Vec::new());
+    let mut comps: Vec<Controls> = rot.comps.iter().map(|c| vec![c[0]]).collect();
+    for k in 0..n - 1 {
+        let (t0, t1) = (grid.times[k], grid.times[k + 1]);
+        let Some(c) = &rot.exact[k + 1] else {
+            times.push(t1);
+            eases.push(grid.ease(k));
+            steps.push(grid.is_step(k));
+            for (out, c) in comps.iter_mut().zip(&rot.comps) {
+                out.push(c[k + 1]);
+            }
+            continue;
+        };
+        if !grid.ease(k).is_none() || grid.is_step(k) {
+            return None;
+        }
+        let pieces = [2usize, 4, 8, 16].into_iter().find_map(|m| {
+            let w = 1.0 / m as f64;
+            (0..m)
+                .map(|j| {
+                    let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
+                    let (qa, da) = tcb_core::squad::squad_with_derivative(c, a);
+                    let (qb, db) = tcb_core::squad::squad_with_derivative(c, b);
+                    let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
+                        // The segment's own ends stay its keys.
+                        let p0 = if j == 0 {
+                            rot.comps[i][k + 1][0]
+                        } else {
+                            qa[i] as f32
+                        };
+                        let p1 = if j + 1 == m {
+                            rot.comps[i][k + 1][1]
+                        } else {
+                            qb[i] as f32
+                        };
+                        [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
+                    });
+                    cubic_holds(c, &ctl, 2.0 / (w * (t1 - t0)), (a, b)).then_some(ctl)
+                })
+                .collect::<Option<Vec<_>>>()
+        })?;
+        let m = pieces.len();
+        for (j, ctl) in pieces.iter().enumerate() {
+            let t = if j + 1 == m {
+                t1
+            } else {
+                t0 + (t1 - t0) * ((j + 1) as f64 / m as f64)
+            };
+            if t <= times[times.len() - 1] {
+                return None;
+            }
+            times.push(t);
+            eases.push(SegmentEase::default());
+            steps.push(false);
+            for (out, ctl) in comps.iter_mut().zip(ctl) {
+                out.push(*ctl);
+            }
+        }
+    }
+    for (out, c) in comps.iter_mut().zip(&rot.comps) {
+        out.push(c[n]);
+    }
+    let grid = TimeGrid {
+        times,
+        eases,
+        steps,
+        pre: grid.pre,
+        post: grid.post,
+    };
+    Some((grid.compact(), comps))
 }
 
 /// Lay per-lane control rows into blocks of `N` lanes (`f32x8`: 8,
@@ -517,25 +605,29 @@ impl Clip {
         let mut loose_rots: Vec<(usize, LooseLane)> = Vec::new();
         let mut keep = vec![true; grids.len()];
         for g in 0..grids.len() {
-            // Small groups of hermite rotations only (reset, which gives the
-            // identity rather than zero, stays on the group path).
-            // Rotations with exact segments stay there too (see `rotation_controls`).
+            // Small groups of rotations only (reset, which gives the
+            // identity rather than zero, stays on the group path). A
+            // rotation with exact segments (see `rotation_controls`) goes
+            // as the cubic pieces of `split_rotation`, or stays too.
             let resets = [grids[g].pre, grids[g].post].contains(&Extrapolation::Reset);
-            let exact = hq_rows[g]
-                .iter()
-                .any(|r| r.1.exact.iter().any(Option::is_some));
-            if vec_rows[g].is_empty()
-                && !hq_rows[g].is_empty()
-                && hq_rows[g].len() < 8
-                && !resets
-                && !exact
-            {
-                keep[g] = false;
-                for (track, rot) in &hq_rows[g] {
-                    let comps: Vec<&Controls> = rot.comps.iter().collect();
-                    loose_rots.push((*track, LooseLane::new(grids[g].clone(), &comps)));
+            if vec_rows[g].is_empty() && !hq_rows[g].is_empty() && hq_rows[g].len() < 8 && !resets {
+                let lanes: Option<Vec<(usize, LooseLane)>> = hq_rows[g]
+                    .iter()
+                    .map(|(track, rot)| {
+                        let (grid, comps) = if rot.exact.iter().all(Option::is_none) {
+                            (grids[g].clone(), rot.comps.clone())
+                        } else {
+                            split_rotation(&grids[g], rot)?
+                        };
+                        let comps: Vec<&Controls> = comps.iter().collect();
+                        Some((*track, LooseLane::new(grid, &comps)))
+                    })
+                    .collect();
+                if let Some(lanes) = lanes {
+                    keep[g] = false;
+                    loose_rots.extend(lanes);
+                    continue;
                 }
-                continue;
             }
             if hq_rows[g].is_empty() && vec_rows[g].len() < 8 {
                 keep[g] = false;

@@ -6,18 +6,26 @@
 //! packed one track per lane, eight per block, components as x/y/z/w planes,
 //! and everything per frame is done across lanes:
 //!
-//! 1. `map_time` for eight grids at once in `f64x4` (pre/post per lane,
-//!    wrap in f64, selects instead of branches);
-//! 2. each lane keeps a window `[ws, we)` of the stored segment it last
-//!    used and that segment's controls (in the [`crate::Instance`], so they
-//!    stay contiguous and cached, as ozz-animation does); a lane whose mapped
-//!    time left its window is refreshed, scalar, only when it crosses a key;
-//! 3. `u`, ease, and the Hermite rows per lane, then the same
-//!    [`tcb_core::basis::hermite`] on `f32x8` as every other kernel.
+//! 1. Each lane's current segment (window `[ws, we)`, width, ease, rate and
+//!    controls) lives in the [`crate::Instance`], packed per block, as
+//!    ozz-animation's sampling context does. Forward playback keeps it
+//!    current from one list of every `(lane, segment)` in the order playback
+//!    needs them (segment k+1 at key time `t_k`, Riot's "keys sorted by the
+//!    time they are needed"): a frame loads exactly the segments whose key
+//!    it passed, and nothing else. Going back in time, or jumping further
+//!    forward than a few keys per lane, is a seek: each lane finds its
+//!    segment by binary search.
+//! 2. A block whose eight lanes are all inside their keys (most frames)
+//!    then needs nothing but `u = (t - ws) / D`, the ease if any lane eases,
+//!    and the Hermite rows per lane: no window test, no time mapping.
+//! 3. Other blocks run [`tcb_core::extrapolate::map_lanes`] across eight
+//!    grids in `f64x4` (pre/post per lane, wrap in f64, selects instead of
+//!    branches), reload lanes whose mapped time left their window, and take
+//!    the sentinel rows of [`crate::grid::sentinel_rows`].
 //!
-//! The stored segments and sentinel rows are those of [`crate::grid`]; the
-//! time mapping is [`tcb_core::extrapolate::map_lanes`], the reference's own.
-
+//! The rows are evaluated by the same [`tcb_core::basis::hermite`] on
+//! `f32x8` as every other kernel, from the same f64 `u` as the reference,
+//! so the values are the reference's bit for bit.
 use crate::clip::{key_pair, per_key};
 use crate::grid::{TimeGrid, sentinel_rows};
 use crate::kernel::KEY_STRIDE;
@@ -28,12 +36,9 @@ use tcb_core::extrapolate::{ModeLanes, map_lanes};
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 
-/// Controls per block: 4 component planes x `[P0, P1, M0, M1]`.
-const CTL: usize = 16;
-
-/// Padding lanes: keys at -PAD_SPAN and +PAD_SPAN (finite, so u stays finite),
-/// zero controls.
-const PAD_SPAN: f64 = 1e300;
+/// Padding lanes: a window from -PAD_SPAN to +PAD_SPAN (finite, so u stays
+/// finite), zero controls; padding rotations are lanes keyed there.
+pub(crate) const PAD_SPAN: f64 = 1e300;
 
 /// One loose track.
 #[derive(Clone, Debug)]
@@ -141,23 +146,28 @@ impl LooseLane {
         error
     }
 
-    /// `[P0, P1, M0, M1]` of every component on stored segment `seg`
-    /// (components past `dim` zero).
+    /// `[P0, P1, M0, M1]` of each component on stored segment `seg` into
+    /// lane `i` of `out` (4 planes per component).
     #[inline]
-    fn segment(&self, seg: usize) -> [[f32; 4]; 4] {
+    fn segment(&self, seg: usize, out: &mut [f32x8], i: usize) {
         let (ka, kb) = key_pair(&self.grid, seg);
         let n = self.grid.times.len();
         // A step segment reads its first key twice; that key's TI belongs
         // to the segment before.
         let step = (1..n).contains(&seg) && self.grid.is_step(seg - 1);
-        std::array::from_fn(|c| {
-            if c < self.dim {
-                let (a, b) = (self.key(ka * self.dim + c), self.key(kb * self.dim + c));
-                [a[0], b[0], a[1], if step { 0.0 } else { b[2] }]
-            } else {
-                [0.0; 4]
-            }
-        })
+        let dim = self.dim;
+        let (ka, kb) = (ka * dim, kb * dim);
+        for c in 0..dim {
+            let (a, b) = match &self.keys {
+                Keys::F32(k) => (k[ka + c], k[kb + c]),
+                Keys::U16 { .. } => (self.key(ka + c), self.key(kb + c)),
+            };
+            let o = &mut out[4 * c..4 * c + 4];
+            o[0].as_mut_array()[i] = a[0];
+            o[1].as_mut_array()[i] = b[0];
+            o[2].as_mut_array()[i] = a[1];
+            o[3].as_mut_array()[i] = if step { 0.0 } else { b[2] };
+        }
     }
 }
 
@@ -179,6 +189,21 @@ pub(crate) struct Loose {
     eased: Vec<bool>,
     /// Component planes in use per block (the widest track's dimension).
     dims: Vec<usize>,
+    /// Per block, its first plane in the instance's controls
+    /// (`[P0, P1, M0, M1]` per component in use); one more entry, the total.
+    ctl_at: Vec<usize>,
+    /// Per block, the latest first key and the earliest last key of its
+    /// lanes: at times between them every lane is inside its keys.
+    inner: Vec<[f64; 2]>,
+    /// Every `(lane, stored segment)` in the order forward playback needs
+    /// them: segment `k + 1` (the post sentinel for the last key) at key
+    /// time `t_k`, ordered by that time.
+    order: Vec<[u32; 2]>,
+}
+
+/// Lane or segment index as stored in [`Loose::order`].
+fn index_u32(i: usize) -> u32 {
+    u32::try_from(i).expect("fewer than 2^32 loose lanes and keys")
 }
 
 impl Loose {
@@ -204,6 +229,9 @@ impl Loose {
             + size_of_val(self.delta.as_slice())
             + size_of_val(self.eased.as_slice())
             + size_of_val(self.dims.as_slice())
+            + size_of_val(self.ctl_at.as_slice())
+            + size_of_val(self.inner.as_slice())
+            + size_of_val(self.order.as_slice())
     }
 
     pub fn new(lanes: Vec<LooseLane>, out: usize) -> Self {
@@ -214,8 +242,10 @@ impl Loose {
                 .map(|h| f64x4::new(std::array::from_fn(|l| lane(4 * h + l).map_or(pad, f))))
                 .collect()
         };
-        let t0 = half(&|l| l.grid.times[0], 0.0);
-        let tn = half(&|l| l.grid.times[l.grid.times.len() - 1], 1.0);
+        let first = |l: &LooseLane| l.grid.times[0];
+        let last = |l: &LooseLane| l.grid.times[l.grid.times.len() - 1];
+        let t0 = half(&first, 0.0);
+        let tn = half(&last, 1.0);
         let modes = |f: fn(&LooseLane) -> Extrapolation| -> Vec<ModeLanes<f64x4>> {
             (0..2 * blocks)
                 .map(|h| {
@@ -243,24 +273,38 @@ impl Loose {
                 }));
             }
         }
+        let block_lanes = |b: usize| (8 * b..8 * b + 8).filter_map(lane);
         let eased = (0..blocks)
+            .map(|b| block_lanes(b).any(|l| l.grid.eases.iter().any(|e| !e.is_none())))
+            .collect();
+        let dims: Vec<usize> = (0..blocks)
+            .map(|b| block_lanes(b).map(|l| l.dim).max().unwrap_or(0))
+            .collect();
+        let mut ctl_at = vec![0];
+        for d in &dims {
+            ctl_at.push(ctl_at[ctl_at.len() - 1] + 4 * d);
+        }
+        let inner = (0..blocks)
             .map(|b| {
-                (8 * b..8 * b + 8)
-                    .filter_map(lane)
-                    .any(|l| l.grid.eases.iter().any(|e| !e.is_none()))
+                let lo = block_lanes(b).map(first).fold(f64::NEG_INFINITY, f64::max);
+                let hi = block_lanes(b).map(last).fold(f64::INFINITY, f64::min);
+                [lo, hi]
             })
             .collect();
-        let dims = (0..blocks)
-            .map(|b| {
-                (8 * b..8 * b + 8)
-                    .filter_map(lane)
-                    .map(|l| l.dim)
-                    .max()
-                    .unwrap_or(0)
+        let mut order: Vec<(f64, u32, u32)> = lanes
+            .iter()
+            .enumerate()
+            .flat_map(|(l, x)| {
+                let t = &x.grid.times;
+                (1..=t.len()).map(move |seg| (t[seg - 1], index_u32(l), index_u32(seg)))
             })
             .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         Loose {
             dims,
+            ctl_at,
+            inner,
+            order: order.into_iter().map(|(_, l, s)| [l, s]).collect(),
             eased,
             lanes,
             blocks,
@@ -272,82 +316,87 @@ impl Loose {
             delta,
         }
     }
+
+    /// The time at which forward playback reaches entry `i` of `order`
+    /// (infinity past the end).
+    #[inline]
+    fn order_time(&self, i: usize) -> f64 {
+        match self.order.get(i) {
+            Some(&[l, seg]) => self.lanes[l as usize].grid.times[seg as usize - 1],
+            None => f64::INFINITY,
+        }
+    }
 }
 
-/// Per-instance state of the loose tracks: each lane's window, ease and
-/// controls, written lane by lane only when a lane crosses a key and read
-/// four lanes at a time.
+/// Per-instance state of the loose tracks: each lane's window, width,
+/// ease, rate and controls, written lane by lane only when a lane crosses a
+/// key and read four or eight lanes at a time; and where forward playback is
+/// in [`Loose::order`].
 #[derive(Clone, Debug)]
 pub(crate) struct LooseState {
-    /// Per half block (4 lanes): window start and end, ease from and to.
-    ws: Vec<f64x4>,
-    we: Vec<f64x4>,
-    ease_from: Vec<f64x4>,
-    ease_to: Vec<f64x4>,
+    /// Per half block (4 lanes): window start and width (`t_{k+1} - t_k`,
+    /// 1 on sentinels), what every frame reads.
+    win: Vec<[f64x4; 2]>,
+    /// Per half block: window end, ease from and to.
+    more: Vec<[f64x4; 3]>,
+    /// Per block: `1 / D` in f32 per lane, the rate of uneased segments.
+    rate: Vec<f32x8>,
+    /// Per lane: the stored segment loaded.
     seg: Vec<usize>,
+    /// Per block from `Loose::ctl_at`: `[P0, P1, M0, M1]` per component.
     ctl: Vec<f32x8>,
-}
-
-/// Set lane `l` of half blocks `v`.
-#[inline(always)]
-fn set_lane(v: &mut [f64x4], l: usize, x: f64) {
-    bytemuck::cast_slice_mut::<f64x4, f64>(v)[l] = x;
+    /// The next entry of `Loose::order` and its time.
+    next: usize,
+    next_time: f64,
+    /// The time last sampled (NaN before the first sample: a seek).
+    last: f64,
 }
 
 impl LooseState {
     pub fn new(loose: &Loose) -> Self {
         let lanes = loose.blocks * 8;
-        // Real lanes start with an empty window (refreshed on first use);
-        // padding lanes with one spanning all time and zero controls.
-        let real = loose.lanes.len();
-        let fill = |inside: f64, pad: f64| -> Vec<f64x4> {
-            (0..lanes / 4)
-                .map(|h| {
-                    f64x4::new(std::array::from_fn(|i| {
-                        if 4 * h + i < real { inside } else { pad }
-                    }))
-                })
-                .collect()
-        };
+        // Every lane starts on a window spanning all time with zero
+        // controls: padding lanes keep it, real lanes are loaded by the
+        // first sample (a seek).
+        let halves = lanes / 4;
         LooseState {
-            ws: fill(f64::INFINITY, -PAD_SPAN),
-            we: fill(f64::NEG_INFINITY, PAD_SPAN),
-            ease_from: vec![f64x4::ZERO; lanes / 4],
-            ease_to: vec![f64x4::ZERO; lanes / 4],
+            win: vec![[f64x4::splat(-PAD_SPAN), f64x4::splat(2.0 * PAD_SPAN)]; halves],
+            more: vec![[f64x4::splat(PAD_SPAN), f64x4::ZERO, f64x4::ZERO]; halves],
+            rate: vec![f32x8::ZERO; loose.blocks],
             seg: vec![usize::MAX; lanes],
-            ctl: vec![f32x8::ZERO; loose.blocks * CTL],
+            ctl: vec![f32x8::ZERO; loose.ctl_at.last().copied().unwrap_or(0)],
+            next: 0,
+            next_time: loose.order_time(0),
+            last: f64::NAN,
         }
     }
 
     /// Load stored segment `seg` of lane `l` into its window, ease and controls.
+    #[inline]
     fn load(&mut self, loose: &Loose, l: usize, seg: usize) {
         let lane = &loose.lanes[l];
-        let t = &lane.grid.times;
+        let t = lane.grid.times.as_slice();
         let n = t.len();
-        let (ws, we) = match seg {
-            0 => (f64::NEG_INFINITY, t[0]),
-            s if s == n => (t[n - 1], f64::INFINITY),
-            s => (t[s - 1], t[s]),
-        };
-        let ease = if (1..n).contains(&seg) {
-            lane.grid.ease(seg - 1)
+        let (ws, we, d, ease) = if seg.wrapping_sub(1) < n - 1 {
+            let (a, b) = (t[seg - 1], t[seg]);
+            (a, b, b - a, lane.grid.ease(seg - 1))
+        } else if seg == 0 {
+            (f64::NEG_INFINITY, t[0], 1.0, Default::default())
         } else {
-            Default::default()
+            (t[n - 1], f64::INFINITY, 1.0, Default::default())
         };
-        set_lane(&mut self.ws, l, ws);
-        set_lane(&mut self.we, l, we);
-        set_lane(&mut self.ease_from, l, ease.from);
-        set_lane(&mut self.ease_to, l, ease.to);
-        self.seg[l] = seg;
+        let (h, i) = (l / 4, l % 4);
+        self.win[h][0].as_mut_array()[i] = ws;
+        self.win[h][1].as_mut_array()[i] = d;
+        let more = &mut self.more[h];
+        more[0].as_mut_array()[i] = we;
+        more[1].as_mut_array()[i] = ease.from;
+        more[2].as_mut_array()[i] = ease.to;
         let (b, i) = (l / 8, l % 8);
-        let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl[b * CTL..(b + 1) * CTL]);
-        let src = lane.segment(seg);
-        // Only the components the track has (the rest stay zero).
-        for (c, src) in src.iter().enumerate().take(lane.dim) {
-            for j in 0..4 {
-                ctl[(4 * c + j) * 8 + i] = src[j];
-            }
-        }
+        // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
+        self.rate[b].as_mut_array()[i] = (1.0 / d) as f32;
+        self.seg[l] = seg;
+        lane.segment(seg, &mut self.ctl[loose.ctl_at[b]..], i);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -364,15 +413,53 @@ impl LooseState {
             segment_from(t, tm, current.wrapping_sub(1)) + 1
         }
     }
-}
 
-/// The derivative rows, only when velocities are wanted.
-#[inline(always)]
-fn derivative_rows(s: f32x8, velocity: bool) -> [f32x8; 4] {
-    if velocity {
-        hermite_basis_derivative(s)
-    } else {
-        [f32x8::ZERO; 4]
+    /// Bring every lane to `time`: forward, the segments of `Loose::order`
+    /// it passed; otherwise a seek. Afterwards each lane whose keys hold
+    /// `time` (`t_0 <= time < t_{n-1}`) has the segment containing it.
+    #[inline]
+    fn advance(&mut self, loose: &Loose, time: f64) {
+        // Forward (never NaN: a NaN time or a NaN `last` seeks).
+        if time >= self.last {
+            if time >= self.next_time {
+                self.stream(loose, time);
+            }
+        } else {
+            self.seek(loose, time);
+        }
+        self.last = time;
+    }
+
+    /// Load the entries of `Loose::order` up to `time`; more than a few
+    /// per lane and a seek is cheaper (out of line: most frames cross no
+    /// key, or only a few).
+    #[inline(never)]
+    fn stream(&mut self, loose: &Loose, time: f64) {
+        let mut budget = 4 * loose.lanes.len() + 64;
+        while time >= self.next_time {
+            if budget == 0 {
+                return self.seek(loose, time);
+            }
+            budget -= 1;
+            let [l, seg] = loose.order[self.next];
+            self.load(loose, l as usize, seg as usize);
+            self.next += 1;
+            self.next_time = loose.order_time(self.next);
+        }
+    }
+
+    /// Every lane's segment at `time` by binary search, and the position
+    /// in `Loose::order` after every entry at or before `time`.
+    #[inline(never)]
+    fn seek(&mut self, loose: &Loose, time: f64) {
+        self.next = loose.order.partition_point(|&[l, seg]| {
+            loose.lanes[l as usize].grid.times[seg as usize - 1] <= time
+        });
+        self.next_time = loose.order_time(self.next);
+        for (l, lane) in loose.lanes.iter().enumerate() {
+            let seg = Self::segment_for(lane, self.seg[l], time);
+            self.load(loose, l, seg);
+        }
     }
 }
 
@@ -385,12 +472,21 @@ struct Rows {
     any_cycles: bool,
 }
 
+/// Two halves as one `f32x8`, each lane rounded as `as f32` does
+/// (the compiler makes it `cvtpd2ps`).
 #[inline(always)]
 fn f32x8_of(a: f64x4, b: f64x4) -> f32x8 {
-    let (a, b) = (a.to_array(), b.to_array());
-    f32x8::new(std::array::from_fn(|i| {
-        if i < 4 { a[i] as f32 } else { b[i - 4] as f32 }
-    }))
+    let (a, b): ([f64; 4], [f64; 4]) = (bytemuck::cast(a), bytemuck::cast(b));
+    f32x8::new([
+        a[0] as f32,
+        a[1] as f32,
+        a[2] as f32,
+        a[3] as f32,
+        b[0] as f32,
+        b[1] as f32,
+        b[2] as f32,
+        b[3] as f32,
+    ])
 }
 
 fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
@@ -400,19 +496,17 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
     }))
 }
 
-/// Refresh the lanes of half block `i` whose window does not hold `tm`
-/// (forward playback: a lane at a time, when it crosses a key).
+/// Reload the lanes of half block `i` whose window does not hold `tm`.
 #[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
-    let ok = st.ws[i].simd_le(tm) & tm.simd_lt(st.we[i]);
+    let ok = st.win[i][0].simd_le(tm) & tm.simd_lt(st.more[i][0]);
     let stale = !ok.to_bitmask() & 0xf;
     if stale != 0 {
         load_stale(loose, st, i, tm, stale);
     }
 }
 
-/// Load the lanes of half block `i` set in `stale` (out of line: most
-/// frames cross no key).
+/// Load the lanes of half block `i` set in `stale` (out of line: rare).
 #[inline(never)]
 fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale: u32) {
     while stale != 0 {
@@ -426,45 +520,36 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
     }
 }
 
-/// Rows for block `b` when every lane is inside its keys, `t_0 <= time < t_{n-1}`:
-/// no extrapolation and no sentinel, just `u`, ease and the basis.
+/// `s` and the rate of block `b` when every lane is inside its keys,
+/// `t_0 <= time < t_{n-1}`, and so (after [`LooseState::advance`]) inside
+/// the segment it holds: `u` and the ease, nothing else.
 #[inline(always)]
-fn rows_inside(loose: &Loose, st: &mut LooseState, b: usize, t: f64x4, velocity: bool) -> Rows {
-    let one = f64x4::ONE;
-    let mut s = [f64x4::ZERO; 2];
-    let mut rate = [f64x4::ZERO; 2];
-    for h in 0..2 {
-        let i = 2 * b + h;
-        refresh(loose, st, i, t);
-        let (ws, we) = (st.ws[i], st.we[i]);
-        let d = we - ws;
-        let u = ((t - ws) / d).max(f64x4::ZERO).min(one);
-        let (ss, dsdu) = if loose.eased[b] {
-            ease(u, st.ease_from[i], st.ease_to[i])
-        } else {
-            (u, one)
-        };
-        s[h] = ss;
-        rate[h] = dsdu / d;
-    }
-    let s32 = f32x8_of(s[0], s[1]);
-    Rows {
-        h: hermite_basis(s32),
-        dh: derivative_rows(s32, velocity),
-        rate: f32x8_of(rate[0], rate[1]),
-        cycles: f32x8::ZERO,
-        any_cycles: false,
+fn inside(loose: &Loose, st: &LooseState, b: usize, time: f64) -> (f32x8, f32x8) {
+    let t = f64x4::splat(time);
+    let [w0, w1] = [st.win[2 * b], st.win[2 * b + 1]];
+    debug_assert!(
+        (0..2).all(|h| (st.win[2 * b + h][0].simd_le(t) & t.simd_lt(st.more[2 * b + h][0])).all())
+    );
+    // `t - ws` is at least 0 and at most `we - ws = D`, so `u` is already
+    // within the [0, 1] the reference clamps it to.
+    let u = [(t - w0[0]) / w0[1], (t - w1[0]) / w1[1]];
+    if loose.eased[b] {
+        let e = [0, 1].map(|h| {
+            let m = &st.more[2 * b + h];
+            ease(u[h], m[1], m[2])
+        });
+        let rate = [e[0].1 / w0[1], e[1].1 / w1[1]];
+        (f32x8_of(e[0].0, e[1].0), f32x8_of(rate[0], rate[1]))
+    } else {
+        (f32x8_of(u[0], u[1]), st.rate[b])
     }
 }
 
-/// Rows for block `b` at `time` (any f64), refreshing lanes that left their window.
-#[inline(always)]
-fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: bool) -> Rows {
+/// Rows for block `b` at `time` (any f64), reloading lanes whose mapped
+/// time left their window.
+#[inline(never)]
+fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: bool) -> Rows {
     let t = f64x4::splat(time);
-    let inside = |i: usize| (t.simd_ge(loose.t0[i]) & t.simd_lt(loose.tn[i])).all();
-    if inside(2 * b) && inside(2 * b + 1) {
-        return rows_inside(loose, st, b, t, velocity);
-    }
     let zero = f64x4::ZERO;
     let one = f64x4::ONE;
     let mut out_tm = [zero; 2];
@@ -496,12 +581,10 @@ fn rows_simd(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: 
     let mut real = [zero; 2];
     for h in 0..2 {
         let i = 2 * b + h;
-        let (ws, we) = (st.ws[i], st.we[i]);
+        let ([ws, d], [we, a, e]) = (st.win[i], st.more[i]);
         let is_real =
             ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
-        let d = is_real.select(we - ws, one);
         let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
-        let (a, e) = (st.ease_from[i], st.ease_to[i]);
         let (ss, dsdu) = if loose.eased[b] {
             ease(u, a, e)
         } else {
@@ -547,19 +630,35 @@ pub(crate) fn sample(
     values: &mut [f32x8],
     mut velocities: Option<&mut [f32x8]>,
 ) {
+    st.advance(loose, time);
     for b in 0..loose.blocks {
-        let rows = rows_simd(loose, st, b, time, velocities.is_some());
-        let ctl = &st.ctl[b * CTL..(b + 1) * CTL];
-        let out = loose.out + 4 * b;
-        for c in 0..loose.dims[b] {
-            let k = &ctl[4 * c..4 * c + 4];
+        let [lo, hi] = loose.inner[b];
+        let out = loose.out + 4 * b..loose.out + 4 * b + 4;
+        if time >= lo && time < hi {
+            let (s, rate) = inside(loose, st, b, time);
+            let ctl = &st.ctl[loose.ctl_at[b]..loose.ctl_at[b + 1]];
+            let h = hermite_basis(s);
+            for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
+                *o = hermite(&h, k[0], k[1], k[2], k[3]);
+            }
+            if let Some(vel) = velocities.as_deref_mut() {
+                let dh = hermite_basis_derivative(s);
+                for (k, o) in ctl.chunks_exact(4).zip(&mut vel[out]) {
+                    *o = hermite(&dh, k[0], k[1], k[2], k[3]) * rate;
+                }
+            }
+            continue;
+        }
+        let rows = rows_mapped(loose, st, b, time, velocities.is_some());
+        let ctl = &st.ctl[loose.ctl_at[b]..loose.ctl_at[b + 1]];
+        for (c, k) in ctl.chunks_exact(4).enumerate() {
             let mut v = hermite(&rows.h, k[0], k[1], k[2], k[3]);
             if rows.any_cycles {
                 v += loose.delta[4 * b + c] * rows.cycles;
             }
-            values[out + c] = v;
+            values[out.start + c] = v;
             if let Some(vel) = velocities.as_deref_mut() {
-                vel[out + c] = hermite(&rows.dh, k[0], k[1], k[2], k[3]) * rows.rate;
+                vel[out.start + c] = hermite(&rows.dh, k[0], k[1], k[2], k[3]) * rows.rate;
             }
         }
     }
