@@ -436,7 +436,8 @@ impl LooseState {
     #[inline(never)]
     fn stream(&mut self, loose: &Loose, time: f64) {
         let mut budget = 4 * loose.lanes.len() + 64;
-        while time >= self.next_time {
+        // `next_time` is infinite past the end, which an infinite `time` passes.
+        while time >= self.next_time && self.next < loose.order.len() {
             if budget == 0 {
                 return self.seek(loose, time);
             }

@@ -567,8 +567,8 @@ proptest! {
 }
 
 /// Playback as an editor or a game drives it: mostly forward, with steps
-/// back, jumps ahead past many keys, loops back to the start and times
-/// beyond the keys. Every frame equals a fresh instance's (a seek), bit for
+/// back, jumps ahead past many keys, loops back to the start, times beyond
+/// the keys, and infinite or NaN times reached from any of those. Every frame equals a fresh instance's (a seek), bit for
 /// bit, so the loose lanes' forward stream and their seeks agree.
 #[test]
 fn scrubbing_equals_random_access() {
@@ -589,8 +589,10 @@ fn scrubbing_equals_random_access() {
                 t + rng.f(0.0, b - a)
             } else if r < 0.95 {
                 a
-            } else {
+            } else if r < 0.98 {
                 rng.f(a - 2.0, b + 2.0)
+            } else {
+                [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][rng.below(3)]
             };
             let mut fresh = Instance::new(compiled.clone(), true);
             let (p, q) = (playing.sample(t).clone(), fresh.sample(t));

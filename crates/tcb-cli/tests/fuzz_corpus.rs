@@ -1,0 +1,51 @@
+//! Replays the committed fuzz corpus (`fuzz/corpus/<target>/`: seeds and
+//! every crash found, each kept under a name that says what it found)
+//! through the fuzz targets' own bodies (`fuzz/src/lib.rs`) on stable Rust,
+//! so CI guards the findings without nightly or cargo-fuzz.
+
+#[path = "../../../fuzz/src/lib.rs"]
+mod bodies;
+
+use std::path::Path;
+
+fn replay(target: &str, body: fn(&[u8])) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/corpus")
+        .join(target);
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("corpus entry").path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no corpus in {}", dir.display());
+    for f in files {
+        let bytes = std::fs::read(&f).expect("read corpus file");
+        let r = std::panic::catch_unwind(|| body(&bytes));
+        assert!(r.is_ok(), "{target}: {} fails again", f.display());
+    }
+}
+
+#[test]
+fn clip_json_corpus() {
+    replay("clip_json", bodies::clip_json);
+}
+
+#[test]
+fn bvh_corpus() {
+    replay("bvh", bodies::bvh);
+}
+
+#[test]
+fn gltf_corpus() {
+    replay("gltf", bodies::gltf);
+}
+
+#[test]
+fn runtime_corpus() {
+    replay("runtime", bodies::runtime);
+}
+
+#[test]
+fn blend_corpus() {
+    replay("blend", bodies::blend);
+}
