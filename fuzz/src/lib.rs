@@ -144,20 +144,16 @@ fn check(clip: &tcb_core::Clip, times: &[f64]) {
             at += dim;
             if let TrackData::Quat(_) = track.data {
                 assert_rotation(&got[r.clone()], &want[r], &track.name, t);
-            } else {
+                continue;
+            }
+            // Where the reference itself is not finite (tangents that
+            // overflow f32 make its curve NaN), the runtime may be better.
+            for (what, got, want) in [("value", &got, &want), ("velocity", &got_v, &want_v)] {
+                let (g, w) = (&got[r.clone()], &want[r.clone()]);
                 assert!(
-                    same(&got[r.clone()], &want[r.clone()]),
-                    "{} at {t}: runtime {:?}, reference {:?}",
-                    track.name,
-                    &got[r.clone()],
-                    &want[r.clone()]
-                );
-                assert!(
-                    same(&got_v[r.clone()], &want_v[r.clone()]),
-                    "{} velocity at {t}: runtime {:?}, reference {:?}",
-                    track.name,
-                    &got_v[r.clone()],
-                    &want_v[r]
+                    w.iter().any(|x| !x.is_finite()) || same(g, w),
+                    "{} {what} at {t}: runtime {g:?}, reference {w:?}",
+                    track.name
                 );
             }
         }
@@ -198,7 +194,7 @@ fn arbitrary_f32(u: &mut Unstructured) -> arbitrary::Result<f32> {
 }
 
 /// Mostly times around the keys, sometimes anything (NaN and infinities included).
-fn arbitrary_time(u: &mut Unstructured) -> arbitrary::Result<f64> {
+pub fn arbitrary_time(u: &mut Unstructured) -> arbitrary::Result<f64> {
     if u.is_empty() {
         return Err(arbitrary::Error::NotEnoughData);
     }
@@ -255,7 +251,7 @@ fn value(u: &mut Unstructured) -> arbitrary::Result<[f32; 4]> {
 }
 
 /// A clip document of 1 to 6 tracks of 1 to 9 keys; `build` refuses what is invalid.
-fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
+pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
     let kinds = [
         TrackKind::Scalar,
         TrackKind::Vec2,

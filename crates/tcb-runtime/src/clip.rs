@@ -305,7 +305,18 @@ pub(crate) fn per_key(rows: &Controls) -> Vec<[f32; KEY_STRIDE]> {
             [p, to, ti]
         })
         .collect();
-    for r in [rows[0], rows[n]] {
+    // The sentinels are read only through the fixed rows of `grid.rs` (hold,
+    // reset, line, at the last key), whose zeros must not meet an infinite
+    // tangent (a key whose parameters overflow f32): there, 0 * inf would
+    // be NaN where the reference returns the key, or zero.
+    let finite = |x: f32| {
+        if x.is_nan() {
+            0.0
+        } else {
+            x.clamp(-f32::MAX, f32::MAX)
+        }
+    };
+    for r in [rows[0], rows[n]].map(|r| r.map(finite)) {
         out.push([r[0], r[2], 0.0]);
         out.push([r[1], 0.0, r[3]]);
     }
@@ -373,7 +384,7 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         let next = if interps[k] == Interp::Step { k } else { k + 1 };
         let (q0, q1) = (keys[k].to_array(), keys[next].to_array());
         let ctl: [[f32; 4]; 4] =
-            std::array::from_fn(|i| [q0[i], q1[i], d0[i], d1[i]].map(|x| x as f32));
+            std::array::from_fn(|i| [q0[i], q1[i], d0[i], d1[i]].map(finite_f32));
         for (i, comp) in comps.iter_mut().enumerate() {
             comp[k + 1] = ctl[i];
         }
@@ -389,10 +400,23 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
     let end_rate = (t.eases()[n - 2].apply(1.0).1 / d) as f32;
     for (i, comp) in comps.iter_mut().enumerate() {
         comp[0] = [first[i] as f32, first[i] as f32, 0.0, 0.0];
-        let arrive = comp[n - 1][3] * end_rate;
+        let arrive = finite_f32(f64::from(comp[n - 1][3]) * f64::from(end_rate));
         comp[n] = [last[i] as f32, last[i] as f32, 0.0, arrive];
     }
     RotationControls { comps, exact }
+}
+
+/// `x` in f32, finite: beyond f32's range the largest finite f32 of its
+/// sign, NaN as 0. Rotation controls come from f64 (squad's derivatives,
+/// tangents of keys with huge parameters); an infinite one would turn the
+/// zero of a hold row into NaN. Segments whose cubic this changes miss
+/// [`cubic_holds`] and are evaluated exactly.
+fn finite_f32(x: f64) -> f32 {
+    if x.is_nan() {
+        0.0
+    } else {
+        x.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
+    }
 }
 
 /// Whether the normalized cubic `ctl` (per component `[P0, P1, M0, M1]`,

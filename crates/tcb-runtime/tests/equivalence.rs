@@ -566,6 +566,92 @@ proptest! {
     }
 }
 
+/// A rotation whose tangents overflow f32 (a continuity of -1e300, which the
+/// contract allows: only non-finite parameters are refused) still holds its
+/// end keys as the reference does: the runtime used to multiply the post
+/// sentinel's infinite arrival velocity by the hold row's zero and return
+/// NaN (found by the `runtime` fuzz target).
+#[test]
+fn rotations_with_overflowing_tangents_hold_their_keys() {
+    for rotation in [RotationMode::Squad, RotationMode::Hermite] {
+        let t = vec![0.0, 1.0, 2.5, 3.0];
+        let q = [
+            Quat::from_rotation_x(0.3),
+            Quat::from_rotation_y(1.2),
+            Quat::from_rotation_z(-0.7),
+            Quat::from_rotation_x(2.0),
+        ];
+        let key = KeyParams {
+            tcb: tcb_core::Tcb::new(-0.4, -1e300, 0.0),
+            ..KeyParams::default()
+        };
+        let s = TrackSettings {
+            rotation,
+            ..TrackSettings::default()
+        };
+        let track = RotationTrack::new(t, q.to_vec(), vec![key; 4], &s).expect("finite parameters");
+        let clip = tcb_core::Clip {
+            name: "overflow".into(),
+            tracks: vec![NamedTrack {
+                name: "r".into(),
+                data: TrackData::Quat(track),
+            }],
+        };
+        let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+        let mut want = [0.0f32; 4];
+        // A vector track with the same keys' parameters, reset before its
+        // keys and held after: bit for bit there, where the reference is
+        // finite.
+        let v = Track::new(
+            vec![0.0, 1.0, 2.5, 3.0],
+            vec![Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE],
+            vec![
+                KeyParams {
+                    tcb: key.tcb,
+                    ..KeyParams::default()
+                };
+                4
+            ],
+            &TrackSettings {
+                pre: Extrapolation::Reset,
+                ..TrackSettings::default()
+            },
+        )
+        .expect("finite parameters");
+        let vclip = tcb_core::Clip {
+            name: "overflow".into(),
+            tracks: vec![NamedTrack {
+                name: "v".into(),
+                data: TrackData::Vec3(v),
+            }],
+        };
+        let mut vinst = Instance::new(Arc::new(Clip::compile(&vclip)), true);
+        for time in [-1.0, 3.5, 1e9] {
+            let (mut got, mut want) = ([0.0f32; 3], [0.0f32; 3]);
+            vinst.sample(time).write_row(&mut got, None);
+            vclip.sample_into(time, &mut want, None);
+            assert_eq!(got, want, "vec3 at {time}");
+        }
+        // Held before and after the keys (inside them, squad's inner points
+        // overflow in the reference too, and both give NaN).
+        for time in [-1.0, 3.5, 1e9] {
+            let mut got = [0.0f32; 4];
+            inst.sample(time).write_row(&mut got, None);
+            clip.sample_into(time, &mut want, None);
+            assert!(want.iter().all(|x| x.is_finite()), "{want:?}");
+            let close = |sign: f32| {
+                got.iter()
+                    .zip(&want)
+                    .all(|(g, w)| (g * sign - w).abs() <= 1e-6)
+            };
+            assert!(
+                close(1.0) || close(-1.0),
+                "{rotation:?} at {time}: runtime {got:?}, reference {want:?}"
+            );
+        }
+    }
+}
+
 /// Playback as an editor or a game drives it: mostly forward, with steps
 /// back, jumps ahead past many keys, loops back to the start, times beyond
 /// the keys, and infinite or NaN times reached from any of those. Every frame equals a fresh instance's (a seek), bit for
