@@ -561,11 +561,14 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
     for h in 0..2 {
         let i = 2 * b + h;
         let m = map_lanes(t, loose.t0[i], loose.tn[i], &loose.pre[i], &loose.post[i]);
-        // Lanes outside the keys read a sentinel: 0 before, n after.
+        // Lanes outside the keys read a sentinel: 0 before, n after. A
+        // time mapped inside but rounded below the first key (`oscillate`
+        // over a huge span) is the first segment at u = 0, as the
+        // reference's clamp of u makes it (and as `TimeGrid::frame` finds).
         let beyond = m
             .last
             .select(f64x4::splat(f64::MAX), f64x4::splat(-f64::MAX));
-        out_tm[h] = m.inside.select(m.time, beyond);
+        out_tm[h] = m.inside.select(m.time.max(loose.t0[i]), beyond);
         dir[h] = m.direction;
         cycles[h] = m.cycles;
         dt[h] = m.dt;

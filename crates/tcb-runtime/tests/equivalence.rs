@@ -652,6 +652,55 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
     }
 }
 
+/// `oscillate` over a huge span maps a time before the keys to the first
+/// key or a rounding below it; the reference evaluates the first segment at
+/// u = 0 there, and so must a loose lane (it read the pre sentinel, with
+/// zero velocity; found by the `runtime` fuzz target).
+#[test]
+fn mapped_times_rounded_below_the_first_key() {
+    let times = vec![
+        15.25,
+        17.5078125,
+        17.507812501,
+        19.812500001,
+        22.882812501,
+        23.421875001,
+        25.132812501,
+        27.609375001,
+        6.744580549654811e238,
+    ];
+    let n = times.len();
+    let values = (0..n)
+        .map(|k| Vec2::new(k as f32 - 3.0, (k * k) as f32 * 0.25))
+        .collect();
+    let settings = TrackSettings {
+        pre: Extrapolation::Oscillate,
+        ..TrackSettings::default()
+    };
+    let key = KeyParams {
+        tcb: Tcb::new(1.09, 0.44, -0.42),
+        ..KeyParams::default()
+    };
+    let track = Track::new(times, values, vec![key; n], &settings).expect("valid");
+    let clip = tcb_core::Clip {
+        name: "oscillate".into(),
+        tracks: vec![NamedTrack {
+            name: "v".into(),
+            data: TrackData::Vec2(track),
+        }],
+    };
+    assert_eq!(Clip::compile(&clip).loose_track_count(), 1);
+    check_clip(&clip, 5);
+    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), true);
+    for time in [6.7080078125, 0.0, -1e10, 15.0] {
+        let (mut got, mut got_v) = ([0.0f32; 2], [0.0f32; 2]);
+        let (mut want, mut want_v) = ([0.0f32; 2], [0.0f32; 2]);
+        inst.sample(time).write_row(&mut got, Some(&mut got_v));
+        clip.sample_into(time, &mut want, Some(&mut want_v));
+        assert_eq!((got, got_v), (want, want_v), "at {time}");
+    }
+}
+
 /// Playback as an editor or a game drives it: mostly forward, with steps
 /// back, jumps ahead past many keys, loops back to the start, times beyond
 /// the keys, and infinite or NaN times reached from any of those. Every frame equals a fresh instance's (a seek), bit for
