@@ -76,10 +76,43 @@ pub(crate) fn hermite_quats(
         if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
             vel[4 * i..4 * i + 4].copy_from_slice(&qv);
         }
+        if !in_range(&p) {
+            let v = vel.as_deref_mut().map(|v| &mut v[4 * i..4 * i + 4]);
+            renormalize_scaled(&p, dp.as_ref(), &mut out[4 * i..4 * i + 4], v);
+        }
     }
 }
 
 pub(crate) use tcb_core::quat::normalize;
+
+/// Whether `|p|^2` of every lane is well inside f32's range, so that
+/// [`normalize`] may run as it is (one compare per block).
+#[inline(always)]
+pub(crate) fn in_range(p: &[f32x8; 4]) -> bool {
+    let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
+    (n2.simd_gt(f32x8::splat(1e-30)) & n2.simd_lt(f32x8::splat(1e30))).all()
+}
+
+/// Rewrite `out` (and `vel`) with [`normalize`] of a block where `|p|^2`
+/// of some lane would overflow or underflow f32 (explicit tangents of
+/// 1e36, say): each lane is first divided by its largest component, which
+/// changes neither the rotation nor its velocity.
+#[cold]
+#[inline(never)]
+pub(crate) fn renormalize_scaled(
+    p: &[f32x8; 4],
+    dp: Option<&[f32x8; 4]>,
+    out: &mut [f32x8],
+    vel: Option<&mut [f32x8]>,
+) {
+    let m = p[0].abs().max(p[1].abs()).max(p[2].abs().max(p[3].abs()));
+    let inv = f32x8::ONE / m;
+    let (q, qv) = normalize(p.map(|x| x * inv), dp.map(|d| d.map(|x| x * inv)));
+    out[..4].copy_from_slice(&q);
+    if let (Some(vel), Some(qv)) = (vel, qv) {
+        vel[..4].copy_from_slice(&qv);
+    }
+}
 
 /// [`normalize`] in place over blocks of 4 planes (rotations sampled as
 /// loose lanes: the curve and its derivative, then normalized).
@@ -93,6 +126,10 @@ pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8
         v.copy_from_slice(&q);
         if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
             vel[4 * b..4 * b + 4].copy_from_slice(&qv);
+        }
+        if !in_range(&p) {
+            let dv = vel.as_deref_mut().map(|d| &mut d[4 * b..4 * b + 4]);
+            renormalize_scaled(&p, dp.as_ref(), v, dv);
         }
     }
 }

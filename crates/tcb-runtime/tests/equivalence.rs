@@ -652,6 +652,58 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
     }
 }
 
+/// A `hermite` rotation with explicit tangents of 1e36: the cubic's squared
+/// length overflows f32, and normalizing it gave a zero quaternion where
+/// the reference (normalizing in f64) gives a rotation (found by the
+/// `runtime` fuzz target).
+#[test]
+fn rotations_with_huge_tangents_stay_unit() {
+    let t = vec![0.0, 1.0, 2.0];
+    let q = vec![
+        Quat::from_rotation_x(0.3),
+        Quat::from_rotation_y(1.2),
+        Quat::IDENTITY,
+    ];
+    let huge = Quat::from_xyzw(2.3e36, 1.9, 1.9, 7.0);
+    let keys = vec![
+        KeyParams::default(),
+        KeyParams {
+            tangent_in: Some(huge),
+            tangent_out: Some(huge),
+            ..KeyParams::default()
+        },
+        KeyParams::default(),
+    ];
+    let s = TrackSettings {
+        rotation: RotationMode::Hermite,
+        ..TrackSettings::default()
+    };
+    let track = RotationTrack::new(t, q, keys, &s).expect("finite tangents");
+    let clip = tcb_core::Clip {
+        name: "huge".into(),
+        tracks: vec![NamedTrack {
+            name: "r".into(),
+            data: TrackData::Quat(track),
+        }],
+    };
+    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+    for time in [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0] {
+        let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
+        inst.sample(time).write_row(&mut got, None);
+        clip.sample_into(time, &mut want, None);
+        assert!(want.iter().all(|x| x.is_finite()), "{want:?}");
+        let close = |sign: f32| {
+            got.iter()
+                .zip(&want)
+                .all(|(g, w)| (g * sign - w).abs() <= 1e-6)
+        };
+        assert!(
+            close(1.0) || close(-1.0),
+            "at {time}: runtime {got:?}, reference {want:?}"
+        );
+    }
+}
+
 /// `oscillate` over a huge span maps a time before the keys to the first
 /// key or a rounding below it; the reference evaluates the first segment at
 /// u = 0 there, and so must a loose lane (it read the pre sentinel, with
