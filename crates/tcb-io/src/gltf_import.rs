@@ -27,6 +27,29 @@ pub struct GltfImport {
     pub warnings: Vec<String>,
 }
 
+/// Refuse a mesh primitive whose `POSITION` accessor does not exist: the
+/// `gltf` crate's own validation (gltf-json 1.4.1, `primitive_validate_hook`)
+/// indexes the accessors with it unchecked and panics (found by the `gltf`
+/// fuzz target).
+fn check_position_accessors(root: &gltf::json::Root) -> Result<(), Error> {
+    use gltf::json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = Checked::Valid(gltf::json::mesh::Semantic::Positions);
+            if let Some(a) = primitive.attributes.get(&position)
+                && a.value() >= root.accessors.len()
+            {
+                return Err(Error::import(format!(
+                    "not a valid glTF 2.0 file: meshes[{m}].primitives[{p}].attributes.POSITION is accessor {}, but the file has {} accessors",
+                    a.value(),
+                    root.accessors.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Import animation `animation` (a name or an index; the first when `None`)
 /// from glTF or GLB bytes. `base` is the directory external buffers are
 /// relative to (`None`: external buffers are an error).
@@ -36,8 +59,15 @@ pub fn import(
     animation: Option<&str>,
     name: &str,
 ) -> Result<GltfImport, Error> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| Error::import(format!("not a valid glTF 2.0 file: {e}")))?;
+    let invalid =
+        |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
+    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(&e))?;
+    let json = unchecked.document.into_json();
+    check_position_accessors(&json)?;
+    let gltf = gltf::Gltf {
+        document: gltf::Document::from_json(json).map_err(|e| invalid(&e))?,
+        blob: unchecked.blob,
+    };
     let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base)?;
     let mut warnings = Vec::new();
     let names = node_names(&gltf.document, &mut warnings);

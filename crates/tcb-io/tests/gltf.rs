@@ -202,3 +202,20 @@ fn absurd_files_are_errors_not_panics() {
         .to_string();
     assert_eq!(err, "no animation 'run' (the file has: 0)");
 }
+
+/// A mesh whose POSITION accessor does not exist is refused with a message;
+/// the `gltf` crate's own validation panics on it (found by fuzzing).
+#[test]
+fn a_missing_position_accessor_is_an_error_not_a_panic() {
+    let text = r#"{"asset": {"version": "2.0"},
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}],
+        "animations": []}"#;
+    let Err(e) = import(text.as_bytes(), None, None, "x") else {
+        panic!("accepted")
+    };
+    assert!(
+        e.to_string()
+            .contains("meshes[0].primitives[0].attributes.POSITION is accessor 1"),
+        "{e}"
+    );
+}
