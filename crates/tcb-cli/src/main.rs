@@ -260,6 +260,7 @@ fn import_options(
     Ok(tcb_io::ImportOptions {
         rotation: rotation.unwrap_or_default(),
         animation: animation.cloned(),
+        ..Default::default()
     })
 }
 

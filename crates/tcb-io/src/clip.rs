@@ -151,9 +151,15 @@ pub fn load_clip(path: &Path) -> Result<Clip, Error> {
     doc.build().map_err(|e| e.in_file(path))
 }
 
-/// Read and parse the clip file at `path` without building it.
+/// Read and parse the clip file at `path` without building it (files
+/// above [`crate::DEFAULT_MAX_FILE_BYTES`] are refused unread).
 pub fn read_clip_doc(path: &Path) -> Result<ClipDoc, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    read_clip_doc_limited(path, crate::DEFAULT_MAX_FILE_BYTES)
+}
+
+/// [`read_clip_doc`] with its own file size limit.
+pub(crate) fn read_clip_doc_limited(path: &Path, limit: u64) -> Result<ClipDoc, Error> {
+    let text = crate::read_text_limited(path, limit)?;
     ClipDoc::parse(&text).map_err(|e| e.in_file(path))
 }
 

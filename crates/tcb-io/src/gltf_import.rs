@@ -330,7 +330,7 @@ fn load_buffers(
                             ))
                         })?;
                         let path = base.join(percent_decode(uri));
-                        std::fs::read(&path).map_err(|e| Error::io(&path, e))?
+                        crate::read_limited(&path, crate::DEFAULT_MAX_FILE_BYTES)?
                     }
                 }
             };

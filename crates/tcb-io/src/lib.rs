@@ -39,13 +39,65 @@ use std::path::Path;
 use tcb_core::RotationMode;
 use tcb_core::skeleton::Skeleton;
 
+/// Files larger than this are refused unread (1 GiB; the bundled CMU
+/// capture, 2752 frames of 31 joints, is 2 MB). [`ImportOptions::max_file_bytes`]
+/// raises it for [`load_with`].
+pub const DEFAULT_MAX_FILE_BYTES: u64 = 1 << 30;
+
 /// Choices for importing other formats (see [`load_with`]).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct ImportOptions {
     /// Rotation mode of BVH rotation tracks (default `squad`).
     pub rotation: RotationMode,
     /// glTF animation to import, by name or index (default: the first).
     pub animation: Option<String>,
+    /// Largest file read, in bytes (default [`DEFAULT_MAX_FILE_BYTES`]).
+    pub max_file_bytes: u64,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        ImportOptions {
+            rotation: RotationMode::default(),
+            animation: None,
+            max_file_bytes: DEFAULT_MAX_FILE_BYTES,
+        }
+    }
+}
+
+/// The bytes of `path`, refusing (unread) a file larger than `limit`.
+pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
+    use std::io::Read;
+    let too_big = |len: u64| {
+        Error::import(format!(
+            "{len} bytes; files above {limit} bytes are refused (ImportOptions::max_file_bytes)"
+        ))
+        .in_file(path)
+    };
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    if len > limit {
+        return Err(too_big(len));
+    }
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// [`read_limited`] as UTF-8 text.
+pub(crate) fn read_text_limited(path: &Path, limit: u64) -> Result<String, Error> {
+    String::from_utf8(read_limited(path, limit)?).map_err(|_| {
+        let e = std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        );
+        Error::io(path, e)
+    })
 }
 
 /// A clip file, BVH or glTF file, read and validated.
@@ -87,9 +139,12 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let (doc, warnings) = match ext.as_str() {
-        "json" => (read_clip_doc(path)?, Vec::new()),
+        "json" => (
+            clip::read_clip_doc_limited(path, options.max_file_bytes)?,
+            Vec::new(),
+        ),
         "bvh" => {
-            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            let text = read_text_limited(path, options.max_file_bytes)?;
             let bvh = bvh::Bvh::parse(&text).map_err(|e| e.in_file(path))?;
             let doc = bvh
                 .to_clip_doc(&stem, options.rotation)
@@ -97,7 +152,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
             (doc, bvh.warnings)
         }
         "gltf" | "glb" => {
-            let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+            let bytes = read_limited(path, options.max_file_bytes)?;
             let base = path.parent().unwrap_or(Path::new("."));
             let g = gltf_import::import(&bytes, Some(base), options.animation.as_deref(), &stem)
                 .map_err(|e| e.in_file(path))?;

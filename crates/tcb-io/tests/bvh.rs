@@ -275,3 +275,30 @@ fn errors_from_files_name_the_file_and_nothing_is_written() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A 2 GB file is refused unread, naming the limit (the file is sparse:
+/// nothing is written to disk); `ImportOptions::max_file_bytes` sets it.
+#[test]
+fn files_above_the_size_limit_are_refused_unread() {
+    let dir = std::env::temp_dir().join(format!("tcb-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["bvh", "json", "gltf"] {
+        let path = dir.join(format!("huge.{ext}"));
+        let f = std::fs::File::create(&path).unwrap();
+        f.set_len(2 << 30).unwrap();
+        let e = tcb_io::load(&path).expect_err("refused");
+        let text = e.to_string();
+        assert!(
+            text.contains("2147483648 bytes; files above 1073741824 bytes are refused"),
+            "{text}"
+        );
+        let small = ImportOptions {
+            max_file_bytes: 1000,
+            ..Default::default()
+        };
+        std::fs::write(&path, vec![b' '; 2000]).unwrap();
+        let e = load_with(&path, &small).expect_err("refused");
+        assert!(e.to_string().contains("files above 1000 bytes"), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
