@@ -147,6 +147,12 @@ fn absurd_files_are_errors_not_panics() {
                {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
             "do not fit in buffer view 0",
         ),
+        // A count at u32::MAX (its byte length overflows 32 bits).
+        (
+            r#"{"bufferView": 0, "componentType": 5126, "count": 4294967295, "type": "SCALAR", "min": [0], "max": [1]},
+               {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#,
+            "do not fit in buffer view 0",
+        ),
         // An offset past the end.
         (
             r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},

@@ -36,7 +36,7 @@
 
 pub mod blend;
 pub mod clip;
-pub mod grid;
+pub(crate) mod grid;
 mod instance;
 mod kernel;
 mod loose;
