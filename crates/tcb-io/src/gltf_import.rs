@@ -27,23 +27,48 @@ pub struct GltfImport {
     pub warnings: Vec<String>,
 }
 
-/// Refuse a mesh primitive whose `POSITION` accessor does not exist: the
-/// `gltf` crate's own validation (gltf-json 1.4.1, `primitive_validate_hook`)
-/// indexes the accessors with it unchecked and panics (found by the `gltf`
-/// fuzz target).
-fn check_position_accessors(root: &gltf::json::Root) -> Result<(), Error> {
+/// Refuse indices the `gltf` crate (1.4.1) reads unchecked and panics on,
+/// its own validation included (both found by the `gltf` fuzz target): a
+/// mesh primitive's `POSITION` accessor (`primitive_validate_hook`), and an
+/// animation channel's target node and sampler and a sampler's accessors
+/// (`Channel::target().node()` unwraps).
+fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
     use gltf::json::validation::Checked;
+    let bad = |what: String, index: usize, kind: &str, count: usize| {
+        Error::import(format!(
+            "not a valid glTF 2.0 file: {what} is {kind} {index}, but the file has {count} {kind}s"
+        ))
+    };
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let position = Checked::Valid(gltf::json::mesh::Semantic::Positions);
             if let Some(a) = primitive.attributes.get(&position)
                 && a.value() >= root.accessors.len()
             {
-                return Err(Error::import(format!(
-                    "not a valid glTF 2.0 file: meshes[{m}].primitives[{p}].attributes.POSITION is accessor {}, but the file has {} accessors",
-                    a.value(),
-                    root.accessors.len()
-                )));
+                let what = format!("meshes[{m}].primitives[{p}].attributes.POSITION");
+                return Err(bad(what, a.value(), "accessor", root.accessors.len()));
+            }
+        }
+    }
+    for (a, anim) in root.animations.iter().enumerate() {
+        for (c, channel) in anim.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= root.nodes.len() {
+                let what = format!("animations[{a}].channels[{c}].target.node");
+                return Err(bad(what, node, "node", root.nodes.len()));
+            }
+            let sampler = channel.sampler.value();
+            if sampler >= anim.samplers.len() {
+                let what = format!("animations[{a}].channels[{c}].sampler");
+                return Err(bad(what, sampler, "sampler", anim.samplers.len()));
+            }
+        }
+        for (i, sampler) in anim.samplers.iter().enumerate() {
+            for (field, acc) in [("input", sampler.input), ("output", sampler.output)] {
+                if acc.value() >= root.accessors.len() {
+                    let what = format!("animations[{a}].samplers[{i}].{field}");
+                    return Err(bad(what, acc.value(), "accessor", root.accessors.len()));
+                }
             }
         }
     }
@@ -63,7 +88,7 @@ pub fn import(
         |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(&e))?;
     let json = unchecked.document.into_json();
-    check_position_accessors(&json)?;
+    check_indices(&json)?;
     let gltf = gltf::Gltf {
         document: gltf::Document::from_json(json).map_err(|e| invalid(&e))?,
         blob: unchecked.blob,

@@ -225,3 +225,22 @@ fn a_missing_position_accessor_is_an_error_not_a_panic() {
         "{e}"
     );
 }
+
+/// An animation channel aimed at a node that does not exist is refused with
+/// a message; the `gltf` crate's `target().node()` unwraps it (found by
+/// fuzzing).
+#[test]
+fn a_missing_target_node_is_an_error_not_a_panic() {
+    let buf = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    let acc = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#;
+    let text = gltf_with(acc, &buf).replace(r#""node": 0"#, r#""node": 5"#);
+    let Err(e) = import(text.as_bytes(), None, None, "x") else {
+        panic!("accepted")
+    };
+    assert!(
+        e.to_string()
+            .contains("animations[0].channels[0].target.node is node 5, but the file has 1 nodes"),
+        "{e}"
+    );
+}
