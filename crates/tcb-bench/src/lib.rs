@@ -16,6 +16,7 @@
 #![forbid(unsafe_code)]
 
 pub mod baseline;
+pub mod icount;
 pub mod measure;
 pub mod peer;
 pub mod report;

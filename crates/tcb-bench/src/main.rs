@@ -9,7 +9,7 @@ use clap::Parser;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
-use tcb_bench::{report, scenarios};
+use tcb_bench::{icount, report, scenarios};
 
 #[derive(Parser)]
 #[command(
@@ -42,6 +42,23 @@ struct Args {
     /// forward over each clip, as `character`.
     #[arg(long, value_name = "FILE")]
     clip: Vec<PathBuf>,
+    /// Count instructions instead of timing: each scenario's runtime pass
+    /// once under valgrind's callgrind (repeatable on the same binary).
+    #[arg(long)]
+    icount: bool,
+    /// With --icount: compare with saved counts; exit 1 when a scenario
+    /// executes more than --icount-max-growth percent more instructions.
+    #[arg(long, value_name = "ICOUNT.json", requires = "icount")]
+    icount_check: Option<PathBuf>,
+    /// With --icount: write the counts here (the baseline to commit).
+    #[arg(long, value_name = "ICOUNT.json", requires = "icount")]
+    icount_save: Option<PathBuf>,
+    /// Largest allowed growth of a scenario's instruction count, percent.
+    #[arg(long, value_name = "PCT", default_value_t = 2.0)]
+    icount_max_growth: f64,
+    /// Run one scenario's pass and exit (what --icount runs under valgrind).
+    #[arg(long, value_name = "NAME", hide = true)]
+    icount_pass: Option<String>,
 }
 
 fn main() -> ExitCode {
@@ -56,7 +73,74 @@ fn main() -> ExitCode {
     }
 }
 
+/// `--icount`: count each scenario under callgrind, then check or save.
+fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
+    let saved = match &args.icount_check {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Some(
+                serde_json::from_str::<serde_json::Value>(&text)
+                    .map_err(|e| format!("{}: {e}", p.display()))?,
+            )
+        }
+        None => None,
+    };
+    let names: Vec<&str> = match &args.only {
+        Some(o) => o.split(',').map(str::trim).collect(),
+        None => icount::NAMES.to_vec(),
+    };
+    if let Some(bad) = names.iter().find(|n| !icount::NAMES.contains(n)) {
+        return Err(format!(
+            "--only {bad}: not counted (one of {})",
+            icount::NAMES.join(", ")
+        )
+        .into());
+    }
+    let exe = std::env::current_exe()?;
+    let mut counts = std::collections::BTreeMap::new();
+    println!("tcb-bench --icount: instructions of one runtime pass under callgrind");
+    println!("flags: {}", report::flags());
+    for name in names {
+        let c = icount::count(&exe, name, &args.bvh)?;
+        println!(
+            "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses",
+            c.instructions, c.l1_misses, c.ll_misses
+        );
+        counts.insert(name.to_string(), c);
+    }
+    if let Some(path) = &args.icount_save {
+        let note = format!(
+            "tcb-bench --icount ({}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
+            report::flags(),
+            path.display()
+        );
+        tcb_io::write_atomically(path, icount::to_json(&counts, &note).as_bytes())?;
+    }
+    let mut ok = true;
+    if let Some(saved) = &saved {
+        let (lines, held) = icount::check(&counts, saved, args.icount_max_growth);
+        println!(
+            "
+instruction counts against the saved ones:"
+        );
+        for l in lines {
+            println!("{l}");
+        }
+        ok = held;
+    }
+    Ok(ok)
+}
+
 fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
+    if let Some(name) = &args.icount_pass {
+        let s = scenarios::named(&args.bvh, |n| n == name)?;
+        let s = s.first().ok_or_else(|| format!("no scenario {name}"))?;
+        icount::run_pass(s);
+        return Ok(true);
+    }
+    if args.icount {
+        return run_icount(args);
+    }
     if args.max_regression.is_nan() || args.max_regression < 0.0 || args.rounds == 0 {
         return Err("--max-regression must be >= 0 and --rounds > 0".into());
     }

@@ -29,9 +29,10 @@ pub struct GltfImport {
 
 /// Refuse indices the `gltf` crate (1.4.1) reads unchecked and panics on,
 /// its own validation included (both found by the `gltf` fuzz target): a
-/// mesh primitive's `POSITION` accessor (`primitive_validate_hook`), and an
+/// mesh primitive's `POSITION` accessor (`primitive_validate_hook`), an
 /// animation channel's target node and sampler and a sampler's accessors
-/// (`Channel::target().node()` unwraps).
+/// (`Channel::target().node()` unwraps), and a target path or an
+/// interpolation it could not read (`Target::property()` unwraps).
 fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
     use gltf::json::validation::Checked;
     let bad = |what: String, index: usize, kind: &str, count: usize| {
@@ -57,6 +58,11 @@ fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
                 let what = format!("animations[{a}].channels[{c}].target.node");
                 return Err(bad(what, node, "node", root.nodes.len()));
             }
+            if !matches!(channel.target.path, Checked::Valid(_)) {
+                return Err(Error::import(format!(
+                    "not a valid glTF 2.0 file: animations[{a}].channels[{c}].target.path is not translation, rotation, scale or weights"
+                )));
+            }
             let sampler = channel.sampler.value();
             if sampler >= anim.samplers.len() {
                 let what = format!("animations[{a}].channels[{c}].sampler");
@@ -64,6 +70,11 @@ fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
             }
         }
         for (i, sampler) in anim.samplers.iter().enumerate() {
+            if !matches!(sampler.interpolation, Checked::Valid(_)) {
+                return Err(Error::import(format!(
+                    "not a valid glTF 2.0 file: animations[{a}].samplers[{i}].interpolation is not LINEAR, STEP or CUBICSPLINE"
+                )));
+            }
             for (field, acc) in [("input", sampler.input), ("output", sampler.output)] {
                 if acc.value() >= root.accessors.len() {
                     let what = format!("animations[{a}].samplers[{i}].{field}");

@@ -244,3 +244,21 @@ fn a_missing_target_node_is_an_error_not_a_panic() {
         "{e}"
     );
 }
+
+/// A channel target path the file format does not know (an extension's, or
+/// a typo) is refused with a message; the `gltf` crate's `property()`
+/// unwraps it (found by fuzzing).
+#[test]
+fn an_unknown_target_path_is_an_error_not_a_panic() {
+    let buf = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    let acc = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#;
+    let text = gltf_with(acc, &buf).replace(r#""path": "translation""#, r#""path": "translashun""#);
+    let Err(e) = import(text.as_bytes(), None, None, "x") else {
+        panic!("accepted")
+    };
+    assert!(
+        e.to_string().contains("target.path is not translation"),
+        "{e}"
+    );
+}

@@ -1,0 +1,213 @@
+//! Instruction counts: the regression gate that holds on noisy machines.
+//!
+//! `tcb-bench --icount` runs each scenario's runtime pass once under
+//! valgrind's callgrind (`--toggle-collect` on [`pass`], so only sampling
+//! counts, not building the scenario) and reads the instructions executed,
+//! with callgrind's cache simulation for L1 and last-level miss estimates.
+//! The same binary gives the same counts whatever else the machine does;
+//! `--icount-check FILE` fails when a scenario executes more than
+//! `--icount-max-growth` percent (default 2) more instructions than the
+//! saved counts, and `--icount-save FILE` writes them.
+
+use crate::scenarios::Scenario;
+use std::collections::BTreeMap;
+use std::hint::black_box;
+use std::path::Path;
+use std::process::Command;
+use tcb_runtime::Instance;
+
+/// The scenarios counted: all but `character-reduced`, whose `tcb reduce`
+/// run takes over 15 minutes under valgrind (rayon is not counted either:
+/// `crowd` is its one-thread pass).
+pub const NAMES: [&str; 7] = [
+    "character-hermite",
+    "character-squad",
+    "crowd",
+    "wide",
+    "sparse",
+    "sparse-rotations",
+    "seek",
+];
+
+/// One pass of a scenario's runtime (every time, every instance), the code
+/// callgrind counts. Never inlined: its name is the toggle.
+#[inline(never)]
+pub fn pass(s: &Scenario, instances: &mut [Instance]) {
+    for &t in &s.times {
+        for (inst, &p) in instances.iter_mut().zip(&s.phases) {
+            black_box(inst.sample(t + p));
+        }
+    }
+}
+
+/// Run [`pass`] once for `s` (what `--icount-pass NAME` does, under valgrind).
+pub fn run_pass(s: &Scenario) {
+    let mut instances: Vec<Instance> = s
+        .phases
+        .iter()
+        .map(|_| Instance::new(s.clip.clone(), false))
+        .collect();
+    pass(s, &mut instances);
+}
+
+/// Counts of one scenario.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Counts {
+    /// Instructions executed.
+    pub instructions: u64,
+    /// L1 misses, instruction and data (callgrind's estimate).
+    pub l1_misses: u64,
+    /// Last-level misses, instruction and data (callgrind's estimate).
+    pub ll_misses: u64,
+}
+
+/// Count scenario `name` by running `exe --icount-pass NAME --bvh BVH`
+/// under callgrind.
+pub fn count(exe: &Path, name: &str, bvh: &Path) -> Result<Counts, String> {
+    let out = std::env::temp_dir().join(format!(
+        "tcb-icount-{}-{name}.callgrind",
+        std::process::id()
+    ));
+    let status = Command::new("valgrind")
+        .arg("--tool=callgrind")
+        .arg("--cache-sim=yes")
+        .arg(format!("--callgrind-out-file={}", out.display()))
+        .arg("--toggle-collect=tcb_bench::icount::pass")
+        .arg(exe)
+        .args(["--icount-pass", name, "--bvh"])
+        .arg(bvh)
+        .output()
+        .map_err(|e| {
+            format!("cannot run valgrind ({e}); install it (apt-get install -y valgrind)")
+        })?;
+    if !status.status.success() {
+        return Err(format!(
+            "valgrind on {name} failed: {}",
+            String::from_utf8_lossy(&status.stderr)
+        ));
+    }
+    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let _ = std::fs::remove_file(&out);
+    parse(&text).ok_or_else(|| format!("no totals in callgrind's output for {name}"))
+}
+
+/// Totals from a callgrind output file (its `events:` and `summary:` lines).
+pub fn parse(text: &str) -> Option<Counts> {
+    let line = |key: &str| text.lines().find_map(|l| l.strip_prefix(key));
+    let events: Vec<&str> = line("events:")?.split_whitespace().collect();
+    let totals: Vec<u64> = line("summary:")?
+        .split_whitespace()
+        .map(|x| x.parse().ok())
+        .collect::<Option<_>>()?;
+    let get = |e: &str| {
+        events
+            .iter()
+            .position(|x| *x == e)
+            .and_then(|i| totals.get(i))
+            .copied()
+            .unwrap_or(0)
+    };
+    Some(Counts {
+        instructions: get("Ir"),
+        l1_misses: get("I1mr") + get("D1mr") + get("D1mw"),
+        ll_misses: get("ILmr") + get("DLmr") + get("DLmw"),
+    })
+}
+
+/// Counts as the saved JSON.
+pub fn to_json(counts: &BTreeMap<String, Counts>, note: &str) -> String {
+    let scenarios: serde_json::Map<String, serde_json::Value> = counts
+        .iter()
+        .map(|(k, c)| {
+            (
+                k.clone(),
+                serde_json::json!({
+                    "instructions": c.instructions,
+                    "l1_misses": c.l1_misses,
+                    "ll_misses": c.ll_misses,
+                }),
+            )
+        })
+        .collect();
+    let doc = serde_json::json!({ "note": note, "scenarios": scenarios });
+    serde_json::to_string_pretty(&doc).expect("plain JSON") + "\n"
+}
+
+/// Compare with saved counts: a line per scenario, and whether every
+/// scenario's instructions grew by at most `max_growth` percent. A saved
+/// scenario that was not counted is a failure; a new one is reported.
+pub fn check(
+    counts: &BTreeMap<String, Counts>,
+    saved: &serde_json::Value,
+    max_growth: f64,
+) -> (Vec<String>, bool) {
+    let mut lines = Vec::new();
+    let mut ok = true;
+    let saved = saved.get("scenarios").and_then(|s| s.as_object());
+    for (name, c) in counts {
+        let Some(before) = saved
+            .and_then(|s| s.get(name))
+            .and_then(|s| s.get("instructions"))
+            .and_then(|x| x.as_u64())
+        else {
+            lines.push(format!("  new {name}: {} instructions", c.instructions));
+            continue;
+        };
+        let growth = 100.0 * (c.instructions as f64 / before as f64 - 1.0);
+        let fine = growth <= max_growth;
+        ok &= fine;
+        lines.push(format!(
+            "  {} {name}: {before} -> {} instructions ({growth:+.2}%, allowed +{max_growth}%), L1 misses {}, LL misses {}",
+            if fine { "ok" } else { "REGRESSION" },
+            c.instructions,
+            c.l1_misses,
+            c.ll_misses
+        ));
+    }
+    if let Some(s) = saved {
+        for name in s.keys().filter(|n| !counts.contains_key(*n)) {
+            lines.push(format!("  MISSING {name}: saved but not counted"));
+            ok = false;
+        }
+    }
+    (lines, ok)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_callgrind_totals() {
+        let text = "version: 1\nevents: Ir Dr Dw I1mr D1mr D1mw ILmr DLmr DLmw\nsummary: 1000 10 20 1 2 3 0 1 1\n";
+        let c = parse(text).unwrap();
+        assert_eq!(
+            c,
+            Counts {
+                instructions: 1000,
+                l1_misses: 6,
+                ll_misses: 2
+            }
+        );
+    }
+
+    #[test]
+    fn five_percent_more_work_fails_two_percent_passes() {
+        let c = |i| Counts {
+            instructions: i,
+            l1_misses: 0,
+            ll_misses: 0,
+        };
+        let saved: serde_json::Value = serde_json::from_str(&to_json(
+            &BTreeMap::from([("wide".to_string(), c(100_000))]),
+            "",
+        ))
+        .unwrap();
+        let now = |i| BTreeMap::from([("wide".to_string(), c(i))]);
+        assert!(check(&now(100_000), &saved, 2.0).1);
+        assert!(check(&now(101_900), &saved, 2.0).1);
+        assert!(!check(&now(105_000), &saved, 2.0).1);
+        // A scenario that disappeared fails too.
+        assert!(!check(&BTreeMap::new(), &saved, 2.0).1);
+    }
+}
