@@ -626,9 +626,22 @@ fn sample_times(args: &SampleArgs, clip: &Clip) -> Result<Vec<f64>, BoxError> {
         if to < from {
             return Err(format!("--to {to} is before --from {from}").into());
         }
-        let n = frame_count(from, to, fps).unwrap_or(u64::MAX);
-        if n > MAX_SAMPLES {
-            return Err(format!("{n} sample times requested; at most {MAX_SAMPLES}").into());
+        match frame_count(from, to, fps) {
+            Some(n) if n <= MAX_SAMPLES => {}
+            Some(n) => {
+                return Err(format!("{n} sample times requested; at most {MAX_SAMPLES}").into());
+            }
+            None => {
+                let fps = if fps >= 1e15 {
+                    format!("{fps:e}")
+                } else {
+                    format!("{fps}")
+                };
+                return Err(format!(
+                    "--fps {fps} over {from} to {to} s asks for more than {MAX_SAMPLES} sample times"
+                )
+                .into());
+            }
         }
         return Ok(frame_times(from, to, fps).collect());
     }

@@ -208,6 +208,11 @@ fn usage_errors() {
             vec!["--fps", "1e12", "--to", "1e6"],
             "sample times requested",
         ),
+        // Too many to count in 64 bits: said so, not as 2^64 - 1 of them.
+        (
+            vec!["--fps", "1e300"],
+            "--fps 1e300 over 0 to 2 s asks for more than 100000000 sample times",
+        ),
     ] {
         let mut all = vec!["sample", clip.as_str()];
         all.extend(args);

@@ -33,7 +33,9 @@ pub fn frame_count(from: f64, to: f64, fps: f64) -> Option<u64> {
     }
     // A tiny allowance so that `to` counts as on the grid despite rounding.
     let steps = ((to - from) * fps * (1.0 + 1e-12) + 1e-9).floor();
-    (steps < u64::MAX as f64).then_some(steps as u64 + 1)
+    // `then`, not `then_some`: the count must not be computed (and
+    // overflow) when there are too many to count.
+    (steps < u64::MAX as f64).then(|| steps as u64 + 1)
 }
 
 /// `from + i / fps` for `i = 0, 1, ..` up to `to` (included when on the grid).
@@ -58,6 +60,8 @@ mod tests {
         assert_eq!(frame_count(0.0, 2.0 - 1e-3, 60.0), Some(120));
         assert_eq!(frame_count(0.1, 0.7, 10.0), Some(7));
         assert_eq!(frame_count(0.0, 1.0, 0.0), None);
+        // More than u64 can count: None, not an overflow.
+        assert_eq!(frame_count(0.0, 2.0, 1e300), None);
         assert_eq!(frame_count(1.0, 0.0, 10.0), None);
         assert_eq!(frame_count(0.0, 1.0, f64::NAN), None);
         assert_eq!(frame_count(0.0, 0.0, 30.0), Some(1));

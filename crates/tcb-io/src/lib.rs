@@ -158,6 +158,12 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
                 .map_err(|e| e.in_file(path))?;
             (g.doc, g.warnings)
         }
+        "" => {
+            return Err(Error::import(
+                "no file extension to tell its type (expected .json, .bvh, .gltf or .glb)",
+            )
+            .in_file(path));
+        }
         _ => {
             return Err(Error::import(format!(
                 "unknown file type '.{ext}' (expected .json, .bvh, .gltf or .glb)"

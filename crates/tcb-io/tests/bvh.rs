@@ -302,3 +302,18 @@ fn files_above_the_size_limit_are_refused_unread() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A file without an extension says so, rather than "unknown file type '.'".
+#[test]
+fn a_file_without_an_extension_says_so() {
+    let dir = std::env::temp_dir().join(format!("tcb-noext-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("clip");
+    std::fs::write(&path, "{}").unwrap();
+    let e = tcb_io::load(&path).expect_err("refused");
+    assert!(
+        e.to_string().contains("no file extension to tell its type"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
