@@ -73,26 +73,29 @@ fn main() -> ExitCode {
     }
 }
 
+/// A saved JSON report or count file, if one is given.
+fn read_json(path: Option<&std::path::Path>) -> Result<Option<serde_json::Value>, String> {
+    let Some(p) = path else { return Ok(None) };
+    let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| format!("{}: {e}", p.display()))
+}
+
 /// `--icount`: count each scenario under callgrind, then check or save.
 fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
-    let saved = match &args.icount_check {
-        Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            Some(
-                serde_json::from_str::<serde_json::Value>(&text)
-                    .map_err(|e| format!("{}: {e}", p.display()))?,
-            )
-        }
-        None => None,
-    };
+    if args.icount_max_growth.is_nan() || args.icount_max_growth < 0.0 {
+        return Err("--icount-max-growth must be a number >= 0".into());
+    }
+    let saved = read_json(args.icount_check.as_deref())?;
     let names: Vec<&str> = match &args.only {
         Some(o) => o.split(',').map(str::trim).collect(),
-        None => icount::NAMES.to_vec(),
+        None => icount::names(),
     };
-    if let Some(bad) = names.iter().find(|n| !icount::NAMES.contains(n)) {
+    if let Some(bad) = names.iter().find(|n| !icount::names().contains(n)) {
         return Err(format!(
             "--only {bad}: not counted (one of {})",
-            icount::NAMES.join(", ")
+            icount::names().join(", ")
         )
         .into());
     }
@@ -152,16 +155,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         return Err("--max-regression must be >= 0 and --rounds > 0".into());
     }
     // Read the baseline first: a bad file should fail before minutes of timing.
-    let saved = match &args.check {
-        Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            Some(
-                serde_json::from_str::<serde_json::Value>(&text)
-                    .map_err(|e| format!("{}: {e}", p.display()))?,
-            )
-        }
-        None => None,
-    };
+    let saved = read_json(args.check.as_deref())?;
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
