@@ -13,7 +13,7 @@ fn bench(c: &mut Criterion) {
     for s in &all {
         let mut g = c.benchmark_group(s.name.as_str());
         g.sample_size(20);
-        let mut run = s.baseline_pass();
+        let mut run = s.baseline_pass(s.times.clone(), s.phases.clone());
         g.bench_function("baseline", |b| b.iter(&mut run));
         let mut run = s.runtime_pass();
         g.bench_function("runtime", |b| b.iter(&mut run));
@@ -21,7 +21,7 @@ fn bench(c: &mut Criterion) {
             let mut run = s.parallel_pass();
             g.bench_function("runtime_parallel", |b| b.iter(&mut run));
         }
-        if let Some(mut run) = s.peer_pass() {
+        if let Some(mut run) = s.peer_pass(s.times.clone()) {
             g.bench_function("splines", |b| b.iter(&mut run));
         }
         if s.read_limit {

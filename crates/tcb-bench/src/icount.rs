@@ -7,7 +7,9 @@
 //! The same binary gives the same counts whatever else the machine does;
 //! `--icount-check FILE` fails when a scenario executes more than
 //! `--icount-max-growth` percent (default 2) more instructions than the
-//! saved counts, and `--icount-save FILE` writes them.
+//! saved counts, or when a scenario's compiled clip holds more bytes
+//! ([`tcb_runtime::Clip::memory_bytes`], deterministic too), and
+//! `--icount-save FILE` writes them.
 
 use crate::scenarios::Scenario;
 use std::collections::BTreeMap;
@@ -37,8 +39,10 @@ pub fn pass(s: &Scenario, instances: &mut [Instance]) {
     }
 }
 
-/// Run [`pass`] once for `s` (what `--icount-pass NAME` does, under valgrind).
+/// Run [`pass`] once for `s` (what `--icount-pass NAME` does, under
+/// valgrind), and print the compiled clip's bytes for [`count`] to read.
 pub fn run_pass(s: &Scenario) {
+    println!("bytes: {}", s.clip.memory_bytes());
     let mut instances: Vec<Instance> = s
         .phases
         .iter()
@@ -56,11 +60,14 @@ pub struct Counts {
     pub l1_misses: u64,
     /// Last-level misses, instruction and data (callgrind's estimate).
     pub ll_misses: u64,
+    /// The compiled clip's heap bytes.
+    pub bytes: u64,
 }
 
 /// Count scenario `name` by running `exe --icount-pass NAME --bvh BVH`
-/// under callgrind.
-pub fn count(exe: &Path, name: &str, bvh: &Path) -> Result<Counts, String> {
+/// under callgrind, or with `clip` the pass over that file
+/// (`--icount-pass NAME --clip FILE`, as `--clip` times it).
+pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<Counts, String> {
     let out = std::env::temp_dir().join(format!(
         "tcb-icount-{}-{name}.callgrind",
         std::process::id()
@@ -73,6 +80,11 @@ pub fn count(exe: &Path, name: &str, bvh: &Path) -> Result<Counts, String> {
         .arg(exe)
         .args(["--icount-pass", name, "--bvh"])
         .arg(bvh)
+        .args(
+            clip.map(|c| [std::ffi::OsStr::new("--clip"), c.as_os_str()])
+                .into_iter()
+                .flatten(),
+        )
         .output()
         .map_err(|e| {
             format!("cannot run valgrind ({e}); install it (apt-get install -y valgrind)")
@@ -85,7 +97,14 @@ pub fn count(exe: &Path, name: &str, bvh: &Path) -> Result<Counts, String> {
     }
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let _ = std::fs::remove_file(&out);
-    parse(&text).ok_or_else(|| format!("no totals in callgrind's output for {name}"))
+    let mut counts =
+        parse(&text).ok_or_else(|| format!("no totals in callgrind's output for {name}"))?;
+    counts.bytes = String::from_utf8_lossy(&status.stdout)
+        .lines()
+        .find_map(|l| l.strip_prefix("bytes: "))
+        .and_then(|b| b.trim().parse().ok())
+        .ok_or_else(|| format!("the pass of {name} printed no bytes"))?;
+    Ok(counts)
 }
 
 /// Totals from a callgrind output file (its `events:` and `summary:` lines).
@@ -108,6 +127,7 @@ pub fn parse(text: &str) -> Option<Counts> {
         instructions: get("Ir"),
         l1_misses: get("I1mr") + get("D1mr") + get("D1mw"),
         ll_misses: get("ILmr") + get("DLmr") + get("DLmw"),
+        bytes: 0,
     })
 }
 
@@ -122,6 +142,7 @@ pub fn to_json(counts: &BTreeMap<String, Counts>, note: &str) -> String {
                     "instructions": c.instructions,
                     "l1_misses": c.l1_misses,
                     "ll_misses": c.ll_misses,
+                    "bytes": c.bytes,
                 }),
             )
         })
@@ -131,8 +152,9 @@ pub fn to_json(counts: &BTreeMap<String, Counts>, note: &str) -> String {
 }
 
 /// Compare with saved counts: a line per scenario, and whether every
-/// scenario's instructions grew by at most `max_growth` percent. A saved
-/// scenario that was not counted is a failure; a new one is reported.
+/// scenario's instructions grew by at most `max_growth` percent and its
+/// bytes not at all. A saved scenario that was not counted is a failure; a
+/// new one is reported.
 pub fn check(
     counts: &BTreeMap<String, Counts>,
     saved: &serde_json::Value,
@@ -142,8 +164,8 @@ pub fn check(
     let mut ok = true;
     let saved = saved.get("scenarios").and_then(|s| s.as_object());
     for (name, c) in counts {
-        let Some(before) = saved
-            .and_then(|s| s.get(name))
+        let entry = saved.and_then(|s| s.get(name));
+        let Some(before) = entry
             .and_then(|s| s.get("instructions"))
             .and_then(|x| x.as_u64())
         else {
@@ -160,6 +182,15 @@ pub fn check(
             c.l1_misses,
             c.ll_misses
         ));
+        if let Some(then) = entry.and_then(|s| s.get("bytes")).and_then(|x| x.as_u64()) {
+            let fine = c.bytes <= then;
+            ok &= fine;
+            lines.push(format!(
+                "  {} {name}: {then} -> {} bytes compiled",
+                if fine { "ok" } else { "REGRESSION" },
+                c.bytes
+            ));
+        }
     }
     if let Some(s) = saved {
         for name in s.keys().filter(|n| !counts.contains_key(*n)) {
@@ -183,7 +214,8 @@ mod tests {
             Counts {
                 instructions: 1000,
                 l1_misses: 6,
-                ll_misses: 2
+                ll_misses: 2,
+                bytes: 0,
             }
         );
     }
@@ -194,6 +226,7 @@ mod tests {
             instructions: i,
             l1_misses: 0,
             ll_misses: 0,
+            bytes: 1000,
         };
         let saved: serde_json::Value = serde_json::from_str(&to_json(
             &BTreeMap::from([("wide".to_string(), c(100_000))]),
@@ -206,5 +239,9 @@ mod tests {
         assert!(!check(&now(105_000), &saved, 2.0).1);
         // A scenario that disappeared fails too.
         assert!(!check(&BTreeMap::new(), &saved, 2.0).1);
+        // So does one byte more.
+        let mut bigger = now(100_000);
+        bigger.get_mut("wide").unwrap().bytes = 1001;
+        assert!(!check(&bigger, &saved, 2.0).1);
     }
 }

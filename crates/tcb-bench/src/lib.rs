@@ -2,12 +2,14 @@
 //!
 //! How the runtime compares, on real data, with the straightforward
 //! implementation ([`baseline`]) and with the `splines` crate ([`peer`]),
-//! and a regression check on those ratios.
+//! named wall-clock baselines with a machine fingerprint, and the
+//! instruction-count gate ([`icount`]).
 //!
 //! ```text
-//! cargo run --release -p tcb-bench                       # the report
-//! cargo run --release -p tcb-bench -- --json out.json    # and as JSON
-//! cargo run --release -p tcb-bench -- --check benches/baseline.json --max-regression 10
+//! cargo run --release -p tcb-bench -- --quick            # a first look, under 10 s
+//! cargo run --release -p tcb-bench                       # the full report
+//! cargo run --release -p tcb-bench -- --save-baseline before   # then --baseline before
+//! cargo run --release -p tcb-bench -- --icount --icount-check benches/icount.json   # the gate
 //! ```
 //!
 //! The scenarios ([`scenarios`]) are shared by the report and by the

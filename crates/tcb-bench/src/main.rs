@@ -1,7 +1,9 @@
-//! `cargo run --release -p tcb-bench`: the comparison report on the bundled
-//! real data; `--json PATH` writes it as JSON; `--check BASELINE.json`
-//! exits non-zero when a ratio regressed by more than `--max-regression`
-//! percent.
+//! `cargo run --release -p tcb-bench [-- --quick]`: the comparison report
+//! on the bundled real data. `--json PATH` or `--save-baseline NAME` saves
+//! it with the machine's fingerprint; `--check PATH` or `--baseline NAME`
+//! compares with a saved one and exits 1 when bytes grew, or (same machine
+//! and build only) a ratio fell by more than `--max-regression` percent.
+//! `--icount` counts instructions under callgrind instead: the CI gate.
 
 #![forbid(unsafe_code)]
 
@@ -17,13 +19,25 @@ use tcb_bench::{icount, report, scenarios};
     about = "Runtime vs scalar baseline vs the splines crate, on real data"
 )]
 struct Args {
-    /// Write the report as JSON here too.
+    /// A first look in under 10 s: 5 rounds of 8 ms, the slow baseline and
+    /// splines crate timed on a subset of the frames. Without it, the full
+    /// run: 11 rounds of 20 ms over every frame (about a minute).
+    #[arg(long)]
+    quick: bool,
+    /// Write the report as JSON here too (with the machine fingerprint).
     #[arg(long, value_name = "PATH")]
     json: Option<PathBuf>,
-    /// Compare with a saved JSON report; exit 1 on a regression.
+    /// Save the report as a named baseline of this machine
+    /// (target/tcb-bench/NAME.json), to compare later runs with.
+    #[arg(long, value_name = "NAME")]
+    save_baseline: Option<String>,
+    /// Compare with a named baseline saved by --save-baseline.
+    #[arg(long, value_name = "NAME", conflicts_with = "check")]
+    baseline: Option<String>,
+    /// Compare with a saved JSON report (--json); exit 1 on a regression.
     #[arg(long, value_name = "BASELINE.json")]
     check: Option<PathBuf>,
-    /// Largest allowed fall of a ratio, percent.
+    /// Largest allowed fall of a same-machine ratio, percent.
     #[arg(long, value_name = "PCT", default_value_t = 10.0)]
     max_regression: f64,
     /// The motion-capture file for character, crowd and seek.
@@ -32,14 +46,16 @@ struct Args {
     /// Only these scenarios (comma separated).
     #[arg(long, value_name = "NAMES")]
     only: Option<String>,
-    /// Timing rounds per implementation (the median is reported).
-    #[arg(long, default_value_t = 11)]
-    rounds: usize,
-    /// Milliseconds per timing.
-    #[arg(long, default_value_t = 20)]
-    slice_ms: u64,
+    /// Timing rounds per implementation, the median is reported (default
+    /// 11, or 5 with --quick).
+    #[arg(long)]
+    rounds: Option<usize>,
+    /// Milliseconds per timing (default 20, or 8 with --quick).
+    #[arg(long, value_name = "MS")]
+    slice_ms: Option<u64>,
     /// Time these clips (JSON, BVH, glTF) instead of the scenarios: 60 fps
-    /// forward over each clip, as `character`.
+    /// forward over each clip, as `character`. With --icount, count them
+    /// (named by file stem), to gate your own clips.
     #[arg(long, value_name = "FILE")]
     clip: Vec<PathBuf>,
     /// Count instructions instead of timing: each scenario's runtime pass
@@ -82,39 +98,78 @@ fn read_json(path: Option<&std::path::Path>) -> Result<Option<serde_json::Value>
         .map_err(|e| format!("{}: {e}", p.display()))
 }
 
+/// Where `--save-baseline NAME` keeps its reports: `TCB_BENCH_BASELINES`,
+/// or `tcb-bench/` in cargo's target directory (beside `release/`, where
+/// criterion keeps its own), so `cargo clean` removes them.
+fn baseline_path(name: &str) -> Result<PathBuf, String> {
+    if name.is_empty()
+        || name.starts_with('.')
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+    {
+        return Err(format!(
+            "baseline name '{name}': use letters, digits, '-', '_' and '.' (not first)"
+        ));
+    }
+    let dir = match std::env::var_os("TCB_BENCH_BASELINES") {
+        Some(d) => PathBuf::from(d),
+        None => {
+            let exe = std::env::current_exe().map_err(|e| format!("baseline directory: {e}"))?;
+            exe.parent()
+                .and_then(|p| p.parent())
+                .ok_or("baseline directory: the executable has no target directory")?
+                .join("tcb-bench")
+        }
+    };
+    Ok(dir.join(format!("{name}.json")))
+}
+
 /// `--icount`: count each scenario under callgrind, then check or save.
 fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if args.icount_max_growth.is_nan() || args.icount_max_growth < 0.0 {
         return Err("--icount-max-growth must be a number >= 0".into());
     }
     let saved = read_json(args.icount_check.as_deref())?;
-    let names: Vec<&str> = match &args.only {
-        Some(o) => o.split(',').map(str::trim).collect(),
-        None => icount::names(),
+    // The bundled scenarios, or with --clip the user's files, each named by
+    // its file stem as the report names it.
+    let jobs: Vec<(String, Option<&std::path::Path>)> = if args.clip.is_empty() {
+        let names: Vec<&str> = match &args.only {
+            Some(o) => o.split(',').map(str::trim).collect(),
+            None => icount::names(),
+        };
+        if let Some(bad) = names.iter().find(|n| !icount::names().contains(n)) {
+            return Err(format!(
+                "--only {bad}: not counted (one of {})",
+                icount::names().join(", ")
+            )
+            .into());
+        }
+        names.into_iter().map(|n| (n.to_string(), None)).collect()
+    } else {
+        args.clip
+            .iter()
+            .map(|p| Ok((scenarios::file(p)?.name, Some(p.as_path()))))
+            .collect::<Result<_, tcb_io::Error>>()?
     };
-    if let Some(bad) = names.iter().find(|n| !icount::names().contains(n)) {
-        return Err(format!(
-            "--only {bad}: not counted (one of {})",
-            icount::names().join(", ")
-        )
-        .into());
-    }
     let exe = std::env::current_exe()?;
     let mut counts = std::collections::BTreeMap::new();
     println!("tcb-bench --icount: instructions of one runtime pass under callgrind");
     println!("flags: {}", report::flags());
-    for name in names {
-        let c = icount::count(&exe, name, &args.bvh)?;
+    for (name, clip) in &jobs {
+        let name = name.as_str();
+        let c = icount::count(&exe, name, &args.bvh, *clip)?;
         println!(
-            "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses",
-            c.instructions, c.l1_misses, c.ll_misses
+            "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses  {:>9} bytes",
+            c.instructions, c.l1_misses, c.ll_misses, c.bytes
         );
         counts.insert(name.to_string(), c);
     }
     if let Some(path) = &args.icount_save {
         let note = format!(
-            "tcb-bench --icount ({}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
+            "tcb-bench --icount ({}, {}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
             report::flags(),
+            env!("TCB_BENCH_RUSTC"),
             path.display()
         );
         tcb_io::write_atomically(path, icount::to_json(&counts, &note).as_bytes())?;
@@ -143,7 +198,10 @@ instruction counts against the saved ones:"
 
 fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if let Some(name) = &args.icount_pass {
-        let s = scenarios::named(&args.bvh, |n| n == name)?;
+        let s = match args.clip.first() {
+            Some(p) => vec![scenarios::file(p)?],
+            None => scenarios::named(&args.bvh, |n| n == name)?,
+        };
         let s = s.first().ok_or_else(|| format!("no scenario {name}"))?;
         icount::run_pass(s);
         return Ok(true);
@@ -151,11 +209,43 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if args.icount {
         return run_icount(args);
     }
-    if args.max_regression.is_nan() || args.max_regression < 0.0 || args.rounds == 0 {
+    let mut timing = if args.quick {
+        report::Timing::QUICK
+    } else {
+        report::Timing::FULL
+    };
+    if let Some(r) = args.rounds {
+        timing.rounds = r;
+    }
+    if let Some(ms) = args.slice_ms {
+        timing.slice = Duration::from_millis(ms.max(1));
+    }
+    if args.max_regression.is_nan() || args.max_regression < 0.0 || timing.rounds == 0 {
         return Err("--max-regression must be >= 0 and --rounds > 0".into());
     }
-    // Read the baseline first: a bad file should fail before minutes of timing.
-    let saved = read_json(args.check.as_deref())?;
+    // Find and read the saved report first: a bad name or file should fail
+    // before a minute of timing.
+    let save = args
+        .save_baseline
+        .as_deref()
+        .map(baseline_path)
+        .transpose()?;
+    let compare = match (&args.check, &args.baseline) {
+        (Some(p), _) => Some(p.clone()),
+        (None, Some(name)) => {
+            let p = baseline_path(name)?;
+            if !p.exists() {
+                return Err(format!(
+                    "no baseline '{name}' ({}): save one first with --save-baseline {name}",
+                    p.display()
+                )
+                .into());
+            }
+            Some(p)
+        }
+        (None, None) => None,
+    };
+    let saved = read_json(compare.as_deref())?;
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
@@ -180,33 +270,48 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
             .map(|p| scenarios::file(p))
             .collect::<Result<_, _>>()?
     };
-    let slice = Duration::from_millis(args.slice_ms.max(1));
-    let mut rows: Vec<_> = all
-        .iter()
-        .map(|s| report::measure(s, args.rounds, slice))
-        .collect();
+    let mut rows: Vec<_> = all.iter().map(|s| report::measure(s, &timing)).collect();
     report::relate(&mut rows);
-    let (flags, machine) = (report::flags(), report::machine());
-    print!("{}", report::table(&rows, &flags, &machine));
-    println!("\ntargets:");
-    for (line, met) in report::targets(&rows) {
-        println!("  {} {line}", if met { "met " } else { "MISS" });
+    let here = report::Fingerprint::here();
+    print!("{}", report::table(&rows, &here, &timing));
+    let goals = report::goals(&rows);
+    if !goals.is_empty() {
+        println!("\ngoals (the README's \"Goals\"):");
+        for (line, met) in goals {
+            println!("  {} {line}", if met { "met    " } else { "not yet" });
+        }
     }
-    if let Some(path) = &args.json {
-        let doc = report::to_json(&rows, &flags, &machine);
-        let text = serde_json::to_string_pretty(&doc)? + "\n";
+    if args.quick {
+        println!(
+            "\nThis was --quick; run without it for the full report (11 rounds of 20 ms, every frame)."
+        );
+    }
+    let doc = report::to_json(&rows, &here, &timing);
+    let text = serde_json::to_string_pretty(&doc)? + "\n";
+    for path in args.json.iter().chain(&save) {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
         tcb_io::write_atomically(path, text.as_bytes())?;
     }
+    if let (Some(name), Some(path)) = (&args.save_baseline, &save) {
+        println!("\nsaved as baseline '{name}' ({})", path.display());
+    }
     let mut ok = true;
-    if let Some(saved) = &saved {
-        let (lines, held) = report::check(&rows, saved, args.max_regression);
-        println!(
-            "\nregression check against {}:",
-            args.check
-                .as_ref()
-                .map(|p| p.display().to_string())
-                .unwrap_or_default()
-        );
+    if let (Some(saved), Some(path)) = (&saved, &compare) {
+        // With --only, scenarios left out are not missing.
+        let mut saved = saved.clone();
+        if names.is_some()
+            && let Some(s) = saved.get_mut("scenarios").and_then(|s| s.as_array_mut())
+        {
+            s.retain(|x| {
+                x.get("name")
+                    .and_then(|n| n.as_str())
+                    .is_some_and(|n| rows.iter().any(|r| r.name == n))
+            });
+        }
+        let (lines, held) = report::check(&rows, &saved, &here, args.max_regression);
+        println!("\nagainst {}:", path.display());
         for l in lines {
             println!("  {l}");
         }

@@ -8,6 +8,8 @@ use std::time::{Duration, Instant};
 pub struct Subject<'a> {
     /// Column name (`baseline`, `runtime`, ...).
     pub name: &'static str,
+    /// Channel-samples in one pass (what the time is divided by).
+    pub samples: f64,
     /// One pass.
     pub run: Box<dyn FnMut() + 'a>,
 }

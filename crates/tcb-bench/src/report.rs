@@ -35,7 +35,12 @@ pub fn flags() -> String {
 
 /// The CPU model and the number of threads rayon uses.
 pub fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+    format!("{}, {} threads", cpu_model(), rayon::current_num_threads())
+}
+
+/// The CPU model (`/proc/cpuinfo`), or the architecture where there is none.
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
             s.lines()
@@ -43,8 +48,119 @@ pub fn machine() -> String {
                 .and_then(|l| l.split_once(':'))
                 .map(|(_, v)| v.trim().to_string())
         })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
-    format!("{cpu}, {} threads", rayon::current_num_threads())
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// What makes wall-clock times comparable: the same CPU model, core count,
+/// compile flags and compiler. Saved reports carry it; times and ratios are
+/// gated only against a report with the same fingerprint.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fingerprint {
+    /// CPU model name.
+    pub cpu: String,
+    /// Cores the process may use (`std::thread::available_parallelism`).
+    pub cores: usize,
+    /// [`flags`]: RUSTFLAGS, profile and SIMD target features.
+    pub flags: String,
+    /// `rustc --version` of the build.
+    pub rustc: String,
+}
+
+impl Fingerprint {
+    /// This process's.
+    pub fn here() -> Self {
+        Fingerprint {
+            cpu: cpu_model(),
+            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            flags: flags(),
+            rustc: env!("TCB_BENCH_RUSTC").to_string(),
+        }
+    }
+
+    /// As saved in a report.
+    pub fn to_json(&self) -> Value {
+        json!({"cpu": self.cpu, "cores": self.cores, "flags": self.flags, "rustc": self.rustc})
+    }
+
+    /// From a saved report (`None` for a report without one, as files
+    /// written before fingerprints were).
+    pub fn from_json(v: &Value) -> Option<Self> {
+        Some(Fingerprint {
+            cpu: v.get("cpu")?.as_str()?.to_string(),
+            cores: usize::try_from(v.get("cores")?.as_u64()?).ok()?,
+            flags: v.get("flags")?.as_str()?.to_string(),
+            rustc: v.get("rustc")?.as_str()?.to_string(),
+        })
+    }
+
+    /// How `saved` differs from this one, one phrase per field.
+    pub fn differences(&self, saved: &Fingerprint) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.cpu != saved.cpu {
+            out.push(format!("CPU '{}' here, '{}' saved", self.cpu, saved.cpu));
+        }
+        if self.cores != saved.cores {
+            out.push(format!("{} cores here, {} saved", self.cores, saved.cores));
+        }
+        if self.flags != saved.flags {
+            out.push(format!("flags {} here, {} saved", self.flags, saved.flags));
+        }
+        if self.rustc != saved.rustc {
+            out.push(format!("{} here, {} saved", self.rustc, saved.rustc));
+        }
+        out
+    }
+}
+
+/// Today's date (UTC), `YYYY-MM-DD`, for the report's header.
+pub fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    civil_date(secs / 86_400)
+}
+
+/// The proleptic Gregorian date of a day count since 1970-01-01
+/// (Howard Hinnant's `civil_from_days`).
+fn civil_date(days: u64) -> String {
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// How long to time.
+#[derive(Clone, Copy, Debug)]
+pub struct Timing {
+    /// Rounds per implementation; the median is reported.
+    pub rounds: usize,
+    /// About this long per timing.
+    pub slice: Duration,
+    /// At most about this many channel-samples in a pass of the slow
+    /// references ([`Scenario::reference_subset`]); `None` plays them all.
+    pub reference_samples: Option<usize>,
+}
+
+impl Timing {
+    /// The full report: 11 rounds of 20 ms, the references on every sample.
+    pub const FULL: Timing = Timing {
+        rounds: 11,
+        slice: Duration::from_millis(20),
+        reference_samples: None,
+    };
+    /// `--quick`: 5 rounds of 8 ms, the references on a subset of 50,000
+    /// channel-samples.
+    pub const QUICK: Timing = Timing {
+        rounds: 5,
+        slice: Duration::from_millis(8),
+        reference_samples: Some(50_000),
+    };
 }
 
 /// One scenario's numbers.
@@ -83,7 +199,7 @@ impl Row {
 }
 
 /// Time every implementation of `s`.
-pub fn measure(s: &Scenario, rounds: usize, slice: Duration) -> Row {
+pub fn measure(s: &Scenario, timing: &Timing) -> Row {
     let mut row = Row {
         name: s.name.to_string(),
         channels: s.channels(),
@@ -91,7 +207,12 @@ pub fn measure(s: &Scenario, rounds: usize, slice: Duration) -> Row {
         ..Row::default()
     };
     if let Some(peer) = &s.peer {
-        let worst = peer.agreement(&s.source, 500);
+        // The check samples the reference, which is slow on wide clips:
+        // 500 times, or under --quick as many as fit its sample budget.
+        let times = timing
+            .reference_samples
+            .map_or(500, |m| (m / s.channels().max(1)).clamp(20, 500));
+        let worst = peer.agreement(&s.source, times);
         row.splines_agreement = Some(worst);
         assert!(
             worst < 1e-4,
@@ -99,38 +220,46 @@ pub fn measure(s: &Scenario, rounds: usize, slice: Duration) -> Row {
             s.name
         );
     }
+    let all = s.channel_samples();
+    let (times, phases) = s.reference_subset(timing.reference_samples);
+    let thinned = (times.len() * phases.len() * s.channels()) as f64;
     let mut subjects = vec![
         Subject {
             name: "baseline",
-            run: Box::new(s.baseline_pass()),
+            samples: thinned,
+            run: Box::new(s.baseline_pass(times.clone(), phases)),
         },
         Subject {
             name: "runtime",
+            samples: all,
             run: Box::new(s.runtime_pass()),
         },
     ];
     if s.parallel {
         subjects.push(Subject {
             name: "runtime_parallel",
+            samples: all,
             run: Box::new(s.parallel_pass()),
         });
     }
-    if let Some(pass) = s.peer_pass() {
+    let peer_samples = (times.len() * s.channels()) as f64;
+    if let Some(pass) = s.peer_pass(times) {
         subjects.push(Subject {
             name: "splines",
+            samples: peer_samples,
             run: Box::new(pass),
         });
     }
     if s.read_limit {
         subjects.push(Subject {
             name: "read_limit",
+            samples: all,
             run: Box::new(s.read_pass()),
         });
     }
-    let secs = median_seconds(&mut subjects, rounds, slice);
-    let per = s.channel_samples();
+    let secs = median_seconds(&mut subjects, timing.rounds, timing.slice);
     for (sub, t) in subjects.iter().zip(&secs) {
-        row.ns.push((sub.name, t * 1e9 / per));
+        row.ns.push((sub.name, t * 1e9 / sub.samples));
     }
     let rt = row.ns_of("runtime").expect("always timed");
     row.speedup_vs_baseline = row.ns_of("baseline").expect("always timed") / rt;
@@ -153,8 +282,8 @@ pub fn relate(rows: &mut [Row]) {
     }
 }
 
-/// The JSON document.
-pub fn to_json(rows: &[Row], flags: &str, machine: &str) -> Value {
+/// The JSON document (what `--json` and `--save-baseline` write).
+pub fn to_json(rows: &[Row], here: &Fingerprint, timing: &Timing) -> Value {
     let scenarios: Vec<Value> = rows
         .iter()
         .map(|r| {
@@ -184,7 +313,16 @@ pub fn to_json(rows: &[Row], flags: &str, machine: &str) -> Value {
             Value::Object(m)
         })
         .collect();
-    json!({"flags": flags, "machine": machine, "scenarios": scenarios})
+    json!({
+        "date": today(),
+        "fingerprint": here.to_json(),
+        "timing": {
+            "rounds": timing.rounds,
+            "slice_ms": timing.slice.as_secs_f64() * 1e3,
+            "reference_samples": timing.reference_samples,
+        },
+        "scenarios": scenarios,
+    })
 }
 
 fn fmt(v: Option<f64>, unit: &str) -> String {
@@ -196,36 +334,63 @@ fn fmt(v: Option<f64>, unit: &str) -> String {
     }
 }
 
-/// The table.
-pub fn table(rows: &[Row], flags: &str, machine: &str) -> String {
+/// The table's columns: header, width.
+const COLUMNS: [(&str, usize); 11] = [
+    ("scenario", 18),
+    ("channels", 8),
+    ("baseline", 9),
+    ("runtime", 9),
+    ("rayon", 9),
+    ("splines", 9),
+    ("x baseline", 10),
+    ("x splines", 9),
+    ("read limit", 10),
+    ("ns/joint", 9),
+    ("MB", 7),
+];
+
+fn table_line(cells: &[String]) -> String {
+    let mut line = String::new();
+    for (i, (cell, (_, width))) in cells.iter().zip(COLUMNS).enumerate() {
+        if i == 0 {
+            let _ = write!(line, "{cell:<width$}");
+        } else {
+            let _ = write!(line, "  {cell:>width$}");
+        }
+    }
+    line.trim_end().to_string()
+}
+
+/// The table, its header (what ran where, when) and a legend.
+pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "tcb-bench: ns per channel-sample (median), ratios measured in this run"
+        "tcb-bench, {}: {} ({} cores, {} rayon threads), {}",
+        today(),
+        here.cpu,
+        here.cores,
+        rayon::current_num_threads(),
+        here.rustc
     );
-    let _ = writeln!(out, "flags:   {flags}");
-    let _ = writeln!(out, "machine: {machine}\n");
+    let _ = writeln!(out, "build: {}", here.flags);
     let _ = writeln!(
         out,
-        "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9}",
-        "scenario",
-        "channels",
-        "baseline",
-        "runtime",
-        "rt+rayon",
-        "splines",
-        "x base",
-        "x splines",
-        "read lim",
-        "ns/joint",
-        "MB"
+        "timing: median of {} rounds of about {} ms per implementation{}\n",
+        timing.rounds,
+        timing.slice.as_millis(),
+        if timing.reference_samples.is_some() {
+            " (--quick: baseline and splines on a subset of the frames)"
+        } else {
+            ""
+        }
     );
+    let header: Vec<String> = COLUMNS.iter().map(|c| c.0.to_string()).collect();
+    let _ = writeln!(out, "{}", table_line(&header));
     for r in rows {
-        let _ = writeln!(
-            out,
-            "{:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9.3}",
-            r.name,
-            r.channels,
+        let cells = [
+            r.name.clone(),
+            r.channels.to_string(),
             fmt(r.ns_of("baseline"), ""),
             fmt(r.ns_of("runtime"), ""),
             fmt(r.ns_of("runtime_parallel"), ""),
@@ -234,14 +399,30 @@ pub fn table(rows: &[Row], flags: &str, machine: &str) -> String {
             fmt(r.speedup_vs_splines, "x"),
             fmt(r.read_limit_fraction.map(|f| f * 100.0), "%"),
             fmt(r.ns_per_joint, ""),
-            r.bytes as f64 / 1e6,
-        );
+            format!("{:.3}", r.bytes as f64 / 1e6),
+        ];
+        let _ = writeln!(out, "{}", table_line(&cells));
     }
+    out.push_str(LEGEND);
     out
 }
 
-/// The issue's targets, each with what was measured.
-pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
+/// What each column means, printed under the table.
+pub const LEGEND: &str = "
+baseline, runtime, rayon, splines: nanoseconds per channel-sample (one value of one
+  channel at one time; a quaternion is 4 channels). baseline: a plain scalar
+  implementation (a struct per segment, a binary search per track); runtime: tcb-runtime
+  on one thread; rayon: the same with instances spread over the threads; splines: the
+  `splines` crate (Catmull-Rom, checked to agree with tcb before it is timed).
+x baseline, x splines: how many times faster the runtime is, timed in this run.
+read limit: the time merely to read the runtime's coefficient bytes, as a percentage of
+  the runtime's time (100% means as fast as memory delivers them).
+ns/joint: runtime nanoseconds per animated joint per frame. MB: the compiled clip's heap.
+";
+
+/// The project's published goals (the README's *Goals*), each with what
+/// was measured: `(line, met)`.
+pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
     let get = |n: &str| rows.iter().find(|r| r.name == n);
     let mut out = Vec::new();
     let native = cfg!(target_feature = "avx2");
@@ -249,14 +430,17 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
         let need = if native { 8.0 } else { 4.0 };
         out.push((
             format!(
-                "wide: runtime {:.2}x the baseline (target {need}x for this build)",
+                "wide: runtime {:.2}x the baseline (goal: at least {need}x for this build)",
                 w.speedup_vs_baseline
             ),
             w.speedup_vs_baseline >= need,
         ));
         if let Some(f) = w.read_limit_fraction {
             out.push((
-                format!("wide: {:.1}% of the read limit (target 60%)", f * 100.0),
+                format!(
+                    "wide: {:.1}% of the read limit (goal: at least 60%)",
+                    f * 100.0
+                ),
                 f >= 0.6,
             ));
         }
@@ -264,7 +448,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     for (n, limit) in [("character-hermite", 2.5), ("character-squad", 3.0)] {
         if let Some(j) = get(n).and_then(|r| r.ns_per_joint) {
             out.push((
-                format!("{n}: {j:.2} ns per joint per frame (target < {limit})"),
+                format!("{n}: {j:.2} ns per joint per frame (goal: under {limit})"),
                 j < limit,
             ));
         }
@@ -274,7 +458,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     {
         out.push((
             format!(
-                "character-reduced: {j:.2} ns per joint per frame (target <= 1.5), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
+                "character-reduced: {j:.2} ns per joint per frame (goal: at most 1.5), {:.3} MB against {:.3} MB dense ({:.2}x smaller)",
                 r.bytes as f64 / 1e6,
                 c.bytes as f64 / 1e6,
                 c.bytes as f64 / r.bytes as f64
@@ -289,7 +473,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
         );
         out.push((
             format!(
-                "seek: {:.2}x the cost of forward playback (target <= 1.2x)",
+                "seek: {:.2}x the cost of forward playback (goal: at most 1.2x)",
                 a / b
             ),
             a / b <= 1.2,
@@ -297,7 +481,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     }
     if let Some(p) = get("crowd").and_then(|r| r.parallel_speedup) {
         out.push((
-            format!("crowd: rayon {p:.2}x one thread (target >= 1.8x on 2 cores)"),
+            format!("crowd: rayon {p:.2}x one thread (goal: at least 1.8x on 2 idle cores)"),
             p >= 1.8,
         ));
     }
@@ -309,7 +493,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
             );
             out.push((
                 format!(
-                    "{name}: {:.1}x the per-channel cost of wide (target <= 1.5x)",
+                    "{name}: {:.1}x the per-channel cost of wide (goal: at most 1.5x)",
                     a / b
                 ),
                 a / b <= 1.5,
@@ -319,7 +503,7 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     for r in rows {
         if let Some(x) = r.speedup_vs_splines {
             out.push((
-                format!("{}: {x:.1}x the splines crate (target >= 20x)", r.name),
+                format!("{}: {x:.1}x the splines crate (goal: at least 20x)", r.name),
                 x >= 20.0,
             ));
         }
@@ -327,12 +511,25 @@ pub fn targets(rows: &[Row]) -> Vec<(String, bool)> {
     out
 }
 
-/// Compare this run's ratios with a saved report: each scenario's
-/// `speedup_vs_baseline` and `read_limit_fraction` may fall by at most
-/// `max_regression` percent. (`parallel_speedup` depends on the core count,
-/// so it is reported but not checked.) Returns the lines to print
-/// and whether everything held.
-pub fn check(rows: &[Row], saved: &Value, max_regression: f64) -> (Vec<String>, bool) {
+/// Compare this run with a saved report (`--check FILE` or `--baseline
+/// NAME`). Returns the lines to print and whether everything held.
+///
+/// - Bytes are deterministic: any growth fails, on any machine.
+/// - Ratios measured in one run (`speedup_vs_baseline`,
+///   `read_limit_fraction`, `speedup_vs_dense`) fail when one fell by more
+///   than `max_regression` percent, but only against a report with this
+///   machine's [`Fingerprint`]: the two sides of a ratio use the memory
+///   system and the vector units differently, so ratios move across CPUs
+///   (an Intel Xeon's `wide` ratio was 299x, an AMD EPYC's 1951x).
+/// - Runtime times are shown against a same-fingerprint report, as
+///   information: wall clock on a shared machine is too noisy to gate on
+///   (the instruction counts of `--icount` are the gate).
+pub fn check(
+    rows: &[Row],
+    saved: &Value,
+    here: &Fingerprint,
+    max_regression: f64,
+) -> (Vec<String>, bool) {
     let mut lines = Vec::new();
     let mut ok = true;
     let Some(scenarios) = saved.get("scenarios").and_then(Value::as_array) else {
@@ -341,12 +538,33 @@ pub fn check(rows: &[Row], saved: &Value, max_regression: f64) -> (Vec<String>, 
             false,
         );
     };
+    let theirs = saved.get("fingerprint").and_then(Fingerprint::from_json);
+    let same = match &theirs {
+        Some(f) => {
+            let d = here.differences(f);
+            if !d.is_empty() {
+                lines.push(format!(
+                    "note: saved on another machine or build ({}); only bytes are checked, ratios are shown as information",
+                    d.join("; ")
+                ));
+            }
+            d.is_empty()
+        }
+        None => {
+            lines.push(
+                "note: the saved report has no machine fingerprint; only bytes are checked, ratios are shown as information".into(),
+            );
+            false
+        }
+    };
     for s in scenarios {
         let Some(name) = s.get("name").and_then(Value::as_str) else {
             continue;
         };
         let Some(row) = rows.iter().find(|r| r.name == name) else {
-            lines.push(format!("{name}: in the baseline file but not measured"));
+            lines.push(format!(
+                "MISSING {name}: in the saved report but not measured"
+            ));
             ok = false;
             continue;
         };
@@ -359,11 +577,33 @@ pub fn check(rows: &[Row], saved: &Value, max_regression: f64) -> (Vec<String>, 
                 continue;
             };
             let change = (now / then - 1.0) * 100.0;
-            let bad = change < -max_regression;
+            let bad = same && change < -max_regression;
             ok &= !bad;
+            let verdict = match (same, bad) {
+                (false, _) => "info",
+                (true, true) => "REGRESSION",
+                (true, false) => "ok",
+            };
             lines.push(format!(
-                "{} {name} {key}: {then:.3} -> {now:.3} ({change:+.1}%, allowed -{max_regression}%)",
-                if bad { "REGRESSION" } else { "ok" }
+                "{verdict} {name} {key}: {then:.3} -> {now:.3} ({change:+.1}%{})",
+                if same {
+                    format!(", allowed -{max_regression}%")
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        if same
+            && let (Some(then), Some(now)) = (
+                s.get("ns_per_channel")
+                    .and_then(|n| n.get("runtime"))
+                    .and_then(Value::as_f64),
+                row.ns_of("runtime"),
+            )
+        {
+            lines.push(format!(
+                "time {name} runtime: {then:.3} -> {now:.3} ns per channel-sample ({:+.1}%, wall clock: information only)",
+                (now / then - 1.0) * 100.0
             ));
         }
         // Memory is deterministic: any growth is a change to look at.
@@ -388,25 +628,108 @@ mod tests {
         Row {
             name: name.into(),
             speedup_vs_baseline: speedup,
+            ns: vec![("runtime", 1.0)],
+            bytes: 1000,
             ..Row::default()
         }
     }
 
+    fn saved(rows: &[Row], fp: &Fingerprint) -> Value {
+        to_json(rows, fp, &Timing::FULL)
+    }
+
     #[test]
     fn check_flags_a_fall_beyond_the_allowance_only() {
-        let saved = to_json(&[row("wide", 100.0), row("sparse", 4.0)], "", "");
-        let (_, ok) = check(&[row("wide", 91.0), row("sparse", 4.5)], &saved, 10.0);
+        let here = Fingerprint::here();
+        let file = saved(&[row("wide", 100.0), row("sparse", 4.0)], &here);
+        let (_, ok) = check(&[row("wide", 91.0), row("sparse", 4.5)], &file, &here, 10.0);
         assert!(ok);
-        let (lines, ok) = check(&[row("wide", 89.0), row("sparse", 4.5)], &saved, 10.0);
+        let (lines, ok) = check(&[row("wide", 89.0), row("sparse", 4.5)], &file, &here, 10.0);
         assert!(!ok);
         assert!(
             lines[0].starts_with("REGRESSION wide speedup_vs_baseline"),
             "{lines:?}"
         );
         // A scenario that disappeared is a failure too.
-        let (_, ok) = check(&[row("wide", 100.0)], &saved, 10.0);
+        let (_, ok) = check(&[row("wide", 100.0)], &file, &here, 10.0);
         assert!(!ok);
-        let (_, ok) = check(&[], &serde_json::json!({}), 10.0);
+        let (_, ok) = check(&[], &serde_json::json!({}), &here, 10.0);
         assert!(!ok);
+    }
+
+    #[test]
+    fn another_machine_gates_bytes_only() {
+        let here = Fingerprint::here();
+        let there = Fingerprint {
+            cpu: "Some Other CPU".into(),
+            ..here.clone()
+        };
+        let file = saved(&[row("wide", 300.0)], &there);
+        // A ratio 6x off is information, not a regression, across machines.
+        let (lines, ok) = check(&[row("wide", 50.0)], &file, &here, 10.0);
+        assert!(ok, "{lines:?}");
+        assert!(
+            lines[0].starts_with("note: saved on another machine"),
+            "{lines:?}"
+        );
+        assert!(lines[0].contains("Some Other CPU"), "{lines:?}");
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.starts_with("info wide speedup_vs_baseline"))
+        );
+        // Bytes still fail.
+        let mut bigger = row("wide", 300.0);
+        bigger.bytes = 1001;
+        let (_, ok) = check(&[bigger], &file, &here, 10.0);
+        assert!(!ok);
+        // A file without a fingerprint is treated the same way.
+        let mut old = file.clone();
+        old.as_object_mut().unwrap().remove("fingerprint");
+        let (lines, ok) = check(&[row("wide", 50.0)], &old, &here, 10.0);
+        assert!(
+            ok && lines[0].contains("no machine fingerprint"),
+            "{lines:?}"
+        );
+    }
+
+    #[test]
+    fn fingerprints_round_trip_and_name_their_differences() {
+        let here = Fingerprint::here();
+        assert_eq!(Fingerprint::from_json(&here.to_json()), Some(here.clone()));
+        let other = Fingerprint {
+            cores: here.cores + 1,
+            rustc: "rustc 0.0.0".into(),
+            ..here.clone()
+        };
+        let d = here.differences(&other);
+        assert_eq!(d.len(), 2, "{d:?}");
+        assert!(d[1].contains("rustc 0.0.0"), "{d:?}");
+    }
+
+    #[test]
+    fn dates() {
+        assert_eq!(civil_date(0), "1970-01-01");
+        assert_eq!(civil_date(20_788), "2026-12-01");
+        assert_eq!(civil_date(11_016), "2000-02-29");
+    }
+
+    #[test]
+    fn headers_do_not_touch() {
+        let t = table(
+            &[row("character-hermite", 21.0)],
+            &Fingerprint::here(),
+            &Timing::QUICK,
+        );
+        let header = t.lines().find(|l| l.starts_with("scenario")).unwrap();
+        for (name, _) in COLUMNS {
+            assert!(header.contains(name), "{header}");
+        }
+        // Every header is separated from the next by at least two spaces.
+        let words: Vec<&str> = header
+            .split("  ")
+            .filter(|w| !w.trim().is_empty())
+            .collect();
+        assert_eq!(words.len(), COLUMNS.len(), "{header}");
     }
 }

@@ -76,12 +76,32 @@ impl Scenario {
         (self.times.len() * self.phases.len() * self.channels()) as f64
     }
 
-    /// One pass of the baseline.
-    pub fn baseline_pass(&self) -> impl FnMut() + '_ {
+    /// The sample times and phases the slow references (the baseline and
+    /// the `splines` crate) play: all of them, or with `max` set, the first
+    /// instances and then the first frames, so that a pass has at most
+    /// about `max` channel-samples (`--quick`: the baseline's pass over
+    /// `crowd` would otherwise take seconds). Times are per channel-sample,
+    /// so the shorter pass measures the same cost. The frames stay
+    /// consecutive: every 4th frame instead made the baseline's binary
+    /// searches mispredict and cost twice as much per sample.
+    pub fn reference_subset(&self, max: Option<usize>) -> (Vec<f64>, Vec<f64>) {
+        let (mut times, mut phases) = (self.times.clone(), self.phases.clone());
+        if let Some(max) = max {
+            let per_time = self.channels().max(1);
+            phases.truncate((max / per_time).clamp(1, phases.len().max(1)));
+            let per_frame = per_time * phases.len();
+            times.truncate((max / per_frame).clamp(2, times.len().max(2)));
+        }
+        (times, phases)
+    }
+
+    /// One pass of the baseline over `times` at each of `phases`
+    /// ([`Scenario::reference_subset`]).
+    pub fn baseline_pass(&self, times: Vec<f64>, phases: Vec<f64>) -> impl FnMut() + '_ {
         let mut row = vec![0.0f32; self.baseline.channel_count()];
         move || {
-            for &t in &self.times {
-                for &p in &self.phases {
+            for &t in &times {
+                for &p in &phases {
                     self.baseline.sample(t + p, &mut row);
                     black_box(&row);
                 }
@@ -135,12 +155,12 @@ impl Scenario {
         }
     }
 
-    /// One pass of the `splines` crate.
-    pub fn peer_pass(&self) -> Option<impl FnMut() + '_> {
+    /// One pass of the `splines` crate over `times`.
+    pub fn peer_pass(&self, times: Vec<f64>) -> Option<impl FnMut() + '_> {
         let peer = self.peer.as_ref()?;
         let mut row = vec![0.0f32; peer.channel_count()];
         Some(move || {
-            for &t in &self.times {
+            for &t in &times {
                 peer.sample(t, &mut row);
                 black_box(&row);
             }

@@ -547,10 +547,15 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
         args.fps,
         args.rounds
     );
-    let row = pool.install(|| tcb_bench::report::measure(&scenario, args.rounds, slice));
-    let (flags, machine) =
-        pool.install(|| (tcb_bench::report::flags(), tcb_bench::report::machine()));
-    let mut out = tcb_bench::report::table(std::slice::from_ref(&row), &flags, &machine);
+    let timing = tcb_bench::report::Timing {
+        rounds: args.rounds,
+        slice,
+        reference_samples: None,
+    };
+    let row = pool.install(|| tcb_bench::report::measure(&scenario, &timing));
+    let here = tcb_bench::report::Fingerprint::here();
+    let mut out =
+        pool.install(|| tcb_bench::report::table(std::slice::from_ref(&row), &here, &timing));
     use std::fmt::Write as _;
     let joints = scenario.joints.unwrap_or(0);
     let rt = row.ns_of("runtime").unwrap_or(f64::NAN);

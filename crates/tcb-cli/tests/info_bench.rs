@@ -99,7 +99,7 @@ fn bench_reports_ns_per_joint_bytes_and_flags() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
     for want in [
-        "flags:",
+        "build:",
         "RUSTFLAGS=",
         "ns per joint",
         "ns per channel",
