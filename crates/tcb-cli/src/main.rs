@@ -151,6 +151,10 @@ struct ExportArgs {
     /// Largest error allowed where the curve must be resampled (relative to max(1, |value|)).
     #[arg(long, value_name = "E", default_value_t = 1e-5)]
     max_error: f64,
+    /// Export track FROM under the name TO (glTF animates only
+    /// <node>.translation, .rotation, .scale and .weights.<i>); repeatable.
+    #[arg(long, value_name = "FROM=TO")]
+    rename: Vec<String>,
 }
 
 #[derive(Args)]
@@ -302,25 +306,52 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         )
         .into());
     }
+    let rename = args
+        .rename
+        .iter()
+        .map(|r| {
+            r.split_once('=')
+                .filter(|(a, b)| !a.is_empty() && !b.is_empty())
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .ok_or_else(|| format!("--rename {r}: expected FROM=TO"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let loaded = tcb_io::load(&args.clip)?;
     warn(&loaded.warnings);
-    let report = tcb_io::gltf_export::export_file(&loaded.clip, &args.output, args.max_error)?;
+    let options = tcb_io::gltf_export::ExportOptions {
+        max_error: args.max_error,
+        rename,
+    };
+    let report = tcb_io::gltf_export::export_file(
+        &loaded.clip,
+        loaded.skeleton.as_ref(),
+        &args.output,
+        &options,
+    )?;
     warn(&report.notes);
     let resampled: Vec<_> = report
         .tracks
         .iter()
         .filter_map(|t| t.resampled_error.map(|e| (&t.name, e)))
         .collect();
-    for (name, e) in &resampled {
-        eprintln!("tcb: resampled {name}: max error {e:e}");
-    }
+    let worst = resampled
+        .iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(String::new(), |(n, e)| {
+            format!(" (max error {e:e}, in {n})")
+        });
+    let joints = loaded
+        .skeleton
+        .as_ref()
+        .map_or("no skeleton".to_string(), |s| {
+            format!("{} joints as the node hierarchy", s.joints.len())
+        });
     eprintln!(
-        "tcb: wrote {}: {} tracks, {} exact, {} resampled, max error {:e}",
+        "tcb: wrote {}: {} tracks, {} exact, {} resampled{worst}; {joints}",
         args.output.display(),
         report.tracks.len(),
         report.tracks.len() - resampled.len(),
         resampled.len(),
-        report.max_error()
     );
     if report.max_error() > args.max_error {
         eprintln!(

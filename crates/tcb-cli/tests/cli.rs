@@ -598,3 +598,64 @@ fn import_and_export_errors_write_nothing() {
         stderr(&o)
     );
 }
+
+#[test]
+fn export_renames_tracks_and_prints_one_summary_line() {
+    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let glb = dir.join("bounce-renamed.glb");
+    // Refused without renames, with the way out in the message.
+    let o = tcb(&[
+        "export",
+        &example("bounce.json"),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("--rename 'ball.position=ball.translation'"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!glb.exists());
+    let o = tcb(&[
+        "export",
+        &example("bounce.json"),
+        "-o",
+        glb.to_str().unwrap(),
+        "--rename",
+        "ball.position=ball.translation",
+        "--rename",
+        "ball.squash=ball.weights.0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let wrote: Vec<&str> = err.lines().filter(|l| l.contains("wrote")).collect();
+    assert_eq!(wrote.len(), 1, "{err}");
+    assert!(
+        wrote[0].contains("3 tracks, 1 exact, 2 resampled (max error"),
+        "{err}"
+    );
+    assert!(!err.contains("tcb: resampled"), "{err}");
+    // The morph weight comes back under its new name.
+    let o = tcb(&["sample", glb.to_str().unwrap(), "--at", "0.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).starts_with("time,ball.translation.x"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(stdout(&o).contains("ball.weights.0"), "{}", stdout(&o));
+    for bad in ["nope=x", "ball.position", "=x"] {
+        let o = tcb(&[
+            "export",
+            &example("bounce.json"),
+            "-o",
+            dir.join("never2.glb").to_str().unwrap(),
+            "--rename",
+            bad,
+        ]);
+        assert!(!o.status.success(), "{bad}");
+        assert!(stderr(&o).contains("--rename"), "{bad}: {}", stderr(&o));
+    }
+    assert!(!dir.join("never2.glb").exists());
+}

@@ -1,11 +1,18 @@
 //! Export to glTF 2.0 (`.gltf` with an embedded buffer, or `.glb`).
 //!
-//! Tracks named `<node>.translation|rotation|scale` and
-//! `<node>.weights.<i>` become animation channels of one flat node per
-//! `<node>`. What glTF can express is written exactly:
+//! With a skeleton (the clip's `skeleton`), its joints become the node
+//! hierarchy: children, and the rest translation, rotation and scale. Tracks
+//! named `<node>.translation|rotation|scale` and `<node>.weights.<i>` become
+//! animation channels of the node `<node>` (a root node of its own when the
+//! skeleton has no such joint). A node with weight tracks gets a mesh with
+//! that many morph targets (one point, zero displacements), because glTF
+//! only animates the weights of a mesh's morph targets. What glTF can
+//! express is written exactly:
 //!
 //! - vector tracks and `hermite` rotations as `CUBICSPLINE`, with
-//!   `out_k = DD_k / D_k` and `in_k+1 = DS_k+1 / D_k` (time-unit tangents);
+//!   `out_k = DD_k / D_k` and `in_k+1 = DS_k+1 / D_k` (time-unit tangents;
+//!   the first key's in-tangent and the last key's out-tangent, which no
+//!   segment uses, are zero, as the glTF spec asks);
 //! - tracks whose every segment is `step` as `STEP`;
 //! - rotations whose every segment is `linear` (slerp), without ease, as
 //!   `LINEAR`.
@@ -16,12 +23,13 @@
 //! derivatives is within the requested error of the reference, measured at
 //! 8 points per piece; the error reached is reported per track. glTF holds
 //! the end values outside the keys, so other `pre`/`post` modes are
-//! reported as notes.
+//! reported as notes. The document is built with the `gltf-json` types.
 
 use crate::Error;
-use crate::gltf_import::base64_encode;
-use serde_json::{Value, json};
+use gltf::json;
+use json::validation::{Checked, USize64};
 use std::path::Path;
+use tcb_core::skeleton::Skeleton;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, Value as TcbValue};
 
 /// How one track was written.
@@ -57,8 +65,6 @@ impl ExportReport {
 struct Sampler {
     times: Vec<f32>,
     interpolation: &'static str,
-    /// Components per output element (3, 4, or the number of morph targets).
-    width: usize,
     /// Output elements (for CUBICSPLINE: in, value, out per key).
     output: Vec<f32>,
     kind: &'static str,
@@ -85,8 +91,7 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
         tout[k] = arr(s.m0).iter().map(|m| m / d).collect();
         tin[k + 1] = arr(s.m1).iter().map(|m| m / d).collect();
     }
-    tin[0] = tout[0].clone();
-    tout[n - 1] = tin[n - 1].clone();
+    // tin[0] and tout[n - 1] stay zero: no segment uses them.
     Cubic {
         values: t.values().iter().map(|v| arr(*v)).collect(),
         times,
@@ -140,7 +145,7 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
     let mut out = Cubic {
         times: vec![keys[0]],
         values: vec![v0],
-        tin: vec![d0.clone()],
+        tin: vec![vec![0.0; dim]],
         tout: vec![d0],
     };
     let mut worst = 0.0f64;
@@ -219,6 +224,10 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
             out.tout.push(dout);
         }
     }
+    // The last key's out tangent is unused: zero, as glTF asks.
+    if let Some(last) = out.tout.last_mut() {
+        last.iter_mut().for_each(|x| *x = 0.0);
+    }
     (out, worst)
 }
 
@@ -233,7 +242,6 @@ fn cubic_sampler(c: &Cubic, kind: &'static str) -> Sampler {
     Sampler {
         times: c.times.iter().map(|&t| t as f32).collect(),
         interpolation: "CUBICSPLINE",
-        width,
         output,
         kind,
     }
@@ -267,30 +275,113 @@ fn target(name: &str, data: &TrackData) -> Result<(String, &'static str, usize),
         }
         return Ok((node.to_string(), "weights", i));
     }
+    let base = name.rsplit_once('.').map_or(name, |p| p.0);
+    let hint = match kind {
+        Vec3 => format!(
+            "; to export it as a translation, rename it: --rename '{name}={base}.translation' (or .scale)"
+        ),
+        Quat => format!("; rename it: --rename '{name}={base}.rotation'"),
+        Scalar => format!(
+            "; to export it as a morph weight, rename it: --rename '{name}={base}.weights.0'"
+        ),
+        Vec2 | Vec4 => "; glTF has no animation target of this kind".to_string(),
+    };
     Err(format!(
-        "track '{name}' ({kind}) has no glTF target: glTF animates <node>.translation, <node>.rotation, <node>.scale and <node>.weights.<i>"
+        "track '{name}' ({kind}) has no glTF target: glTF animates <node>.translation, <node>.rotation, <node>.scale and <node>.weights.<i>{hint}"
     ))
 }
 
-/// Export `clip` to glTF; `.glb` when `binary`. Returns the file bytes and
-/// the report.
+/// Choices for [`export`].
+#[derive(Clone, Debug)]
+pub struct ExportOptions {
+    /// Largest error allowed where a curve must be resampled (relative to
+    /// max(1, |value|)); default 1e-5.
+    pub max_error: f64,
+    /// Track renames applied before names are matched to nodes, `(from,
+    /// to)`: for example `("ball.position", "ball.translation")`.
+    pub rename: Vec<(String, String)>,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        ExportOptions {
+            max_error: 1e-5,
+            rename: Vec::new(),
+        }
+    }
+}
+
+/// A node of the exported scene.
+struct NodeOut {
+    name: String,
+    parent: Option<usize>,
+    rest: Option<tcb_core::skeleton::Transform>,
+    /// Morph targets its weight channel animates (0: no mesh).
+    morphs: usize,
+}
+
+/// The track names after `renames`, checked: every `from` names a track,
+/// and no two tracks end up with one name.
+fn renamed(clip: &tcb_core::Clip, renames: &[(String, String)]) -> Result<Vec<String>, Error> {
+    let mut names: Vec<String> = clip.tracks.iter().map(|t| t.name.clone()).collect();
+    for (from, to) in renames {
+        let i = clip
+            .tracks
+            .iter()
+            .position(|t| t.name == *from)
+            .ok_or_else(|| Error::import(format!("--rename {from}={to}: no track '{from}'")))?;
+        names[i] = to.clone();
+    }
+    for (i, n) in names.iter().enumerate() {
+        if names[..i].contains(n) {
+            return Err(Error::import(format!(
+                "two tracks would be named '{n}' after renaming"
+            )));
+        }
+    }
+    Ok(names)
+}
+
+/// Export `clip` to glTF; `.glb` when `binary`. With `skeleton`, its
+/// joints are the node hierarchy (children and rest transforms); tracks
+/// animate the node of their name. Returns the file bytes and the report.
 pub fn export(
     clip: &tcb_core::Clip,
+    skeleton: Option<&Skeleton>,
     binary: bool,
-    max_error: f64,
+    options: &ExportOptions,
 ) -> Result<(Vec<u8>, ExportReport), Error> {
+    let max_error = options.max_error;
+    let track_names = renamed(clip, &options.rename)?;
     let mut report = ExportReport::default();
-    let mut nodes: Vec<String> = Vec::new();
+    let mut nodes: Vec<NodeOut> = skeleton
+        .map(|s| {
+            s.joints
+                .iter()
+                .map(|j| NodeOut {
+                    name: j.name.clone(),
+                    parent: j.parent,
+                    rest: Some(j.rest),
+                    morphs: 0,
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     // (node, path, sampler)
     let mut channels: Vec<(usize, &'static str, Sampler)> = Vec::new();
     // Weight tracks per node: (target index, track index).
     let mut weights: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
     for (ti, t) in clip.tracks.iter().enumerate() {
-        let (node, path, morph) = target(&t.name, &t.data).map_err(Error::import)?;
-        let ni = match nodes.iter().position(|n| *n == node) {
+        let (node, path, morph) = target(&track_names[ti], &t.data).map_err(Error::import)?;
+        let ni = match nodes.iter().position(|n| n.name == node) {
             Some(i) => i,
             None => {
-                nodes.push(node);
+                nodes.push(NodeOut {
+                    name: node,
+                    parent: None,
+                    rest: None,
+                    morphs: 0,
+                });
                 nodes.len() - 1
             }
         };
@@ -329,7 +420,7 @@ pub fn export(
         if list.iter().enumerate().any(|(i, (m, _))| *m != i) {
             return Err(Error::import(format!(
                 "node '{}': weight tracks must be numbered 0, 1, 2, ... without gaps or repeats",
-                nodes[ni]
+                nodes[ni].name
             )));
         }
         let per: Vec<(Sampler, Option<f64>)> = list
@@ -342,7 +433,7 @@ pub fn export(
         {
             return Err(Error::import(format!(
                 "node '{}': glTF stores all morph weights of a node in one sampler; its weight tracks need the same key times and the same exactness (all exact or all resampled the same way)",
-                nodes[ni]
+                nodes[ni].name
             )));
         }
         for ((_, ti), (_, e)) in list.iter().zip(&per) {
@@ -351,13 +442,14 @@ pub fn export(
                 resampled_error: *e,
             });
         }
+        nodes[ni].morphs = list.len();
         channels.push((
             ni,
             "weights",
             merge(&per.iter().map(|p| &p.0).collect::<Vec<_>>()),
         ));
     }
-    let bytes = write(&clip.name, &nodes, &channels, binary);
+    let bytes = write(&clip.name, &nodes, &channels, binary)?;
     Ok((bytes, report))
 }
 
@@ -401,7 +493,6 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
                 } else {
                     "LINEAR"
                 },
-                width: dim,
                 output,
                 kind,
             };
@@ -441,98 +532,255 @@ fn merge(samplers: &[&Sampler]) -> Sampler {
     Sampler {
         times: samplers[0].times.clone(),
         interpolation: samplers[0].interpolation,
-        width: 1,
         output,
         kind: "SCALAR",
     }
 }
 
+/// The binary buffer and the document that describes it.
+struct Builder {
+    root: json::Root,
+    bin: Vec<u8>,
+}
+
+impl Builder {
+    /// Append `data` as one buffer view and an f32 accessor of `count`
+    /// elements of type `ty`, with per-component min and max when `bounds`
+    /// (glTF requires them on animation inputs and on `POSITION`).
+    fn accessor(
+        &mut self,
+        data: &[f32],
+        count: usize,
+        ty: json::accessor::Type,
+        bounds: bool,
+        vertex: bool,
+    ) -> json::Index<json::Accessor> {
+        let offset = self.bin.len();
+        for x in data {
+            self.bin.extend_from_slice(&x.to_le_bytes());
+        }
+        let view = self.root.push(json::buffer::View {
+            buffer: json::Index::new(0),
+            byte_length: USize64::from(data.len() * 4),
+            byte_offset: Some(USize64::from(offset)),
+            byte_stride: None,
+            name: None,
+            target: vertex.then_some(Checked::Valid(json::buffer::Target::ArrayBuffer)),
+            extensions: None,
+            extras: Default::default(),
+        });
+        let (min, max) = if bounds {
+            let width = data.len() / count.max(1);
+            let fold = |init: f32, f: fn(f32, f32) -> f32| {
+                (0..width)
+                    .map(|c| data.iter().skip(c).step_by(width).copied().fold(init, f))
+                    .collect::<Vec<f32>>()
+            };
+            (
+                Some(serde_json::json!(fold(f32::INFINITY, f32::min))),
+                Some(serde_json::json!(fold(f32::NEG_INFINITY, f32::max))),
+            )
+        } else {
+            (None, None)
+        };
+        self.root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64::from(count),
+            component_type: Checked::Valid(json::accessor::GenericComponentType(
+                json::accessor::ComponentType::F32,
+            )),
+            extensions: None,
+            extras: Default::default(),
+            type_: Checked::Valid(ty),
+            min,
+            max,
+            name: None,
+            normalized: false,
+            sparse: None,
+        })
+    }
+
+    /// A mesh of one point with `targets` morph targets that move nothing:
+    /// what glTF needs before a node's weights can be animated.
+    fn morph_mesh(&mut self, targets: usize) -> json::Index<json::Mesh> {
+        use json::accessor::Type::Vec3;
+        let position = self.accessor(&[0.0; 3], 1, Vec3, true, true);
+        let targets: Vec<json::mesh::MorphTarget> = (0..targets)
+            .map(|_| json::mesh::MorphTarget {
+                positions: Some(self.accessor(&[0.0; 3], 1, Vec3, true, true)),
+                normals: None,
+                tangents: None,
+            })
+            .collect();
+        let weights = vec![0.0; targets.len()];
+        self.root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            primitives: vec![json::mesh::Primitive {
+                attributes: [(Checked::Valid(json::mesh::Semantic::Positions), position)].into(),
+                extensions: None,
+                extras: Default::default(),
+                indices: None,
+                material: None,
+                mode: Checked::Valid(json::mesh::Mode::Points),
+                targets: Some(targets),
+            }],
+            weights: Some(weights),
+        })
+    }
+}
+
 fn write(
     name: &str,
-    nodes: &[String],
+    nodes: &[NodeOut],
     channels: &[(usize, &'static str, Sampler)],
     binary: bool,
-) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let mut views = Vec::new();
-    let mut accessors = Vec::new();
-    let mut push = |data: &[f32], count: usize, kind: &str, minmax: bool| -> usize {
-        let offset = bin.len();
-        for x in data {
-            bin.extend_from_slice(&x.to_le_bytes());
-        }
-        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": data.len() * 4}));
-        let mut a = json!({"bufferView": views.len() - 1, "componentType": 5126, "count": count, "type": kind});
-        if minmax {
-            let min = data.iter().copied().fold(f32::INFINITY, f32::min);
-            let max = data.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-            a["min"] = json!([min]);
-            a["max"] = json!([max]);
-        }
-        accessors.push(a);
-        accessors.len() - 1
+) -> Result<Vec<u8>, Error> {
+    use json::accessor::Type;
+    let mut b = Builder {
+        root: json::Root {
+            asset: json::Asset {
+                generator: Some("tcb export".into()),
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        bin: Vec::new(),
     };
     let mut samplers = Vec::new();
     let mut anim_channels = Vec::new();
     for (node, path, s) in channels {
-        let input = push(&s.times, s.times.len(), "SCALAR", true);
-        let count = s.output.len() / if s.kind == "SCALAR" { 1 } else { s.width };
-        let output = push(&s.output, count, s.kind, false);
-        samplers.push(json!({"input": input, "output": output, "interpolation": s.interpolation}));
-        anim_channels
-            .push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
+        let input = b.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
+        let (count, ty) = match s.kind {
+            "SCALAR" => (s.output.len(), Type::Scalar),
+            "VEC3" => (s.output.len() / 3, Type::Vec3),
+            _ => (s.output.len() / 4, Type::Vec4),
+        };
+        let output = b.accessor(&s.output, count, ty, false, false);
+        let interpolation = match s.interpolation {
+            "STEP" => json::animation::Interpolation::Step,
+            "LINEAR" => json::animation::Interpolation::Linear,
+            _ => json::animation::Interpolation::CubicSpline,
+        };
+        samplers.push(json::animation::Sampler {
+            extensions: None,
+            extras: Default::default(),
+            input,
+            interpolation: Checked::Valid(interpolation),
+            output,
+        });
+        let property = match *path {
+            "translation" => json::animation::Property::Translation,
+            "rotation" => json::animation::Property::Rotation,
+            "scale" => json::animation::Property::Scale,
+            _ => json::animation::Property::MorphTargetWeights,
+        };
+        anim_channels.push(json::animation::Channel {
+            sampler: json::Index::new(samplers.len() as u32 - 1),
+            target: json::animation::Target {
+                extensions: None,
+                extras: Default::default(),
+                node: json::Index::new(*node as u32),
+                path: Checked::Valid(property),
+            },
+            extensions: None,
+            extras: Default::default(),
+        });
     }
-    let mut doc = json!({
-        "asset": {"version": "2.0", "generator": "tcb export"},
-        "scene": 0,
-        "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
-        "nodes": nodes.iter().map(|n| json!({"name": n})).collect::<Vec<Value>>(),
-        "bufferViews": views,
-        "accessors": accessors,
-        "animations": [{"name": name, "channels": anim_channels, "samplers": samplers}],
+    let meshes: Vec<Option<json::Index<json::Mesh>>> = nodes
+        .iter()
+        .map(|n| (n.morphs > 0).then(|| b.morph_mesh(n.morphs)))
+        .collect();
+    let mut roots = Vec::new();
+    let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        match n.parent {
+            Some(p) => children[p].push(json::Index::new(i as u32)),
+            None => roots.push(json::Index::new(i as u32)),
+        }
+    }
+    for (i, n) in nodes.iter().enumerate() {
+        let rest = n.rest.unwrap_or_default();
+        let node = json::Node {
+            name: Some(n.name.clone()),
+            children: (!children[i].is_empty()).then(|| children[i].clone()),
+            mesh: meshes[i],
+            // Identity parts are left out, as glTF writers do.
+            translation: (rest.translation != glam::Vec3::ZERO)
+                .then(|| <[f32; 3]>::from(rest.translation)),
+            rotation: (rest.rotation != glam::Quat::IDENTITY)
+                .then(|| json::scene::UnitQuaternion(<[f32; 4]>::from(rest.rotation.normalize()))),
+            scale: (rest.scale != glam::Vec3::ONE).then(|| <[f32; 3]>::from(rest.scale)),
+            ..Default::default()
+        };
+        b.root.push(node);
+    }
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: Default::default(),
+        name: None,
+        nodes: roots,
     });
+    b.root.scene = Some(scene);
+    b.root.push(json::Animation {
+        extensions: None,
+        extras: Default::default(),
+        channels: anim_channels,
+        name: Some(name.to_string()),
+        samplers,
+    });
+    while !b.bin.len().is_multiple_of(4) {
+        b.bin.push(0);
+    }
+    let too_big = || Error::import("the export is larger than glTF's 4 GiB limit");
+    let mut buffer = json::Buffer {
+        byte_length: USize64::from(b.bin.len()),
+        name: None,
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    };
+    let serialize = |e: serde_json::Error| Error::import(format!("writing the glTF JSON: {e}"));
     if binary {
-        doc["buffers"] = json!([{"byteLength": bin.len()}]);
-        let mut json_bytes = serde_json::to_vec(&doc).expect("serializable");
-        while !json_bytes.len().is_multiple_of(4) {
-            json_bytes.push(b' ');
-        }
-        while !bin.len().is_multiple_of(4) {
-            bin.push(0);
-        }
-        let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
-        let mut out = Vec::with_capacity(total);
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&json_bytes);
-        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&bin);
-        out
+        b.root.push(buffer);
+        let json_bytes = b.root.to_vec().map_err(serialize)?;
+        let length = 12 + 8 + json_bytes.len().next_multiple_of(4) + 8 + b.bin.len();
+        let glb = gltf::binary::Glb {
+            header: gltf::binary::Header {
+                magic: *b"glTF",
+                version: 2,
+                length: u32::try_from(length).map_err(|_| too_big())?,
+            },
+            json: json_bytes.into(),
+            bin: Some(b.bin.into()),
+        };
+        glb.to_vec()
+            .map_err(|e| Error::import(format!("writing the GLB: {e}")))
     } else {
-        doc["buffers"] = json!([{
-            "byteLength": bin.len(),
-            "uri": format!("data:application/octet-stream;base64,{}", base64_encode(&bin)),
-        }]);
-        let mut text = serde_json::to_vec_pretty(&doc).expect("serializable");
+        buffer.uri = Some(format!(
+            "data:application/octet-stream;base64,{}",
+            crate::gltf_import::base64_encode(&b.bin)
+        ));
+        b.root.push(buffer);
+        let mut text = b.root.to_vec_pretty().map_err(serialize)?;
         text.push(b'\n');
-        text
+        Ok(text)
     }
 }
 
 /// Export to `path` (`.glb` binary, else `.gltf`), written atomically.
 pub fn export_file(
     clip: &tcb_core::Clip,
+    skeleton: Option<&Skeleton>,
     path: &Path,
-    max_error: f64,
+    options: &ExportOptions,
 ) -> Result<ExportReport, Error> {
     let binary = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let (bytes, report) = export(clip, binary, max_error).map_err(|e| e.in_file(path))?;
+    let (bytes, report) = export(clip, skeleton, binary, options).map_err(|e| e.in_file(path))?;
     crate::write_atomically(path, &bytes)?;
     Ok(report)
 }

@@ -20,7 +20,11 @@ fn round_trip(
     binary: bool,
     max_error: f64,
 ) -> (tcb_core::Clip, tcb_io::gltf_export::ExportReport) {
-    let (bytes, report) = export(clip, binary, max_error).unwrap();
+    let options = tcb_io::gltf_export::ExportOptions {
+        max_error,
+        ..Default::default()
+    };
+    let (bytes, report) = export(clip, None, binary, &options).unwrap();
     let back = import(&bytes, None, None, "rt").unwrap();
     (back.doc.build().unwrap(), report)
 }
@@ -144,7 +148,13 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
         .build()
         .unwrap()
     };
-    let (_, report) = export(&with(r#""post": "repeat","#), true, 1e-5).unwrap();
+    let (_, report) = export(
+        &with(r#""post": "repeat","#),
+        None,
+        true,
+        &Default::default(),
+    )
+    .unwrap();
     assert_eq!(
         report.notes,
         ["track 'hip.translation': post 'repeat' is not expressible; glTF holds the end value"]
@@ -153,7 +163,9 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
         .unwrap()
         .build()
         .unwrap();
-    let err = export(&bad, true, 1e-5).unwrap_err().to_string();
+    let err = export(&bad, None, true, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         err.starts_with("track 'hip.squash' (vec3) has no glTF target"),
         "{err}"
@@ -163,9 +175,105 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
         .build()
         .unwrap();
     assert!(
-        export(&gap, true, 1e-5)
+        export(&gap, None, true, &Default::default())
             .unwrap_err()
             .to_string()
             .contains("without gaps")
     );
+}
+
+/// Import, export with the skeleton, import again: the same joints (by
+/// name), parents, rest transforms and motion.
+fn hierarchy_round_trips(path: &str) {
+    let first = tcb_io::load(path.as_ref()).unwrap();
+    let skeleton = first.skeleton.clone().expect("importers fill the skeleton");
+    let (bytes, _) = export(&first.clip, Some(&skeleton), true, &Default::default()).unwrap();
+    let again = import(&bytes, None, None, "rt").unwrap();
+    let back = &again.skeleton;
+    assert_eq!(back.joints.len(), skeleton.joints.len(), "{path}");
+    for joint in &skeleton.joints {
+        let b = &back.joints[back.joint(&joint.name).expect("joint kept")];
+        let name = |s: &tcb_core::skeleton::Skeleton, p: Option<usize>| {
+            p.map(|p| s.joints[p].name.clone())
+        };
+        assert_eq!(
+            name(back, b.parent),
+            name(&skeleton, joint.parent),
+            "{path}: parent of {}",
+            joint.name
+        );
+        let r = &joint.rest;
+        let close = |a: glam::Vec3, b: glam::Vec3| {
+            (a - b).abs().max_element() <= 1e-6 * a.abs().max_element().max(1.0)
+        };
+        assert!(
+            close(r.translation, b.rest.translation),
+            "{path}: {} translation",
+            joint.name
+        );
+        assert!(close(r.scale, b.rest.scale), "{path}: {} scale", joint.name);
+        assert!(
+            r.rotation.normalize().dot(b.rest.rotation).abs() > 1.0 - 1e-6,
+            "{path}: {} rotation",
+            joint.name
+        );
+    }
+    let clip = again.doc.build().unwrap();
+    let (start, end) = first.clip.time_range().unwrap();
+    let worst = compare(
+        &first.clip,
+        &clip,
+        (0..=500).map(|i| start + (end - start) * f64::from(i) / 500.0),
+    );
+    // Squad is resampled within the default 1e-5.
+    assert!(worst.iter().all(|w| *w <= 2e-5), "{path}: {worst:?}");
+}
+
+#[test]
+fn bvh_hierarchy_rest_pose_and_motion_round_trip() {
+    hierarchy_round_trips(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/cmu-01_01.bvh"
+    ));
+}
+
+#[test]
+fn gltf_hierarchy_rest_pose_and_motion_round_trip() {
+    hierarchy_round_trips(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/simple_skin.gltf"
+    ));
+}
+
+#[test]
+fn unused_tangents_are_zero() {
+    // The first key's in-tangent and the last key's out-tangent, exact and
+    // resampled.
+    let clip = tcb_io::ClipDoc::parse(CLIP).unwrap().build().unwrap();
+    let (bytes, _) = export(&clip, None, true, &Default::default()).unwrap();
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let mut cubic = 0;
+    for anim in gltf.document.animations() {
+        for ch in anim.channels() {
+            if ch.sampler().interpolation() != gltf::animation::Interpolation::CubicSpline {
+                continue;
+            }
+            let out = ch.sampler().output();
+            let view = out.view().unwrap();
+            let at = view.offset() + out.offset();
+            let floats: Vec<f32> = blob[at..at + view.length()]
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            let width = floats.len() / out.count();
+            let n = out.count() / 3;
+            let first_in = &floats[..width];
+            let last_out = &floats[(3 * n - 1) * width..];
+            assert!(first_in.iter().all(|x| *x == 0.0), "{first_in:?}");
+            assert!(last_out.iter().all(|x| *x == 0.0), "{last_out:?}");
+            cubic += 1;
+        }
+    }
+    assert!(cubic >= 4, "{cubic} cubic samplers");
 }
