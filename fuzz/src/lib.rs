@@ -11,7 +11,9 @@
 
 use arbitrary::{Arbitrary, Unstructured};
 use std::sync::Arc;
-use tcb_core::{Ends, Extrapolation, Interp, RotationMode, TangentRule, TrackData, TrackKind};
+use tcb_core::{
+    Ends, Extrapolation, Hemisphere, Interp, RotationMode, TangentRule, TrackData, TrackKind,
+};
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 use tcb_runtime::{BlendMask, Instance};
 
@@ -238,6 +240,7 @@ fn settings(u: &mut Unstructured) -> arbitrary::Result<SettingsDoc> {
         pre: some(u, |u| u.choose(Extrapolation::ALL).copied())?,
         post: some(u, |u| u.choose(Extrapolation::ALL).copied())?,
         rotation: some(u, |u| u.choose(RotationMode::ALL).copied())?,
+        hemisphere: some(u, |u| u.choose(Hemisphere::ALL).copied())?,
     })
 }
 

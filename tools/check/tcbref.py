@@ -136,6 +136,7 @@ class Settings:
         self.pre = d.get("pre", "constant")
         self.post = d.get("post", "constant")
         self.rotation = d.get("rotation", "squad")
+        self.hemisphere = d.get("hemisphere", "nearest")
 
 
 def key_tangents(times, chords, keys, st, dim, wrap_sign=1.0):
@@ -229,7 +230,7 @@ def dh_row(s):
 class Track:
     def __init__(self, doc, defaults):
         merged = dict(defaults)
-        for k in ("tangent_rule", "ends", "match_speed", "continuity_fade", "tcb", "pre", "post", "rotation"):
+        for k in ("tangent_rule", "ends", "match_speed", "continuity_fade", "tcb", "pre", "post", "rotation", "hemisphere"):
             if k in doc:
                 merged[k] = doc[k]
         self.st = Settings(merged)
@@ -246,7 +247,8 @@ class Track:
             self.keys = [dict(k) for k in self.keys]
             for i, q in enumerate(vals):
                 q = normalize(q)
-                if qs and dot(qs[-1], q) < 0:
+                # hemisphere "keep": keys and tangents exactly as written.
+                if self.st.hemisphere == "nearest" and qs and dot(qs[-1], q) < 0:
                     q = mul(q, -1)
                     for side in ("in", "out"):
                         if side in self.keys[i]:

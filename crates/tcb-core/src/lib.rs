@@ -65,7 +65,8 @@ pub mod vector;
 pub use clip::{Clip, NamedTrack, TrackData, TrackKind};
 pub use error::TrackError;
 pub use params::{
-    Ease, Ends, Extrapolation, Interp, KeyParams, RotationMode, TangentRule, Tcb, TrackSettings,
+    Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, RotationMode, TangentRule, Tcb,
+    TrackSettings,
 };
 pub use rotation::RotationTrack;
 pub use track::Track;

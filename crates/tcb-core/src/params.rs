@@ -229,6 +229,20 @@ named_enum! {
     }
 }
 
+named_enum! {
+    /// Whether a rotation track's keys are moved to one hemisphere at load.
+    Hemisphere {
+        /// Each key is flipped to the hemisphere of the previous one
+        /// (`q_k = -q_k` where `dot(q_{k-1}, q_k) < 0`), its explicit
+        /// tangents with it, so every segment takes the short way.
+        #[default]
+        Nearest = "nearest",
+        /// Keys and their tangents are used exactly as written (glTF
+        /// `CUBICSPLINE` rotations, which viewers interpolate as stored).
+        Keep = "keep",
+    }
+}
+
 /// Track-wide settings; the clip file's `defaults`, overridable per track.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct TrackSettings {
@@ -246,6 +260,8 @@ pub struct TrackSettings {
     pub post: Extrapolation,
     /// Rotation tracks only.
     pub rotation: RotationMode,
+    /// Rotation tracks only: flip keys to one hemisphere at load, or keep them.
+    pub hemisphere: Hemisphere,
 }
 
 /// Per-key parameters of a track with values of type `V`.

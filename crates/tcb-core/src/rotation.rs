@@ -33,7 +33,9 @@
 use crate::ease::SegmentEase;
 use crate::error::TrackError;
 use crate::extrapolate::{Mapped, map_time};
-use crate::params::{Ends, Extrapolation, Interp, KeyParams, RotationMode, TrackSettings};
+use crate::params::{
+    Ends, Extrapolation, Hemisphere, Interp, KeyParams, RotationMode, TrackSettings,
+};
 use crate::tangent::{TangentKey, key_tangents};
 use crate::track::{Track, check_keys, keys_or_default, locate, segment_eases};
 use glam::{DQuat, DVec3, DVec4, Quat, Vec4};
@@ -162,7 +164,8 @@ pub struct RotationTrack {
 
 impl RotationTrack {
     /// Build a rotation track; `settings.rotation` chooses the mode.
-    /// Quaternions are normalized and made hemisphere-consistent.
+    /// Quaternions are normalized and, unless `settings.hemisphere` is
+    /// [`Hemisphere::Keep`], made hemisphere-consistent.
     pub fn new(
         times: Vec<f64>,
         values: Vec<Quat>,
@@ -199,7 +202,8 @@ impl RotationTrack {
                 return Err(TrackError::ZeroQuaternion { key });
             }
             let mut v = v / len;
-            if let Some(prev) = qs.last()
+            if settings.hemisphere == Hemisphere::Nearest
+                && let Some(prev) = qs.last()
                 && DVec4::from(*prev).dot(v) < 0.0
             {
                 // The key's explicit tangents describe the curve through the
@@ -278,9 +282,20 @@ impl RotationTrack {
         &self.times
     }
 
-    /// Key rotations, normalized and hemisphere-consistent.
+    /// Key rotations, normalized (and hemisphere-consistent unless the
+    /// track keeps them as written).
     pub fn values(&self) -> &[Quat] {
         &self.values
+    }
+
+    /// Key rotations in f64, as the reference interpolates them ([`values`]
+    /// rounded them to f32). Slerp between keys more than 90 degrees apart,
+    /// which tracks that keep their hemispheres have, amplifies that
+    /// rounding: interpolate these.
+    ///
+    /// [`values`]: RotationTrack::values
+    pub fn keys(&self) -> &[DQuat] {
+        &self.keys
     }
 
     /// The settings the track was built with.
@@ -468,6 +483,42 @@ mod tests {
         // No hemisphere flip: slerp to -q goes the long way.
         let long = slerp(p, -q, 0.5);
         assert!(!close(long, DQuat::from_rotation_z(0.5), 1e-3));
+    }
+
+    #[test]
+    fn hemisphere_keep_uses_keys_and_tangents_as_written() {
+        let q1 = Quat::from_rotation_z(0.5);
+        let mut keys = vec![KeyParams::default(); 2];
+        keys[1].tangent_in = Some(Quat::from_xyzw(0.0, 0.0, 0.1, 0.0));
+        let settings = TrackSettings {
+            rotation: RotationMode::Hermite,
+            hemisphere: Hemisphere::Keep,
+            ..TrackSettings::default()
+        };
+        let t =
+            RotationTrack::new(vec![0.0, 1.0], vec![Quat::IDENTITY, -q1], keys, &settings).unwrap();
+        assert_eq!(t.values()[1], -q1);
+        let h = t.hermite_track().unwrap();
+        assert_eq!(h.values()[1], Vec4::from_array((-q1).to_array()));
+        // Nearest flips the key and its tangent.
+        let nearest = TrackSettings {
+            hemisphere: Hemisphere::Nearest,
+            ..settings
+        };
+        let mut keys = vec![KeyParams::default(); 2];
+        keys[1].tangent_in = Some(Quat::from_xyzw(0.0, 0.0, 0.1, 0.0));
+        let t =
+            RotationTrack::new(vec![0.0, 1.0], vec![Quat::IDENTITY, -q1], keys, &nearest).unwrap();
+        assert_eq!(t.values()[1], q1);
+        // Squad with keep goes the long way: half way is not the short half.
+        let squad = TrackSettings {
+            rotation: RotationMode::Squad,
+            hemisphere: Hemisphere::Keep,
+            ..TrackSettings::default()
+        };
+        let t =
+            RotationTrack::new(vec![0.0, 1.0], vec![Quat::IDENTITY, -q1], vec![], &squad).unwrap();
+        assert!(t.sample(0.5).dot(Quat::from_rotation_z(0.25)).abs() < 0.5);
     }
 
     #[test]

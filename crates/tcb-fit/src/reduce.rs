@@ -39,7 +39,7 @@ use std::str::FromStr;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tcb_core::skeleton::Skeleton;
-use tcb_core::{Clip, Ends, Extrapolation, RotationMode, TangentRule, TrackKind};
+use tcb_core::{Clip, Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, TrackKind};
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 
 /// The error measure (`--metric`).
@@ -702,6 +702,7 @@ impl<'a> Plan<'a> {
             pre: Some(base.pre),
             post: Some(base.post),
             rotation: Some(RotationMode::Hermite),
+            hemisphere: None,
         };
         let mut tracks = Vec::new();
         let mut kept = vec![false; src.tracks.len()];
@@ -732,6 +733,11 @@ impl<'a> Plan<'a> {
                     settings: SettingsDoc {
                         pre: Some(resolved.pre).filter(|m| *m != base.pre),
                         post: Some(resolved.post).filter(|m| *m != base.post),
+                        // Fitted to a curve that keeps its keys as written:
+                        // so do the fitted keys.
+                        hemisphere: (doc.kind == TrackKind::Quat
+                            && resolved.hemisphere == Hemisphere::Keep)
+                            .then_some(Hemisphere::Keep),
                         ..SettingsDoc::default()
                     },
                 }
@@ -750,6 +756,7 @@ impl<'a> Plan<'a> {
                         pre: Some(resolved.pre),
                         post: Some(resolved.post),
                         rotation: (doc.kind == TrackKind::Quat).then_some(resolved.rotation),
+                        hemisphere: (doc.kind == TrackKind::Quat).then_some(resolved.hemisphere),
                     };
                     tracks.push(TrackDoc {
                         settings: only_different(&full, &defaults),
@@ -784,6 +791,9 @@ fn only_different(full: &SettingsDoc, defaults: &SettingsDoc) -> SettingsDoc {
         pre: diff(full.pre, defaults.pre),
         post: diff(full.post, defaults.post),
         rotation: full.rotation.and_then(|r| diff(Some(r), defaults.rotation)),
+        hemisphere: full
+            .hemisphere
+            .and_then(|h| diff(Some(h), defaults.hemisphere.or(Some(Hemisphere::Nearest)))),
     }
 }
 

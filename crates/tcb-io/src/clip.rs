@@ -17,8 +17,8 @@ use std::path::Path;
 use std::str::FromStr;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{
-    Clip, Ease, Ends, Extrapolation, Interp, KeyParams, NamedTrack, RotationMode, RotationTrack,
-    TangentRule, Tcb, Track, TrackData, TrackKind, TrackSettings, Value,
+    Clip, Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
+    RotationTrack, TangentRule, Tcb, Track, TrackData, TrackKind, TrackSettings, Value,
 };
 
 /// The format string a clip file carries.
@@ -43,10 +43,12 @@ pub struct SettingsDoc {
     pub post: Option<Extrapolation>,
     /// `rotation` (quat tracks).
     pub rotation: Option<RotationMode>,
+    /// `hemisphere` (quat tracks): `nearest` or `keep`.
+    pub hemisphere: Option<Hemisphere>,
 }
 
 impl SettingsDoc {
-    const FIELDS: [&'static str; 8] = [
+    const FIELDS: [&'static str; 9] = [
         "tangent_rule",
         "ends",
         "match_speed",
@@ -55,6 +57,7 @@ impl SettingsDoc {
         "pre",
         "post",
         "rotation",
+        "hemisphere",
     ];
 
     /// These settings, with any field they leave out taken from `base`.
@@ -68,6 +71,7 @@ impl SettingsDoc {
             pre: self.pre.or(base.pre),
             post: self.post.or(base.post),
             rotation: self.rotation.or(base.rotation),
+            hemisphere: self.hemisphere.or(base.hemisphere),
         }
     }
 
@@ -83,6 +87,7 @@ impl SettingsDoc {
             pre: self.pre.unwrap_or(d.pre),
             post: self.post.unwrap_or(d.post),
             rotation: self.rotation.unwrap_or(d.rotation),
+            hemisphere: self.hemisphere.unwrap_or(d.hemisphere),
         };
         (settings, self.tcb.map_or(Tcb::DEFAULT, Tcb::from_array))
     }
@@ -425,6 +430,7 @@ fn settings_json(s: &SettingsDoc) -> Vec<String> {
     text("pre", s.pre.map(|x| x.name()));
     text("post", s.post.map(|x| x.name()));
     text("rotation", s.rotation.map(|x| x.name()));
+    text("hemisphere", s.hemisphere.map(|x| x.name()));
     if let Some(b) = s.match_speed {
         f.push(format!("\"match_speed\": {b}"));
     }
@@ -667,6 +673,9 @@ fn parse_settings(obj: &Map<String, Json>, loc: &Location) -> Result<SettingsDoc
         post: get("post").map(|v| as_enum(v, loc, "post")).transpose()?,
         rotation: get("rotation")
             .map(|v| as_enum(v, loc, "rotation"))
+            .transpose()?,
+        hemisphere: get("hemisphere")
+            .map(|v| as_enum(v, loc, "hemisphere"))
             .transpose()?,
     })
 }

@@ -13,7 +13,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::{Interpolation, Property};
 use std::path::Path;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
-use tcb_core::{Interp, RotationMode, TrackKind};
+use tcb_core::{Hemisphere, Interp, RotationMode, TrackKind};
 
 /// A glTF file's hierarchy and one of its animations as a clip.
 #[derive(Clone, Debug)]
@@ -228,7 +228,10 @@ pub fn import(
             }
             let mut settings = SettingsDoc::default();
             if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
+                // Viewers interpolate the stored components as they are,
+                // sign changes and all (clip-format.md).
                 settings.rotation = Some(RotationMode::Hermite);
+                settings.hemisphere = Some(Hemisphere::Keep);
             }
             tracks.push(TrackDoc {
                 name,

@@ -262,3 +262,57 @@ fn an_unknown_target_path_is_an_error_not_a_panic() {
         "{e}"
     );
 }
+
+/// A CUBICSPLINE rotation whose second key is stored with the other sign:
+/// viewers interpolate the stored components (the glTF spec's cubic, then
+/// normalize), so the import keeps them as written (`hemisphere: keep`)
+/// and plays the same long way round.
+#[test]
+fn sign_changing_cubicspline_rotations_play_as_stored() {
+    let (s, c) = (15f32.to_radians().sin(), 15f32.to_radians().cos());
+    let v0 = [0.0, 0.0, 0.0, 1.0];
+    let v1 = [0.0, 0.0, -s, -c];
+    let zero = [0.0f32; 4];
+    let mut out = vec![0.0f32, 1.0];
+    for e in [zero, v0, zero, zero, v1, zero] {
+        out.extend_from_slice(&e);
+    }
+    let acc = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 6, "type": "VEC4"}"#;
+    let text = gltf_with(acc, &floats(&out))
+        .replace(r#""path": "translation""#, r#""path": "rotation""#)
+        .replace(r#""LINEAR""#, r#""CUBICSPLINE""#);
+    let g = import(text.as_bytes(), None, None, "t").unwrap();
+    assert_eq!(
+        g.doc.tracks[0].settings.hemisphere,
+        Some(tcb_core::Hemisphere::Keep)
+    );
+    let clip = g.doc.build().unwrap();
+    for i in 0..=20 {
+        let u = f64::from(i) / 20.0;
+        let (a, b) = (
+            2.0 * u.powi(3) - 3.0 * u * u + 1.0,
+            -2.0 * u.powi(3) + 3.0 * u * u,
+        );
+        let p: Vec<f64> = (0..4)
+            .map(|k| a * f64::from(v0[k]) + b * f64::from(v1[k]))
+            .collect();
+        let len = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let mut row = [0.0f32; 4];
+        clip.sample_into(u, &mut row, None);
+        for k in 0..4 {
+            let want = p[k] / len;
+            assert!(
+                (f64::from(row[k]) - want).abs() < 1e-5,
+                "u {u} component {k}: {} vs {want}",
+                row[k]
+            );
+        }
+    }
+    // Half way it is far from the short way's half way (the keys are the
+    // identity and 30 degrees about z).
+    let mut row = [0.0f32; 4];
+    clip.sample_into(0.5, &mut row, None);
+    let short = Quat::from_rotation_z(15f32.to_radians());
+    assert!(Quat::from_array(row).dot(short).abs() < 0.2, "{row:?}");
+}

@@ -27,7 +27,6 @@ use crate::kernel::{HQ_STRIDE, KEY_STRIDE, SQ_STRIDE};
 use crate::loose::{Loose, LooseLane};
 use crate::pose::PoseLayout;
 use crate::quant::Quantized;
-use glam::DQuat;
 use std::collections::HashMap;
 use std::sync::Arc;
 use tcb_core::ease::SegmentEase;
@@ -361,7 +360,7 @@ const CUBIC_VELOCITY_TOL: f32 = 5e-5;
 /// the cubic misses keep their squad controls, and the kernel evaluates
 /// those lanes exactly ([`kernel::exact_quats`]).
 fn rotation_controls(t: &RotationTrack) -> RotationControls {
-    let keys: Vec<DQuat> = t.values().iter().map(|q| q.as_dquat()).collect();
+    let keys = t.keys();
     let n = keys.len();
     let interps = t.interps();
     let mut comps = match t.hermite_track() {
@@ -404,6 +403,34 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         comp[n] = [last[i] as f32, last[i] as f32, 0.0, arrive];
     }
     RotationControls { comps, exact }
+}
+
+/// How much normalizing can grow an error of a rotation's cubic:
+/// `|d(p / |p|)| <= 2 |dp| / |p|`, so `2 / min(1, |p|)` with `|p|` the
+/// smallest length of its cubic pieces (sampled at 33 points per segment,
+/// with 5% to spare between them). Near 2 for curves close to unit length;
+/// large where a curve between keys on opposite hemispheres, kept as
+/// written, passes near zero.
+fn normalize_gain(rot: &RotationControls) -> f32 {
+    use tcb_core::basis::{hermite, hermite_basis};
+    let n = rot.comps[0].len();
+    let mut least = 1.0f32;
+    for s in 1..n - 1 {
+        if rot.exact[s].is_some() {
+            continue; // evaluated exactly, not as this cubic
+        }
+        for j in 0..=32 {
+            let h = hermite_basis(j as f32 / 32.0);
+            let len2: f32 = (0..4)
+                .map(|c| {
+                    let k = rot.comps[c][s];
+                    hermite(&h, k[0], k[1], k[2], k[3]).powi(2)
+                })
+                .sum();
+            least = least.min(len2.sqrt());
+        }
+    }
+    2.0 / (0.95 * least).max(1e-6)
 }
 
 /// `x` in f32, finite: beyond f32's range the largest finite f32 of its
@@ -624,6 +651,14 @@ impl Clip {
             }
         }
 
+        // How much normalizing can grow a quantization error of each
+        // rotation (before its rows are moved into loose lanes).
+        let mut rot_gain = vec![2.0f32; source.tracks.len()];
+        if options.quantize {
+            for (track, rot) in hq_rows.iter().flatten() {
+                rot_gain[*track] = normalize_gain(rot);
+            }
+        }
         // Small groups of vector channels only: one lane per track (see loose.rs).
         let mut loose_lanes: Vec<(usize, LooseLane)> = Vec::new();
         let mut loose_rots: Vec<(usize, LooseLane)> = Vec::new();
@@ -743,12 +778,13 @@ impl Clip {
                     quant_error[*track] = quant_error[*track].max(bound);
                 }
                 let (qr, err) = Quantized::new(&hq, keys, hq_blocks, HQ_STRIDE);
-                for (lane, (track, _)) in hq_rows[g].iter().enumerate() {
+                for (lane, (track, rot)) in hq_rows[g].iter().enumerate() {
                     let e = |j: usize| err[(lane / 8) * HQ_STRIDE + j][lane % 8];
                     let bound = (0..4)
                         .map(|c| e(c) + 4.0 / 27.0 * (e(4 + c) + e(8 + c)))
                         .fold(0.0f32, f32::max);
-                    quant_error[*track] = quant_error[*track].max(2.0 * bound);
+                    let bound = bound * normalize_gain(rot);
+                    quant_error[*track] = quant_error[*track].max(bound);
                 }
                 (qvec, qhq) = (Some(q), Some(qr));
                 vec = Vec::new();
@@ -775,21 +811,21 @@ impl Clip {
             slots[*track].index = plane_slots(at, lane);
         }
         // Quantized: loose lanes too (expanded only on key crossings).
-        let mut quantize_lane = |track: usize, lane: &mut LooseLane, rotation: bool| {
+        let mut quantize_lane = |track: usize, lane: &mut LooseLane, gain: f32| {
             if options.quantize {
                 let bound = lane
                     .quantize()
                     .iter()
                     .map(|e| e[0] + 4.0 / 27.0 * (e[1] + e[2]))
                     .fold(0.0f32, f32::max);
-                quant_error[track] = if rotation { 2.0 * bound } else { bound };
+                quant_error[track] = gain * bound;
             }
         };
         for (track, lane) in &mut loose_lanes {
-            quantize_lane(*track, lane, false);
+            quantize_lane(*track, lane, 1.0);
         }
         for (track, lane) in &mut loose_rots {
-            quantize_lane(*track, lane, true);
+            quantize_lane(*track, lane, rot_gain[*track]);
         }
         let loose = Loose::new(loose_lanes.into_iter().map(|(_, l)| l).collect(), at);
         at += 4 * loose.blocks;

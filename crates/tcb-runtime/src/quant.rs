@@ -13,8 +13,10 @@
 //! A sample inside the keys is `h1 P0 + h2 P1 + h3 M0 + h4 M1` with
 //! `h1 + h2 = 1`, `h1, h2 >= 0` and `|h3|, |h4| <= 4/27`, so it moves by at
 //! most `e_P + 4/27 (e_TO + e_TI)` (the bound [`crate::Clip::quantization_error`]
-//! reports; rotations are normalized after, which at most doubles it for
-//! curves within 1% of unit length). Linear extrapolation adds `|dt| e_TO`.
+//! reports; rotations are normalized after, which multiplies it by at most
+//! `2 / min(1, |p|)` with |p| the curve's smallest length: about 2 near unit
+//! length, more for curves between keys on opposite hemispheres that a
+//! track keeps as written). Linear extrapolation adds `|dt| e_TO`.
 //! The kernels themselves are unchanged: an instance expands the two keys a
 //! group reads into a two-slot cache (forward playback expands one key per
 //! crossing), and a track on its own key times expands its segment into its
