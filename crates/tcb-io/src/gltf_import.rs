@@ -401,12 +401,6 @@ fn read(buffers: &[Vec<u8>], a: &gltf::Accessor, dim: usize) -> Result<Vec<f32>,
             a.dimensions()
         ));
     }
-    if a.sparse().is_some() {
-        return Err(format!(
-            "accessor {} is sparse (not supported for animation)",
-            a.index()
-        ));
-    }
     let ty = a.data_type();
     let float = ty == DataType::F32;
     if !float && !a.normalized() {
@@ -415,33 +409,119 @@ fn read(buffers: &[Vec<u8>], a: &gltf::Accessor, dim: usize) -> Result<Vec<f32>,
             a.index()
         ));
     }
-    let size = ty.size();
+    if ty == DataType::U32 {
+        return Err(format!(
+            "accessor {} is u32 (not allowed for animation)",
+            a.index()
+        ));
+    }
     let count = a.count();
-    let Some(view) = a.view() else {
-        return Err(format!("accessor {} has no buffer view", a.index()));
-    };
-    let data = &buffers[view.buffer().index()];
-    let elem = size * dim;
-    let stride = view.stride().unwrap_or(elem);
-    let range = (|| {
-        let view_end = view.offset().checked_add(view.length())?;
-        let last = count.checked_sub(1)?.checked_mul(stride)?;
-        let end = a.offset().checked_add(last)?.checked_add(elem)?;
-        (stride >= elem && end <= view.length() && view_end <= data.len()).then_some(())
-    })();
     if count == 0 {
         return Err(format!("accessor {} has no elements", a.index()));
     }
-    if range.is_none() {
-        return Err(format!(
-            "accessor {}: {count} elements of {elem} bytes (stride {stride}) from byte {} do not fit in buffer view {} ({} bytes) or its buffer",
-            a.index(),
-            a.offset(),
-            view.index(),
-            view.length()
-        ));
+    let what = format!("accessor {}", a.index());
+    let mut out = match a.view() {
+        Some(view) => decode(buffers, &view, a.offset(), count, ty, dim, true, &what)?,
+        // A sparse accessor without a view starts from zeros; bound what
+        // that allocates (a count is a u32 in the file, not in its bytes).
+        None if a.sparse().is_some() => {
+            if count > MAX_SPARSE_ELEMENTS {
+                return Err(format!(
+                    "{what}: sparse over {count} elements with no buffer view (at most {MAX_SPARSE_ELEMENTS})"
+                ));
+            }
+            vec![0.0; count * dim]
+        }
+        None => return Err(format!("{what} has no buffer view")),
+    };
+    if let Some(sparse) = a.sparse() {
+        // Core glTF 2.0 (gltf-transform writes it for morph animation):
+        // replace the listed elements.
+        let n = sparse.count();
+        if n == 0 || n > count {
+            return Err(format!(
+                "{what}: sparse count {n} (must be 1 to the accessor's {count})"
+            ));
+        }
+        let iv = sparse.indices();
+        let size = iv.index_type().size();
+        let raw = bytes_of(buffers, &iv.view(), iv.offset(), n * size).ok_or_else(|| {
+            format!(
+                "{what}: {n} sparse indices do not fit in buffer view {}",
+                iv.view().index()
+            )
+        })?;
+        let vv = sparse.values();
+        let values = decode(buffers, &vv.view(), vv.offset(), n, ty, dim, false, &what)?;
+        let mut previous = None;
+        for (i, b) in raw.chunks_exact(size).enumerate() {
+            let index = match size {
+                1 => usize::from(b[0]),
+                2 => usize::from(u16::from_le_bytes([b[0], b[1]])),
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+            };
+            if index >= count || previous.is_some_and(|p| index <= p) {
+                return Err(format!(
+                    "{what}: sparse index {i} is {index} (indices must increase and stay below {count})"
+                ));
+            }
+            previous = Some(index);
+            out[index * dim..(index + 1) * dim].copy_from_slice(&values[i * dim..(i + 1) * dim]);
+        }
     }
-    let bytes = &data[view.offset() + a.offset()..];
+    Ok(out)
+}
+
+/// Largest element count of a sparse accessor with no buffer view.
+const MAX_SPARSE_ELEMENTS: usize = 1 << 24;
+
+/// `len` bytes at `offset` in `view`, if they are there.
+fn bytes_of<'a>(
+    buffers: &'a [Vec<u8>],
+    view: &gltf::buffer::View,
+    offset: usize,
+    len: usize,
+) -> Option<&'a [u8]> {
+    let data = buffers.get(view.buffer().index())?;
+    let end = offset.checked_add(len)?;
+    let view_end = view.offset().checked_add(view.length())?;
+    (end <= view.length() && view_end <= data.len())
+        .then(|| &data[view.offset() + offset..view.offset() + end])
+}
+
+/// `count` elements of `dim` components of type `ty` (normalized integers
+/// converted as the glTF spec says) from `offset` in `view`, after checking
+/// that every byte exists. Sparse values are tightly packed (`strided`
+/// false).
+#[allow(clippy::too_many_arguments)]
+fn decode(
+    buffers: &[Vec<u8>],
+    view: &gltf::buffer::View,
+    offset: usize,
+    count: usize,
+    ty: DataType,
+    dim: usize,
+    strided: bool,
+    what: &str,
+) -> Result<Vec<f32>, String> {
+    let size = ty.size();
+    let elem = size * dim;
+    let stride = if strided {
+        view.stride().unwrap_or(elem)
+    } else {
+        elem
+    };
+    let span = (|| count.checked_sub(1)?.checked_mul(stride)?.checked_add(elem))();
+    let bytes = span
+        .filter(|_| stride >= elem)
+        .and_then(|len| bytes_of(buffers, view, offset, len))
+        .ok_or_else(|| {
+            format!(
+                "{what}: {count} elements of {elem} bytes (stride {stride}) from byte {offset} do not fit in buffer view {} ({} bytes) or its buffer",
+                view.index(),
+                view.length()
+            )
+        })?;
     let mut out = Vec::with_capacity(count * dim);
     for e in 0..count {
         for c in 0..dim {
@@ -453,15 +533,10 @@ fn read(buffers: &[Vec<u8>], a: &gltf::Accessor, dim: usize) -> Result<Vec<f32>,
                 DataType::U8 => f32::from(b[0]) / 255.0,
                 DataType::I16 => (f32::from(i16::from_le_bytes([b[0], b[1]])) / 32767.0).max(-1.0),
                 DataType::U16 => f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0,
-                DataType::U32 => {
-                    return Err(format!(
-                        "accessor {} is u32 (not allowed for animation)",
-                        a.index()
-                    ));
-                }
+                DataType::U32 => return Err(format!("{what} is u32 (not allowed for animation)")),
             };
             if !v.is_finite() {
-                return Err(format!("accessor {}: element {e} is not finite", a.index()));
+                return Err(format!("{what}: element {e} is not finite"));
             }
             out.push(v);
         }

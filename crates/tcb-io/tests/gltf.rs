@@ -316,3 +316,61 @@ fn sign_changing_cubicspline_rotations_play_as_stored() {
     let short = Quat::from_rotation_z(15f32.to_radians());
     assert!(Quat::from_array(row).dot(short).abs() < 0.2, "{row:?}");
 }
+
+/// Sparse accessors (core glTF 2.0; gltf-transform writes them for morph
+/// animation): the listed elements replace the base, which is zeros when
+/// the accessor has no buffer view.
+#[test]
+fn sparse_accessors_import() {
+    let mut buf = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 7.0, 8.0, 9.0, 4.0, 5.0, 6.0]);
+    buf.extend_from_slice(&1u32.to_le_bytes());
+    let sparse = |index_offset: usize| {
+        format!(
+            r#""sparse": {{"count": 1, "indices": {{"bufferView": 0, "byteOffset": {index_offset}, "componentType": 5125}},
+                          "values": {{"bufferView": 0, "byteOffset": 32}}}}"#
+        )
+    };
+    let input = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]}"#;
+    let sample = |acc: String| -> Result<[f32; 3], String> {
+        let g =
+            import(gltf_with(&acc, &buf).as_bytes(), None, None, "t").map_err(|e| e.to_string())?;
+        let clip = g.doc.build().unwrap();
+        let mut row = [0.0f32; 3];
+        clip.sample_into(0.5, &mut row, None);
+        Ok(row)
+    };
+    // No base: key 0 is zero, key 1 is (4, 5, 6).
+    let no_base = format!(
+        r#"{input}, {{"componentType": 5126, "count": 2, "type": "VEC3", {}}}"#,
+        sparse(44)
+    );
+    assert_eq!(sample(no_base).unwrap(), [2.0, 2.5, 3.0]);
+    // A base of (1, 2, 3), (7, 8, 9) with element 1 replaced.
+    let with_base = format!(
+        r#"{input}, {{"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3", {}}}"#,
+        sparse(44)
+    );
+    assert_eq!(sample(with_base).unwrap(), [2.5, 3.5, 4.5]);
+    // An index beyond the accessor (the u32 at byte 40 is 6.0's bits) and
+    // indices past the view are errors that say so.
+    let bad = format!(
+        r#"{input}, {{"componentType": 5126, "count": 2, "type": "VEC3", {}}}"#,
+        sparse(40)
+    );
+    let err = sample(bad).unwrap_err();
+    assert!(err.contains("sparse index 0 is"), "{err}");
+    let outside = format!(
+        r#"{input}, {{"componentType": 5126, "count": 2, "type": "VEC3", {}}}"#,
+        sparse(46)
+    );
+    let err = sample(outside).unwrap_err();
+    assert!(err.contains("sparse indices do not fit"), "{err}");
+    // A view-less sparse accessor claiming 4 billion elements is refused
+    // before anything is allocated.
+    let huge = format!(
+        r#"{input}, {{"componentType": 5126, "count": 4000000000, "type": "VEC3", {}}}"#,
+        sparse(44)
+    );
+    let err = sample(huge).unwrap_err();
+    assert!(err.contains("no buffer view (at most 16777216)"), "{err}");
+}
