@@ -259,3 +259,54 @@ fn exported_cmu_squad_glb_gives_the_same_joint_positions() {
     let worst = cmu_worst(tcb_core::RotationMode::Squad, 1e-6);
     assert!(worst < 1e-5, "worst relative position difference {worst}");
 }
+
+/// The same check through three.js: with `TCB_THREEJS_POSITIONS` naming the
+/// `positions.json` that `tools/gltf/viewer/shoot.mjs` wrote for the GLB of
+/// `tcb export data/cmu-01_01.bvh` (squad, the default; `TCB_THREEJS_ROTATION=hermite`
+/// for an export of the hermite import), three.js's GLTFLoader and
+/// AnimationMixer put every joint where `SkeletonBinding` does, to 1e-5
+/// relative. Skipped without it: CI has no browser.
+#[test]
+fn threejs_positions_match_skeleton_binding() {
+    let Some(file) = std::env::var_os("TCB_THREEJS_POSITIONS") else {
+        eprintln!("skipped: set TCB_THREEJS_POSITIONS (see tools/gltf/viewer/README.md)");
+        return;
+    };
+    let mode = match std::env::var("TCB_THREEJS_ROTATION").as_deref() {
+        Ok("hermite") => tcb_core::RotationMode::Hermite,
+        _ => tcb_core::RotationMode::Squad,
+    };
+    let text = std::fs::read_to_string(&file).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    let options = tcb_io::ImportOptions {
+        rotation: mode,
+        ..Default::default()
+    };
+    let loaded = tcb_io::load_with(std::path::Path::new(path), &options).unwrap();
+    let skeleton = loaded.skeleton.clone().unwrap();
+    let clip = Arc::new(Clip::compile(&loaded.clip));
+    let binding = SkeletonBinding::new(skeleton.clone(), &clip);
+    let mut instance = Instance::new(clip, false);
+    let n = skeleton.joints.len();
+    let mut local = vec![Default::default(); n];
+    let mut model = vec![glam::Affine3A::IDENTITY; n];
+    let (mut worst, mut compared) = (0.0f64, 0);
+    for (t, joints) in doc.as_object().unwrap() {
+        binding.model_transforms(instance.sample(t.parse().unwrap()), &mut local, &mut model);
+        for (j, joint) in skeleton.joints.iter().enumerate() {
+            let p = &joints[joint.name.as_str()];
+            let theirs = DVec3::new(
+                p[0].as_f64().unwrap(),
+                p[1].as_f64().unwrap(),
+                p[2].as_f64().unwrap(),
+            );
+            let ours = DVec3::from(model[j].translation.to_array().map(f64::from));
+            worst = worst.max((ours - theirs).length() / theirs.length().max(1.0));
+            compared += 1;
+        }
+    }
+    eprintln!("three.js: {compared} joint positions, worst relative difference {worst:e}");
+    assert!(compared > 0);
+    assert!(worst < 1e-5, "worst relative difference {worst}");
+}
