@@ -310,7 +310,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
                     .is_some_and(|n| rows.iter().any(|r| r.name == n))
             });
         }
-        let (lines, held) = report::check(&rows, &saved, &here, args.max_regression);
+        let (lines, held) = report::check(&rows, &saved, &here, &timing, args.max_regression);
         println!("\nagainst {}:", path.display());
         for l in lines {
             println!("  {l}");

@@ -528,6 +528,7 @@ pub fn check(
     rows: &[Row],
     saved: &Value,
     here: &Fingerprint,
+    timing: &Timing,
     max_regression: f64,
 ) -> (Vec<String>, bool) {
     let mut lines = Vec::new();
@@ -538,6 +539,15 @@ pub fn check(
             false,
         );
     };
+    let now = to_json(&[], here, timing);
+    if let Some(then) = saved.get("timing")
+        && *then != now["timing"]
+    {
+        lines.push(format!(
+            "note: the saved report was timed differently ({then}; now {}): its ratios are less comparable",
+            now["timing"]
+        ));
+    }
     let theirs = saved.get("fingerprint").and_then(Fingerprint::from_json);
     let same = match &theirs {
         Some(f) => {
@@ -642,19 +652,40 @@ mod tests {
     fn check_flags_a_fall_beyond_the_allowance_only() {
         let here = Fingerprint::here();
         let file = saved(&[row("wide", 100.0), row("sparse", 4.0)], &here);
-        let (_, ok) = check(&[row("wide", 91.0), row("sparse", 4.5)], &file, &here, 10.0);
+        let (_, ok) = check(
+            &[row("wide", 91.0), row("sparse", 4.5)],
+            &file,
+            &here,
+            &Timing::FULL,
+            10.0,
+        );
         assert!(ok);
-        let (lines, ok) = check(&[row("wide", 89.0), row("sparse", 4.5)], &file, &here, 10.0);
+        let (lines, ok) = check(
+            &[row("wide", 89.0), row("sparse", 4.5)],
+            &file,
+            &here,
+            &Timing::FULL,
+            10.0,
+        );
         assert!(!ok);
         assert!(
             lines[0].starts_with("REGRESSION wide speedup_vs_baseline"),
             "{lines:?}"
         );
         // A scenario that disappeared is a failure too.
-        let (_, ok) = check(&[row("wide", 100.0)], &file, &here, 10.0);
+        let (_, ok) = check(&[row("wide", 100.0)], &file, &here, &Timing::FULL, 10.0);
         assert!(!ok);
-        let (_, ok) = check(&[], &serde_json::json!({}), &here, 10.0);
+        let (_, ok) = check(&[], &serde_json::json!({}), &here, &Timing::FULL, 10.0);
         assert!(!ok);
+        // A --quick run against a full one says so.
+        let (lines, _) = check(
+            &[row("wide", 100.0), row("sparse", 4.0)],
+            &file,
+            &here,
+            &Timing::QUICK,
+            10.0,
+        );
+        assert!(lines[0].contains("timed differently"), "{lines:?}");
     }
 
     #[test]
@@ -666,7 +697,7 @@ mod tests {
         };
         let file = saved(&[row("wide", 300.0)], &there);
         // A ratio 6x off is information, not a regression, across machines.
-        let (lines, ok) = check(&[row("wide", 50.0)], &file, &here, 10.0);
+        let (lines, ok) = check(&[row("wide", 50.0)], &file, &here, &Timing::FULL, 10.0);
         assert!(ok, "{lines:?}");
         assert!(
             lines[0].starts_with("note: saved on another machine"),
@@ -681,12 +712,12 @@ mod tests {
         // Bytes still fail.
         let mut bigger = row("wide", 300.0);
         bigger.bytes = 1001;
-        let (_, ok) = check(&[bigger], &file, &here, 10.0);
+        let (_, ok) = check(&[bigger], &file, &here, &Timing::FULL, 10.0);
         assert!(!ok);
         // A file without a fingerprint is treated the same way.
         let mut old = file.clone();
         old.as_object_mut().unwrap().remove("fingerprint");
-        let (lines, ok) = check(&[row("wide", 50.0)], &old, &here, 10.0);
+        let (lines, ok) = check(&[row("wide", 50.0)], &old, &here, &Timing::FULL, 10.0);
         assert!(
             ok && lines[0].contains("no machine fingerprint"),
             "{lines:?}"
