@@ -52,6 +52,62 @@ enum Command {
     Info(InfoArgs),
     /// Time the runtime on a clip: ns per joint and per channel, bytes, flags.
     Bench(BenchArgs),
+    /// Draw tracks as an SVG: values, velocity, speed or the 2D path.
+    Plot(PlotArgs),
+    /// Write the figures of docs/figures/ (the paper's, redrawn) to a directory.
+    Figures(FiguresArgs),
+}
+
+#[derive(Args)]
+struct PlotArgs {
+    /// The clip: clip JSON, BVH, glTF or GLB.
+    clip: PathBuf,
+    /// The SVG to write.
+    #[arg(short, long, value_name = "OUT.svg")]
+    output: PathBuf,
+    /// A track to draw (repeatable; default: every track if they have at
+    /// most 16 channels, else the first).
+    #[arg(long, value_name = "NAME")]
+    track: Vec<String>,
+    /// Start of the time range, seconds (default: 15% of the keys' span
+    /// before the first key; the first key with --path).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// End of the time range, seconds.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    to: Option<f64>,
+    /// d/dt of each channel.
+    #[arg(long, conflicts_with_all = ["speed", "path", "components"])]
+    velocity: bool,
+    /// The length of the velocity (rotations: angular speed, degrees/s).
+    #[arg(long, conflicts_with_all = ["path", "components"])]
+    speed: bool,
+    /// The 2D path of vector tracks, with keys, tangent handles and inbetweens.
+    #[arg(long)]
+    path: bool,
+    /// Rotations: the 4 components instead of angle and axis; with --path,
+    /// the two components to draw (default x,y).
+    #[arg(long, value_name = "x,y", num_args = 0..=1, default_missing_value = "")]
+    components: Option<String>,
+    /// Inbetween dots per segment at equal time steps (default 8 with --path).
+    #[arg(long, value_name = "N")]
+    inbetweens: Option<usize>,
+    /// BVH: rotation mode of its rotation tracks, as `tcb import`.
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF: the animation, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
+}
+
+#[derive(Args)]
+struct FiguresArgs {
+    /// The directory to write the SVGs to (created if missing).
+    #[arg(short, long, value_name = "DIR")]
+    output: PathBuf,
+    /// The repository holding examples/clips/ (default: the current directory).
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    root: PathBuf,
 }
 
 #[derive(Args)]
@@ -209,6 +265,8 @@ fn main() -> ExitCode {
         Command::Reduce(args) => reduce(&args),
         Command::Info(args) => info(&args),
         Command::Bench(args) => bench(&args),
+        Command::Plot(args) => plot(&args),
+        Command::Figures(args) => figures(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -608,6 +666,84 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
     }
     writeln!(out, "bytes: {} compiled", mb(row.bytes))?;
     io::stdout().lock().write_all(out.as_bytes())?;
+    Ok(())
+}
+
+fn plot(args: &PlotArgs) -> Result<(), BoxError> {
+    if extension(&args.output) != "svg" {
+        return Err(format!("{}: the output must end in .svg", args.output.display()).into());
+    }
+    if let (Some(a), Some(b)) = (args.from, args.to)
+        && a.partial_cmp(&b) != Some(std::cmp::Ordering::Less)
+    {
+        return Err(format!("--from {a} --to {b}: the time range is empty").into());
+    }
+    for (name, v) in [("--from", args.from), ("--to", args.to)] {
+        if v.is_some_and(|v| !v.is_finite()) {
+            return Err(format!("{name} must be a finite number of seconds").into());
+        }
+    }
+    if args.inbetweens.is_some_and(|n| n > 1000) {
+        return Err("--inbetweens must be at most 1000".into());
+    }
+    let mode = if args.path {
+        let components = match args.components.as_deref() {
+            None | Some("") => [0, 1],
+            Some(c) => tcb_plot::parse_components(c)?,
+        };
+        tcb_plot::Mode::Path { components }
+    } else if args.velocity {
+        tcb_plot::Mode::Velocity
+    } else if args.speed {
+        tcb_plot::Mode::Speed
+    } else if args.components.is_some() {
+        tcb_plot::Mode::Components
+    } else {
+        tcb_plot::Mode::Value
+    };
+    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
+    let loaded = tcb_io::load_with(&args.clip, &options)?;
+    warn(&loaded.warnings);
+    let file = args.clip.file_name().map_or_else(
+        || args.clip.display().to_string(),
+        |f| f.to_string_lossy().into_owned(),
+    );
+    if args.track.is_empty() && loaded.clip.channel_count() > 16 {
+        eprintln!(
+            "tcb: plotting '{}' ({} tracks; choose others with --track)",
+            loaded.clip.tracks[0].name,
+            loaded.clip.tracks.len()
+        );
+    }
+    let plot = tcb_plot::Plot {
+        tracks: args.track.clone(),
+        from: args.from,
+        to: args.to,
+        mode,
+        inbetweens: args.inbetweens,
+        ..tcb_plot::Plot::new(file)
+    };
+    let svg = tcb_plot::render(&loaded.clip, &plot)?;
+    tcb_io::write_atomically(&args.output, svg.as_bytes())?;
+    eprintln!("tcb: wrote {}", args.output.display());
+    Ok(())
+}
+
+fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
+    std::fs::create_dir_all(&args.output).map_err(|e| format!("{}: {e}", args.output.display()))?;
+    // Draw them all before writing any.
+    let all = tcb_plot::figures()
+        .into_iter()
+        .map(|f| Ok((f.name, f.render(&args.root)?)))
+        .collect::<Result<Vec<_>, tcb_plot::PlotError>>()?;
+    for (name, svg) in &all {
+        tcb_io::write_atomically(&args.output.join(name), svg.as_bytes())?;
+    }
+    eprintln!(
+        "tcb: wrote {} figures to {}",
+        all.len(),
+        args.output.display()
+    );
     Ok(())
 }
 

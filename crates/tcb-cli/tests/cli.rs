@@ -659,3 +659,96 @@ fn export_renames_tracks_and_prints_one_summary_line() {
     }
     assert!(!dir.join("never2.glb").exists());
 }
+
+#[test]
+fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
+    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let out = dir.join("plot.svg");
+    let mut inputs: Vec<String> = std::fs::read_dir(examples())
+        .unwrap()
+        .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+        .filter(|p| p.ends_with(".json"))
+        .collect();
+    inputs.sort();
+    inputs.push(data("cmu-01_01.bvh"));
+    inputs.push(data("simple_skin.gltf"));
+    for input in &inputs {
+        for extra in [&[][..], &["--velocity"], &["--speed"]] {
+            let _ = std::fs::remove_file(&out);
+            let mut args = vec!["plot", input.as_str(), "-o", out.to_str().unwrap()];
+            args.extend_from_slice(extra);
+            // Rotations and vectors are drawn apart: plot each kind alone.
+            let o = tcb(&args);
+            let err = stderr(&o);
+            if !o.status.success() {
+                assert!(err.contains("separately"), "{input} {extra:?}: {err}");
+                continue;
+            }
+            let svg = std::fs::read_to_string(&out).unwrap();
+            assert!(
+                svg.starts_with("<svg") && svg.contains("time (s)"),
+                "{input}"
+            );
+        }
+    }
+    let o = tcb(&[
+        "plot",
+        &example("careen.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--path",
+        "--inbetweens",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb(&[
+        "plot",
+        &example("spin.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--track",
+        "top.squad",
+        "--components",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let never = dir.join("never.svg");
+    for (args, message) in [
+        (
+            vec!["--track", "ball.nope"],
+            "no track 'ball.nope' (the clip has: ball.position",
+        ),
+        (
+            vec!["--from", "2", "--to", "1"],
+            "--from 2 --to 1: the time range is empty",
+        ),
+        (
+            vec!["--track", "ball.squash", "--path"],
+            "'ball.squash' is scalar",
+        ),
+        (
+            vec!["--path", "--components", "x,q"],
+            "--components x,q: two different components",
+        ),
+    ] {
+        let bounce = example("bounce.json");
+        let mut all = vec!["plot", bounce.as_str(), "-o", never.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let o = tcb(&all);
+        assert!(!o.status.success(), "{args:?}");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+        assert!(!never.exists());
+    }
+    let o = tcb(&[
+        "plot",
+        &example("bounce.json"),
+        "-o",
+        dir.join("x.png").to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&o).contains("the output must end in .svg"),
+        "{}",
+        stderr(&o)
+    );
+}
