@@ -1,5 +1,5 @@
 //! `tcb sample` against values computed independently of this code base:
-//! `tools/check/tcbref.py`, a plain-Python reading of `spec/math.md`, wrote
+//! `tools/check/tcbref.py`, a plain-Python reading of `docs/math.md`, wrote
 //! `tools/check/golden/*.csv` (regenerate with
 //! `python3 tools/check/check.py --write-golden`). Tolerance 1e-5 relative
 //! (absolute below 1); quaternions up to sign.

@@ -1,4 +1,4 @@
-//! `tcb reduce` as a user runs it (`spec/reduce.md`): the summary line, a
+//! `tcb reduce` as a user runs it (`docs/reduce.md`): the summary line, a
 //! result the other commands accept, and bad input that writes nothing.
 
 use std::path::{Path, PathBuf};

@@ -6,7 +6,7 @@
 //! conditions, ease, extrapolation and rotations, with a scalar reference
 //! spline that the SIMD runtime is checked against.
 //!
-//! The mathematics follows the project's contract (`spec/math.md`) exactly;
+//! The mathematics follows the project's contract (`docs/math.md`) exactly;
 //! each module's documentation carries its formulas:
 //!
 //! | module | what |

@@ -1,5 +1,5 @@
 //! Fitting cubic Hermite keys to dense samples within a tolerance at every
-//! sample (the check times of `spec/reduce.md`).
+//! sample (the check times of `docs/reduce.md`).
 //!
 //! For fixed key times the curve is linear in its unknowns, so the best
 //! curve in the least-squares sense is one banded solve ([`crate::band`]).

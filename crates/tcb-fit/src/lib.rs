@@ -1,6 +1,6 @@
 //! # tcb-fit
 //!
-//! Key reduction (`tcb reduce`, the project's `spec/reduce.md`): dense
+//! Key reduction (`tcb reduce`, the project's `docs/reduce.md`): dense
 //! animation, such as motion capture with a key per frame, replaced by far
 //! fewer cubic Hermite keys that stay within a stated error of the original
 //! at every check time.

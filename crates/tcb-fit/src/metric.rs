@@ -1,4 +1,4 @@
-//! What `spec/reduce.md` compares: the check times, clips as `tcb sample`
+//! What `docs/reduce.md` compares: the check times, clips as `tcb sample`
 //! plays them (the runtime), and the `shell` and `value` errors.
 //!
 //! ```text
@@ -82,7 +82,7 @@ pub struct Measured {
     pub each: Vec<f64>,
 }
 
-/// The rest-pose height H of `spec/reduce.md`: the largest distance of any
+/// The rest-pose height H of `docs/reduce.md`: the largest distance of any
 /// joint from the (first) root in the rest pose.
 pub fn rest_height(skeleton: &Skeleton) -> f64 {
     let local: Vec<Transform> = skeleton.joints.iter().map(|j| j.rest).collect();

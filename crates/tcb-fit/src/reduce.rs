@@ -1,4 +1,4 @@
-//! The whole reduction (`tcb reduce`, `spec/reduce.md`).
+//! The whole reduction (`tcb reduce`, `docs/reduce.md`).
 //!
 //! 1. Play the input on the runtime at the check times (the reference).
 //! 2. Give every track a tolerance of its own in its own units, such that

@@ -1,5 +1,5 @@
 //! `tcb reduce` on the bundled CMU clip, checked by a metric written here
-//! from `spec/reduce.md` alone: its own BVH hierarchy reader, its own check
+//! from `docs/reduce.md` alone: its own BVH hierarchy reader, its own check
 //! times, and its own forward kinematics in f64. Only the playing of the
 //! clips (the runtime, as `tcb sample` plays them) is shared with the fitter.
 

@@ -1,4 +1,4 @@
-//! The clip file, format `tcb-clip/1` (the project's `spec/clip-format.md`).
+//! The clip file, format `tcb-clip/1` (the project's `docs/clip-format.md`).
 //!
 //! [`ClipDoc`] is the file as written: every optional field stays optional,
 //! so a clip read and written again says no more than it said. [`ClipDoc::build`]

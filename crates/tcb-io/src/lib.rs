@@ -1,6 +1,6 @@
 //! # tcb-io
 //!
-//! The clip file (`tcb-clip/1` JSON, the project's `spec/clip-format.md`):
+//! The clip file (`tcb-clip/1` JSON, the project's `docs/clip-format.md`):
 //! parsing with errors that name the file, the track and the key, building
 //! validated [`tcb_core::Clip`]s, and writing clips without leaving
 //! half-written files.
@@ -118,7 +118,10 @@ pub struct Loaded {
 /// `.glb`), by extension, with default [`ImportOptions`].
 ///
 /// ```
-/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// # /*
+/// let path = "data/cmu-01_01.bvh"; // from the repository's root
+/// # */
 /// let loaded = tcb_io::load(path.as_ref())?;
 /// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31 + 7); // joints and End Sites
 /// assert_eq!(loaded.clip.tracks[0].name, "Hips.translation");

@@ -614,7 +614,10 @@ impl Clip {
     /// [`compile`](Self::compile) with options (quantization).
     ///
     /// ```
-    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    /// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    /// # /*
+    /// let path = "data/cmu-01_01.bvh"; // from the repository's root
+    /// # */
     /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
     /// let plain = tcb_runtime::Clip::compile(&source);
     /// let options = tcb_runtime::CompileOptions { quantize: true };

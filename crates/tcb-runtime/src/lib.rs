@@ -7,7 +7,11 @@
 //! use tcb_runtime::{Clip, Instance, blend};
 //!
 //! // Load once: validate, compile to structure-of-arrays, share by Arc.
-//! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/clips/bounce.json")).unwrap();
+//! # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/clips/bounce.json");
+//! # /*
+//! let path = "examples/clips/bounce.json"; // from the repository's root
+//! # */
+//! let text = std::fs::read_to_string(path).unwrap();
 //! let clip = Arc::new(Clip::compile(&tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()));
 //! let ball = clip.track("ball.position").unwrap();
 //!

@@ -16,7 +16,10 @@
 //! ```
 //! use std::sync::Arc;
 //! use tcb_runtime::{Clip, Instance, Rig, blend};
-//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+//! # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+//! # /*
+//! let path = "data/cmu-01_01.bvh"; // from the repository's root
+//! # */
 //! let loaded = tcb_io::load(path.as_ref()).unwrap();
 //! let rig = Arc::new(Rig::from_skeleton(loaded.skeleton.as_ref().unwrap()).unwrap());
 //! let clip = Arc::new(Clip::compile(&loaded.clip));

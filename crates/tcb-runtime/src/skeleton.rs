@@ -13,7 +13,10 @@ use tcb_core::skeleton::{Skeleton, Transform};
 ///
 /// ```
 /// use std::sync::Arc;
-/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// # /*
+/// let path = "data/cmu-01_01.bvh"; // from the repository's root
+/// # */
 /// let loaded = tcb_io::load(path.as_ref()).unwrap();
 /// let clip = Arc::new(tcb_runtime::Clip::compile(&loaded.clip));
 /// let binding = tcb_runtime::SkeletonBinding::new(loaded.skeleton.unwrap(), &clip);

@@ -1,0 +1,30 @@
+//! Key reduction: fit the bundled motion capture with far fewer keys within
+//! the default model-space tolerance, and print what it saves.
+//!
+//! ```text
+//! cargo run --release --example reduce
+//! ```
+
+const CMU: &str = include_str!("../data/cmu-01_01.bvh");
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let bvh = tcb_io::bvh::Bvh::parse(CMU)?;
+    let doc = bvh.to_clip_doc("cmu", tcb_core::RotationMode::Hermite)?;
+    let clip = doc.build()?;
+    let input = tcb_fit::reduce::Input {
+        doc: &doc,
+        clip: &clip,
+        skeleton: Some(&bvh.skeleton),
+    };
+    let reduced = tcb_fit::reduce(input, &Default::default(), &|_, _| {})?;
+    println!("{}", reduced.summary_line());
+    println!(
+        "compiled runtime clip: {} -> {} bytes ({:.2}x smaller), keys {} -> {}",
+        reduced.before.bytes,
+        reduced.after.bytes,
+        reduced.before.bytes as f64 / reduced.after.bytes as f64,
+        reduced.before.keys,
+        reduced.after.keys
+    );
+    Ok(())
+}
