@@ -36,6 +36,26 @@ const MAX_SAMPLES: u64 = 100_000_000;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// glTF: let buffer URIs name files outside the .gltf's folder (absolute
+    /// paths, '..', symbolic links out of it). Only for a trusted asset tree.
+    #[arg(long, global = true)]
+    allow_outside_paths: bool,
+}
+
+/// `--allow-outside-paths`, read by every command that imports.
+static ALLOW_OUTSIDE_PATHS: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// [`tcb_io::load`] with `--allow-outside-paths`.
+fn load(path: &std::path::Path) -> Result<tcb_io::Loaded, tcb_io::Error> {
+    tcb_io::load_with(path, &import_options_plain())
+}
+
+fn import_options_plain() -> tcb_io::ImportOptions {
+    tcb_io::ImportOptions {
+        allow_outside_paths: ALLOW_OUTSIDE_PATHS.load(std::sync::atomic::Ordering::Relaxed),
+        ..Default::default()
+    }
 }
 
 #[derive(Subcommand)]
@@ -258,6 +278,10 @@ struct SampleArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    ALLOW_OUTSIDE_PATHS.store(
+        cli.allow_outside_paths,
+        std::sync::atomic::Ordering::Relaxed,
+    );
     let result = match cli.command {
         Command::Sample(args) => sample(&args),
         Command::Import(args) => import(&args),
@@ -322,7 +346,7 @@ fn import_options(
     Ok(tcb_io::ImportOptions {
         rotation: rotation.unwrap_or_default(),
         animation: animation.cloned(),
-        ..Default::default()
+        ..import_options_plain()
     })
 }
 
@@ -374,7 +398,7 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
                 .ok_or_else(|| format!("--rename {r}: expected FROM=TO"))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let loaded = tcb_io::load(&args.clip)?;
+    let loaded = load(&args.clip)?;
     warn(&loaded.warnings);
     let options = tcb_io::gltf_export::ExportOptions {
         max_error: args.max_error,
@@ -748,7 +772,7 @@ fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
 }
 
 fn sample(args: &SampleArgs) -> Result<(), BoxError> {
-    let loaded = tcb_io::load(&args.clip)?;
+    let loaded = load(&args.clip)?;
     warn(&loaded.warnings);
     let clip = loaded.clip;
     let times = sample_times(args, &clip)?;

@@ -752,3 +752,47 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
         stderr(&o)
     );
 }
+
+#[test]
+fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
+    let dir = temp_clip("x", "").parent().unwrap().join("outside-test");
+    let asset = dir.join("asset");
+    std::fs::create_dir_all(&asset).unwrap();
+    let times_and_values: Vec<u8> = [0.0f32, 1.0, 0.0, 1.0]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    std::fs::write(dir.join("data.bin"), &times_and_values).unwrap();
+    let gltf = r#"{"asset": {"version": "2.0"}, "nodes": [{"name": "a"}],
+      "buffers": [{"byteLength": 16, "uri": "../data.bin"}],
+      "bufferViews": [{"buffer": 0, "byteLength": 16}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                    {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "SCALAR"}],
+      "animations": [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}],
+                      "samplers": [{"input": 0, "output": 1}]}]}"#;
+    let file = asset.join("up.gltf");
+    std::fs::write(&file, gltf).unwrap();
+    let out = dir.join("up.json");
+    let o = tcb(&[
+        "import",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("buffer 0 ('../data.bin'): is outside the glTF file's folder (allow it with --allow-outside-paths"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = tcb(&[
+        "import",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--allow-outside-paths",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+}

@@ -95,6 +95,23 @@ pub fn import(
     animation: Option<&str>,
     name: &str,
 ) -> Result<GltfImport, Error> {
+    let options = crate::ImportOptions {
+        animation: animation.map(str::to_string),
+        ..Default::default()
+    };
+    import_with(bytes, base, name, &options)
+}
+
+/// [`import`] with the animation, the file size limit and the buffer URI
+/// policy of `options`: a buffer URI is a `data:` URI or a relative path
+/// that stays inside `base`, unless `options.allow_outside_paths`.
+pub fn import_with(
+    bytes: &[u8],
+    base: Option<&Path>,
+    name: &str,
+    options: &crate::ImportOptions,
+) -> Result<GltfImport, Error> {
+    let animation = options.animation.as_deref();
     let invalid =
         |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(&e))?;
@@ -104,7 +121,7 @@ pub fn import(
         document: gltf::Document::from_json(json).map_err(|e| invalid(&e))?,
         blob: unchecked.blob,
     };
-    let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base)?;
+    let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base, options)?;
     let mut warnings = Vec::new();
     let names = node_names(&gltf.document, &mut warnings);
     let skeleton = skeleton(&gltf.document, &names);
@@ -338,6 +355,7 @@ fn load_buffers(
     doc: &Document,
     blob: Option<&[u8]>,
     base: Option<&Path>,
+    options: &crate::ImportOptions,
 ) -> Result<Vec<Vec<u8>>, Error> {
     doc.buffers()
         .map(|b| {
@@ -368,8 +386,8 @@ fn load_buffers(
                                 "buffer {i}: external file '{uri}' but no directory to find it in"
                             ))
                         })?;
-                        let path = base.join(percent_decode(uri));
-                        crate::read_limited(&path, crate::DEFAULT_MAX_FILE_BYTES)?
+                        read_buffer(base, uri, b.length(), options)
+                            .map_err(|m| Error::import(format!("buffer {i} ('{uri}'): {m}")))?
                     }
                 }
             };
@@ -383,6 +401,72 @@ fn load_buffers(
             Ok(data)
         })
         .collect()
+}
+
+/// The bytes of an external buffer: `uri` (percent-decoded) relative to
+/// `base`, refused when it leaves `base` (an absolute path, `..`, a
+/// symbolic link out of it) unless `options.allow_outside_paths`, or when it
+/// is not a regular file; its size is checked against `byte_length` before
+/// anything is allocated, and only `byte_length` bytes are read.
+fn read_buffer(
+    base: &Path,
+    uri: &str,
+    byte_length: usize,
+    options: &crate::ImportOptions,
+) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    use std::path::Component;
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
+    let decoded = percent_decode(uri);
+    let relative = Path::new(&decoded);
+    let outside = "is outside the glTF file's folder (allow it with --allow-outside-paths for a trusted asset tree)";
+    let climbs = relative.components().any(|c| {
+        matches!(
+            c,
+            Component::ParentDir | Component::RootDir | Component::Prefix(_)
+        )
+    });
+    if !options.allow_outside_paths && (climbs || relative.is_absolute() || decoded.contains('\\'))
+    {
+        return Err(outside.into());
+    }
+    let path = base.join(relative);
+    let meta = std::fs::metadata(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if !options.allow_outside_paths {
+        // Through symbolic links too: the real file must be under the real folder.
+        let real = std::fs::canonicalize(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let folder = std::fs::canonicalize(base).map_err(|e| format!("{}: {e}", base.display()))?;
+        if !real.starts_with(&folder) {
+            return Err(format!("{outside}: it resolves to {}", real.display()));
+        }
+    }
+    if !meta.is_file() {
+        return Err(format!("{} is not a regular file", path.display()));
+    }
+    let want = byte_length as u64;
+    if want > options.max_file_bytes {
+        return Err(format!(
+            "byteLength {want} is above the {} bytes allowed (ImportOptions::max_file_bytes)",
+            options.max_file_bytes
+        ));
+    }
+    if meta.len() < want {
+        return Err(format!(
+            "{} has {} bytes but the buffer's byteLength is {want}",
+            path.display(),
+            meta.len()
+        ));
+    }
+    let file = std::fs::File::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut bytes = Vec::with_capacity(byte_length);
+    file.take(want)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(bytes)
 }
 
 /// Read accessor `a` as f32 rows of `dim` components (normalized integers

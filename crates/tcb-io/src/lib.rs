@@ -53,6 +53,10 @@ pub struct ImportOptions {
     pub animation: Option<String>,
     /// Largest file read, in bytes (default [`DEFAULT_MAX_FILE_BYTES`]).
     pub max_file_bytes: u64,
+    /// glTF: let buffer URIs name files outside the `.gltf`'s folder
+    /// (absolute paths, `..`, symbolic links out of it); default `false`,
+    /// for a trusted asset tree only (`--allow-outside-paths`).
+    pub allow_outside_paths: bool,
 }
 
 impl Default for ImportOptions {
@@ -61,6 +65,7 @@ impl Default for ImportOptions {
             rotation: RotationMode::default(),
             animation: None,
             max_file_bytes: DEFAULT_MAX_FILE_BYTES,
+            allow_outside_paths: false,
         }
     }
 }
@@ -157,7 +162,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         "gltf" | "glb" => {
             let bytes = read_limited(path, options.max_file_bytes)?;
             let base = path.parent().unwrap_or(Path::new("."));
-            let g = gltf_import::import(&bytes, Some(base), options.animation.as_deref(), &stem)
+            let g = gltf_import::import_with(&bytes, Some(base), &stem, options)
                 .map_err(|e| e.in_file(path))?;
             (g.doc, g.warnings)
         }
@@ -175,6 +180,11 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
         }
     };
     let clip = doc.build().map_err(|e| e.in_file(path))?;
+    // Warnings name the file, like errors.
+    let warnings = warnings
+        .into_iter()
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
     Ok(Loaded {
         skeleton: doc.skeleton.clone(),
         doc,

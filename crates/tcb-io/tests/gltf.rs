@@ -374,3 +374,77 @@ fn sparse_accessors_import() {
     let err = sample(huge).unwrap_err();
     assert!(err.contains("no buffer view (at most 16777216)"), "{err}");
 }
+
+/// Buffer URIs stay inside the asset's folder (clip-format.md): `..`, an
+/// absolute path and a symbolic link out of it are refused unless allowed,
+/// as is anything but a regular file; a missing or short file is named.
+#[test]
+fn buffer_uris_stay_inside_the_assets_folder() {
+    let root = std::env::temp_dir().join(format!("tcb-uri-test-{}", std::process::id()));
+    let asset = root.join("asset");
+    std::fs::create_dir_all(&asset).unwrap();
+    let data = floats(&[0.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    std::fs::write(root.join("outside.bin"), &data).unwrap();
+    std::fs::write(asset.join("inside.bin"), &data).unwrap();
+    std::fs::write(asset.join("short.bin"), &data[..5]).unwrap();
+    let acc = r#"{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                 {"bufferView": 0, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"}"#;
+    let with_uri = |uri: &str| {
+        let text = gltf_with(acc, &data);
+        let at = text.find("data:").unwrap();
+        let end = at + text[at..].find('"').unwrap();
+        format!("{}{uri}{}", &text[..at], &text[end..])
+    };
+    let load = |name: &str, uri: &str, allow: bool| {
+        let path = asset.join(name);
+        std::fs::write(&path, with_uri(uri)).unwrap();
+        let options = tcb_io::ImportOptions {
+            allow_outside_paths: allow,
+            ..Default::default()
+        };
+        tcb_io::load_with(&path, &options)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    load("inside.gltf", "inside.bin", false).unwrap();
+    let outside = root.join("outside.bin");
+    for (name, uri) in [
+        ("up.gltf", "../outside.bin".to_string()),
+        ("abs.gltf", outside.to_string_lossy().into_owned()),
+    ] {
+        let e = load(name, &uri, false).unwrap_err();
+        assert!(
+            e.contains(&format!(
+                "buffer 0 ('{uri}'): is outside the glTF file's folder"
+            )),
+            "{e}"
+        );
+        load(name, &uri, true).unwrap();
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&outside, asset.join("link.bin")).unwrap();
+        let e = load("link.gltf", "link.bin", false).unwrap_err();
+        assert!(e.contains("is outside the glTF file's folder"), "{e}");
+        assert!(e.contains("it resolves to"), "{e}");
+        if std::process::Command::new("mkfifo")
+            .arg(asset.join("fifo.bin"))
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            let e = load("fifo.gltf", "fifo.bin", false).unwrap_err();
+            assert!(e.contains("fifo.bin is not a regular file"), "{e}");
+        }
+    }
+    let e = load("short.gltf", "short.bin", false).unwrap_err();
+    assert!(
+        e.contains("short.bin has 5 bytes but the buffer's byteLength is 32"),
+        "{e}"
+    );
+    let e = load("missing.gltf", "missing.bin", false).unwrap_err();
+    assert!(
+        e.contains("buffer 0 ('missing.bin'):") && e.contains("missing.bin: No such file"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
