@@ -298,7 +298,7 @@ pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
     file_with(path, &FileOptions::default())
 }
 
-/// [`file`] with a frame rate, instance count and import options. With
+/// [`file()`] with a frame rate, instance count and import options. With
 /// several instances, each plays from its own random phase within the clip,
 /// one second (or the whole clip, if shorter) per pass.
 pub fn file_with(path: &Path, options: &FileOptions) -> Result<Scenario, tcb_io::Error> {

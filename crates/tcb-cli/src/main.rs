@@ -228,7 +228,7 @@ struct ExportArgs {
     #[arg(long, value_name = "E", default_value_t = 1e-5)]
     max_error: f64,
     /// Export track FROM under the name TO (glTF animates only
-    /// <node>.translation, .rotation, .scale and .weights.<i>); repeatable.
+    /// `<node>.translation`, `.rotation`, `.scale` and `.weights.<i>`); repeatable.
     #[arg(long, value_name = "FROM=TO")]
     rename: Vec<String>,
 }

@@ -2,7 +2,7 @@
 //! sample (the check times of `docs/reduce.md`).
 //!
 //! For fixed key times the curve is linear in its unknowns, so the best
-//! curve in the least-squares sense is one banded solve ([`crate::band`]).
+//! curve in the least-squares sense is one banded solve (`band.rs`).
 //! Keys are chosen by *greedy insertion*: start from the two end keys, fit,
 //! and split every span where some sample is out of tolerance at its worst
 //! sample within the span's middle half; repeat until every sample is

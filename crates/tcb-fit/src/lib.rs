@@ -9,7 +9,7 @@
 //! |---|---|
 //! | [`fit`] | least-squares Hermite fits with greedy key insertion and removal |
 //! | [`metric`] | check times, playing clips on the runtime, the `shell` and `value` errors |
-//! | [`reduce`] | the whole job: tolerances per track, knot sharing, verification, the written clip |
+//! | [`mod@reduce`] | the whole job: tolerances per track, knot sharing, verification, the written clip |
 //!
 //! ```
 //! // A dense track: one key per frame of a smooth motion, 120 fps for 2 s.

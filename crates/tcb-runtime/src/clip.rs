@@ -1,8 +1,8 @@
 //! Compiling validated tcb-core clips into the runtime layout.
 //!
 //! Tracks are grouped by identical key times, segment eases and `pre`/`post`
-//! modes; a group's channels share one [`FrameBasis`](crate::grid::FrameBasis)
-//! per frame. Per group, per stored segment (see [`crate::grid`]), per block
+//! modes; a group's channels share one `grid::FrameBasis`
+//! per frame. Per group, per stored segment (see `grid.rs`), per block
 //! of 8 channels, the Hermite controls are stored lane-contiguous as
 //! `wide::f32x8` (32-byte aligned, zero-padded):
 //!
@@ -17,7 +17,7 @@
 //! rotation mode compiles to the same cubic form: `hermite` curves as they
 //! are, squad and slerp segments as the cubic through their ends with
 //! their end derivatives, checked against the f64 formula when the clip is
-//! compiled (see [`rotation_controls`]); the few segments where that cubic
+//! compiled (see `rotation_controls`); the few segments where that cubic
 //! would miss (large turns between keys) are evaluated exactly, lane by
 //! lane under a mask, from [`tcb_core::squad`] in `f64x4`. Nothing falls
 //! back to the scalar reference.

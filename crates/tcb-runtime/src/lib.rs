@@ -33,7 +33,7 @@
 //! }
 //! ```
 //!
-//! How it works: see [`clip`] (the layout), [`grid`] (the per-frame basis
+//! How it works: see [`clip`] (the layout), `grid.rs` (the per-frame basis
 //! and the sentinels that keep the kernels free of per-channel branches).
 
 #![forbid(unsafe_code)]

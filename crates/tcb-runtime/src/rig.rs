@@ -10,7 +10,7 @@
 //! usual and then copies each channel to the rig's lane (one precomputed
 //! index pair per component, no allocation). Tracks the clip lacks keep the
 //! rig's rest values. Every pose of a rig shares its layout, so poses of any
-//! clips of the rig blend ([`crate::blend`]), and a pose of another rig is
+//! clips of the rig blend ([`crate::blend()`]), and a pose of another rig is
 //! refused.
 //!
 //! ```
