@@ -18,14 +18,104 @@ use std::path::Path;
 use std::process::Command;
 use tcb_runtime::Instance;
 
-/// The scenarios counted: every one of [`crate::scenarios::NAMES`] but
-/// `character-reduced`, whose `tcb reduce` run takes over 15 minutes under
-/// valgrind (rayon is not counted either: `crowd` is its one-thread pass).
+/// Counted passes that are not timing scenarios: `blend` (cross-fading
+/// two poses of the CMU rig, the poses sampled before counting) and `batch`
+/// (`crowd` through `tcb_runtime::batch::sample_all`, in a one-thread rayon
+/// pool so that the count repeats).
+pub const EXTRA: [&str; 2] = ["blend", "batch"];
+
+/// The passes counted: every one of [`crate::scenarios::NAMES`] (the
+/// reduced character's clip is reduced by the parent process and handed to
+/// the counted one as a file: `tcb reduce` itself takes over 15 minutes
+/// under valgrind) and [`EXTRA`].
 pub fn names() -> Vec<&'static str> {
-    crate::scenarios::NAMES
-        .into_iter()
-        .filter(|n| *n != "character-reduced")
-        .collect()
+    crate::scenarios::NAMES.into_iter().chain(EXTRA).collect()
+}
+
+/// The function whose calls callgrind counts for pass `name`.
+pub fn toggle(name: &str) -> &'static str {
+    match name {
+        "blend" => "tcb_bench::icount::blend_frames",
+        "batch" => "tcb_bench::icount::batch_frames",
+        _ => "tcb_bench::icount::pass",
+    }
+}
+
+/// Blend `pairs` (cycled) into `out`, `frames` times: the `blend` pass.
+#[inline(never)]
+pub fn blend_frames(
+    pairs: &[(tcb_runtime::Pose, tcb_runtime::Pose)],
+    out: &mut tcb_runtime::Pose,
+    frames: usize,
+) {
+    for f in 0..frames {
+        let (a, b) = &pairs[f % pairs.len()];
+        let w = (f % 17) as f32 / 16.0;
+        tcb_runtime::blend(out, &[(a, 1.0 - w), (b, w)], None).expect("one rig");
+        black_box(&*out);
+    }
+}
+
+/// Every frame of `s` through `batch::sample_all`: the `batch` pass, run
+/// on the pool's one worker thread.
+#[inline(never)]
+pub fn batch_frames(s: &Scenario, instances: &mut [Instance]) {
+    let mut times = vec![0.0; instances.len()];
+    for &t in &s.times {
+        for (x, p) in times.iter_mut().zip(&s.phases) {
+            *x = t + p;
+        }
+        tcb_runtime::batch::sample_all(instances, &times);
+        black_box(&instances[0]);
+    }
+}
+
+/// Run the counted part of `blend` or `batch` once (under valgrind), and
+/// print the bytes of the clips involved.
+pub fn run_extra(name: &str, bvh: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    use std::sync::Arc;
+    match name {
+        "blend" => {
+            let load = |mode| {
+                let options = tcb_io::ImportOptions {
+                    rotation: mode,
+                    ..Default::default()
+                };
+                tcb_io::load_with(bvh, &options)
+            };
+            let a = load(tcb_core::RotationMode::Hermite)?;
+            let b = load(tcb_core::RotationMode::Squad)?;
+            let skeleton = a.skeleton.clone().ok_or("the BVH has no skeleton")?;
+            let rig = Arc::new(tcb_runtime::Rig::from_skeleton(&skeleton)?);
+            let (ca, cb) = (
+                Arc::new(tcb_runtime::Clip::compile(&a.clip)),
+                Arc::new(tcb_runtime::Clip::compile(&b.clip)),
+            );
+            println!("bytes: {}", ca.memory_bytes() + cb.memory_bytes());
+            let mut ia = Instance::with_rig(ca, &rig, false)?;
+            let mut ib = Instance::with_rig(cb, &rig, false)?;
+            let pairs: Vec<_> = (0..16)
+                .map(|i| {
+                    let t = f64::from(i) * 1.3;
+                    (ia.sample(t).clone(), ib.sample(t + 0.7).clone())
+                })
+                .collect();
+            let mut out = rig.rest_pose(false);
+            blend_frames(&pairs, &mut out, 1376);
+        }
+        _ => {
+            let s = crate::scenarios::crowd(bvh)?;
+            println!("bytes: {}", s.clip.memory_bytes());
+            let mut instances: Vec<Instance> = s
+                .phases
+                .iter()
+                .map(|_| Instance::new(s.clip.clone(), false))
+                .collect();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+            pool.install(|| batch_frames(&s, &mut instances));
+        }
+    }
+    Ok(())
 }
 
 /// One pass of a scenario's runtime (every time, every instance), the code
@@ -68,6 +158,7 @@ pub struct Counts {
 /// under callgrind, or with `clip` the pass over that file
 /// (`--icount-pass NAME --clip FILE`, as `--clip` times it).
 pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<Counts, String> {
+    let toggle = format!("--toggle-collect={}", toggle(name));
     let out = std::env::temp_dir().join(format!(
         "tcb-icount-{}-{name}.callgrind",
         std::process::id()
@@ -76,7 +167,7 @@ pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<
         .arg("--tool=callgrind")
         .arg("--cache-sim=yes")
         .arg(format!("--callgrind-out-file={}", out.display()))
-        .arg("--toggle-collect=tcb_bench::icount::pass")
+        .arg(&toggle)
         .arg(exe)
         .args(["--icount-pass", name, "--bvh"])
         .arg(bvh)

@@ -133,7 +133,8 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     let saved = read_json(args.icount_check.as_deref())?;
     // The bundled scenarios, or with --clip the user's files, each named by
     // its file stem as the report names it.
-    let jobs: Vec<(String, Option<&std::path::Path>)> = if args.clip.is_empty() {
+    let scratch = std::env::temp_dir().join(format!("tcb-icount-{}", std::process::id()));
+    let jobs: Vec<(String, Option<PathBuf>)> = if args.clip.is_empty() {
         let names: Vec<&str> = match &args.only {
             Some(o) => o.split(',').map(str::trim).collect(),
             None => icount::names(),
@@ -145,11 +146,25 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
             )
             .into());
         }
-        names.into_iter().map(|n| (n.to_string(), None)).collect()
+        let mut jobs = Vec::new();
+        for n in names {
+            let clip = if n == "character-reduced" {
+                // Reduced here, natively; counted from the written clip.
+                let doc = scenarios::reduced_doc(&args.bvh)?;
+                std::fs::create_dir_all(&scratch)?;
+                let path = scratch.join("character-reduced.json");
+                tcb_io::write_clip_doc(&doc, &path)?;
+                Some(path)
+            } else {
+                None
+            };
+            jobs.push((n.to_string(), clip));
+        }
+        jobs
     } else {
         args.clip
             .iter()
-            .map(|p| Ok((scenarios::file(p)?.name, Some(p.as_path()))))
+            .map(|p| Ok((scenarios::file(p)?.name, Some(p.clone()))))
             .collect::<Result<_, tcb_io::Error>>()?
     };
     let exe = std::env::current_exe()?;
@@ -158,13 +173,14 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     println!("flags: {}", report::flags());
     for (name, clip) in &jobs {
         let name = name.as_str();
-        let c = icount::count(&exe, name, &args.bvh, *clip)?;
+        let c = icount::count(&exe, name, &args.bvh, clip.as_deref())?;
         println!(
             "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses  {:>9} bytes",
             c.instructions, c.l1_misses, c.ll_misses, c.bytes
         );
         counts.insert(name.to_string(), c);
     }
+    let _ = std::fs::remove_dir_all(&scratch);
     if let Some(path) = &args.icount_save {
         let note = format!(
             "tcb-bench --icount ({}, {}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
@@ -198,6 +214,10 @@ instruction counts against the saved ones:"
 
 fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if let Some(name) = &args.icount_pass {
+        if icount::EXTRA.contains(&name.as_str()) {
+            icount::run_extra(name, &args.bvh)?;
+            return Ok(true);
+        }
         let s = match args.clip.first() {
             Some(p) => vec![scenarios::file(p)?],
             None => scenarios::named(&args.bvh, |n| n == name)?,

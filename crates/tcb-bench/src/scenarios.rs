@@ -250,6 +250,20 @@ pub fn character(bvh: &Path, rotation: RotationMode) -> Result<Scenario, tcb_io:
 /// contract's defaults (shell metric, `--knots track`), played like
 /// `character-hermite`.
 pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
+    let (loaded, reduced) = reduce_cmu(bvh)?;
+    let end = reduced.clip.time_range().map_or(0.0, |r| r.1);
+    let mut s = Scenario::new("character-reduced", reduced.clip, frames(end, 60.0));
+    s.joints = Some(animated_joints(&loaded));
+    Ok(s)
+}
+
+/// The clip `character-reduced` plays, as a document (what `--icount`
+/// hands to the counted process).
+pub fn reduced_doc(bvh: &Path) -> Result<tcb_io::ClipDoc, tcb_io::Error> {
+    Ok(reduce_cmu(bvh)?.1.doc)
+}
+
+fn reduce_cmu(bvh: &Path) -> Result<(tcb_io::Loaded, tcb_fit::Reduced), tcb_io::Error> {
     let options = tcb_io::ImportOptions {
         rotation: RotationMode::Hermite,
         ..Default::default()
@@ -262,10 +276,7 @@ pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     };
     let reduced = tcb_fit::reduce(input, &tcb_fit::ReduceOptions::default(), &|_, _| {})
         .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(bvh))?;
-    let end = reduced.clip.time_range().map_or(0.0, |r| r.1);
-    let mut s = Scenario::new("character-reduced", reduced.clip, frames(end, 60.0));
-    s.joints = Some(animated_joints(&loaded));
-    Ok(s)
+    Ok((loaded, reduced))
 }
 
 /// How [`file_with`] plays a user's clip.
