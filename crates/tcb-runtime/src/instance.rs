@@ -11,6 +11,38 @@ use crate::rig::{Rig, RigError, RigMap};
 use std::sync::Arc;
 use wide::f32x8;
 
+/// How an instance turns the time it is given into the clip's time,
+/// whatever the clip's own `pre`/`post` say ([`Instance::set_playback`]).
+/// Time is wrapped in f64 before anything becomes f32.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Playback {
+    /// The clip's own time: outside its keys its `pre`/`post` modes apply.
+    #[default]
+    Clip,
+    /// Over and over from the first key to the last.
+    Loop,
+    /// Held at the first key before it and at the last after it (velocity 0).
+    Clamp,
+    /// Forwards to the last key, backwards to the first, and so on
+    /// (velocities change sign on the way back).
+    PingPong,
+}
+
+/// A playback setting [`Instance::set_playback`] refuses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaybackError {
+    /// The speed given.
+    pub speed: f64,
+}
+
+impl std::fmt::Display for PlaybackError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "playback speed {} is not a finite number", self.speed)
+    }
+}
+
+impl std::error::Error for PlaybackError {}
+
 /// One playing copy of a clip: a cursor per group and the output pose.
 /// Allocates when created, never when sampling.
 #[derive(Clone, Debug)]
@@ -24,6 +56,8 @@ pub struct Instance {
     caches: Vec<[KeyCache; 2]>,
     /// With a rig: the map into its layout and the pose in it.
     rig: Option<Box<(RigMap, Pose)>>,
+    /// Playback mode and speed.
+    playback: (Playback, f64),
 }
 
 impl Instance {
@@ -47,6 +81,68 @@ impl Instance {
                 .collect(),
             clip,
             rig: None,
+            playback: (Playback::Clip, 1.0),
+        }
+    }
+
+    /// Play the clip in `mode` at `speed` (1 is the clip's own speed, 2
+    /// twice as fast, negative backwards): [`sample`](Self::sample)`(t)`
+    /// then samples the clip at the time `mode` maps `speed * t` to, over
+    /// the clip's keys, and scales velocities to match. A NaN or infinite
+    /// speed is refused.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use tcb_runtime::{Clip, Instance, Playback};
+    /// let clip = tcb_io::ClipDoc::parse(r#"{"format": "tcb-clip/1", "tracks": [
+    ///   {"name": "x", "kind": "scalar", "times": [0, 2], "values": [0, 4]}]}"#)
+    ///     .unwrap().build().unwrap();
+    /// let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), true);
+    /// inst.set_playback(Playback::PingPong, 1.0).unwrap();
+    /// let pose = inst.sample(3.0); // on the way back: clip time 1
+    /// let x = pose.layout().track("x").unwrap();
+    /// assert_eq!(pose.scalar(x), 2.0);
+    /// assert!(pose.scalar_velocity(x) < 0.0);
+    /// ```
+    pub fn set_playback(&mut self, mode: Playback, speed: f64) -> Result<(), PlaybackError> {
+        if !speed.is_finite() {
+            return Err(PlaybackError { speed });
+        }
+        self.playback = (mode, speed);
+        Ok(())
+    }
+
+    /// The playback mode and speed.
+    pub fn playback(&self) -> (Playback, f64) {
+        self.playback
+    }
+
+    /// The clip time `time` plays, and the factor its velocities take.
+    fn clip_time(&self, time: f64) -> (f64, f32) {
+        let (mode, speed) = self.playback;
+        let t = time * speed;
+        if mode == Playback::Clip {
+            return (t, speed as f32);
+        }
+        let Some((t0, t1)) = self.clip.time_range() else {
+            return (t, speed as f32);
+        };
+        let d = t1 - t0;
+        match mode {
+            Playback::Clip => (t, speed as f32),
+            Playback::Clamp if t < t0 => (t0, 0.0),
+            Playback::Clamp if t > t1 => (t1, 0.0),
+            Playback::Clamp => (t, speed as f32),
+            _ if d <= 0.0 || !t.is_finite() => (t0, 0.0),
+            Playback::Loop => (t0 + (t - t0).rem_euclid(d), speed as f32),
+            Playback::PingPong => {
+                let u = (t - t0).rem_euclid(2.0 * d);
+                if u <= d {
+                    (t0 + u, speed as f32)
+                } else {
+                    (t0 + 2.0 * d - u, -speed as f32)
+                }
+            }
         }
     }
 
@@ -86,8 +182,10 @@ impl Instance {
         }
     }
 
-    /// Sample every track at `time` (seconds; any f64) into the pose.
+    /// Sample every track at `time` (seconds; any f64) into the pose,
+    /// through the [playback](Self::set_playback) mode and speed.
     pub fn sample(&mut self, time: f64) -> &Pose {
+        let (time, rate) = self.clip_time(time);
         sample_into(
             &self.clip,
             time,
@@ -97,6 +195,12 @@ impl Instance {
             &mut self.pose,
             &mut self.caches,
         );
+        if rate != 1.0
+            && let Some(v) = &mut self.pose.velocities
+        {
+            let r = f32x8::splat(rate);
+            v.iter_mut().for_each(|x| *x *= r);
+        }
         match self.rig.as_deref_mut() {
             Some((map, out)) => {
                 map.apply(&self.pose, out);

@@ -54,7 +54,7 @@ pub mod batch;
 
 pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
-pub use instance::Instance;
+pub use instance::{Instance, Playback, PlaybackError};
 pub use pose::Pose;
 pub use rig::{Rig, RigError, RigTrack};
 pub use skeleton::SkeletonBinding;

@@ -65,6 +65,9 @@ fn steady_playback_and_blending_allocate_nothing() {
     for clip in clips {
         let mut a = tcb_runtime::Instance::new(clip.clone(), true);
         let mut b = tcb_runtime::Instance::new(clip.clone(), true);
+        // Playback at the instance: ping-pong at 1.5x, velocities scaled.
+        b.set_playback(tcb_runtime::Playback::PingPong, 1.5)
+            .unwrap();
         let mut out = a.pose().clone();
         let mask = tcb_runtime::BlendMask::new(&clip, |t| if t.0 % 2 == 0 { 1.0 } else { 0.25 });
         // Through a rig (every track, plus one the clip lacks).
