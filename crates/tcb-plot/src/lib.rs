@@ -218,6 +218,17 @@ fn angular_speed(q: [f32; 4], d: [f32; 4]) -> f64 {
     2.0 * glam::DVec3::new(w.x, w.y, w.z).length().to_degrees()
 }
 
+/// The speed of a track at `t`: the length of its velocity, or for a
+/// rotation its angular speed in degrees per second.
+fn speed(data: &TrackData, t: f64) -> f64 {
+    let (v, d) = at(data, t);
+    if data.kind() == TrackKind::Quat {
+        angular_speed(v, d)
+    } else {
+        d.iter().map(|x| f64::from(*x).powi(2)).sum::<f64>().sqrt()
+    }
+}
+
 /// One drawn line: label, colour index, points.
 struct Line {
     label: String,
@@ -513,9 +524,13 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                     true,
                 )?;
             }
-            Mode::Value | Mode::Velocity | Mode::Components if rotations == 0 => {
+            // Channels against time: vectors' components, or (velocity,
+            // --components) a rotation's four.
+            Mode::Value | Mode::Velocity | Mode::Components
+                if rotations == 0 || (rotations == tracks.len() && plot.mode != Mode::Value) =>
+            {
                 let velocity = plot.mode == Mode::Velocity;
-                if plot.mode == Mode::Components {
+                if plot.mode == Mode::Components && rotations == 0 {
                     return err("--components is for rotation tracks");
                 }
                 let mut lines = Vec::new();
@@ -560,10 +575,11 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                     &mut marks,
                     0,
                 );
-                let y = if velocity {
-                    "d/dt (value units per second)"
-                } else {
-                    "value"
+                let y = match (velocity, rotations > 0) {
+                    (true, false) => "d/dt (value units per second)",
+                    (true, true) => "d/dt of the components (per second)",
+                    (false, true) => "quaternion components",
+                    (false, false) => "value",
                 };
                 chart(
                     &root,
@@ -584,33 +600,14 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                     if rotations > 0 && !rotation {
                         return err("--speed: plot rotations and vectors separately");
                     }
-                    let speed = |s: f64| {
-                        let (v, d) = at(&t.data, s);
-                        if rotation {
-                            angular_speed(v, d)
-                        } else {
-                            d.iter().map(|x| f64::from(*x).powi(2)).sum::<f64>().sqrt()
-                        }
-                    };
                     lines.push(Line {
                         label: format!("speed of {}", t.name),
                         colour: i,
-                        points: times.iter().map(|&s| (s, speed(s))).collect(),
+                        points: times.iter().map(|&s| (s, speed(&t.data, s))).collect(),
                     });
                 }
                 let mut marks = Marks::default();
-                key_marks(
-                    &|d, s| {
-                        let (v, dv) = at(d, s);
-                        vec![if d.kind() == TrackKind::Quat {
-                            angular_speed(v, dv)
-                        } else {
-                            dv.iter().map(|x| f64::from(*x).powi(2)).sum::<f64>().sqrt()
-                        }]
-                    },
-                    &mut marks,
-                    0,
-                );
+                key_marks(&|d, s| vec![speed(d, s)], &mut marks, 0);
                 let y = if rotations > 0 {
                     "angular speed (degrees per second)"
                 } else {
@@ -632,61 +629,8 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                 if rotations != tracks.len() {
                     return err("plot rotations and vectors separately (choose with --track)");
                 }
-                if plot.mode == Mode::Velocity || plot.mode == Mode::Components {
-                    let velocity = plot.mode == Mode::Velocity;
-                    let mut lines = Vec::new();
-                    for (i, t) in tracks.iter().enumerate() {
-                        for c in 0..4 {
-                            let label = format!(
-                                "{}{}.{}",
-                                if velocity { "d/dt " } else { "" },
-                                t.name,
-                                NAMES[c]
-                            );
-                            let points = times
-                                .iter()
-                                .map(|&s| {
-                                    let (v, d) = at(&t.data, s);
-                                    (s, f64::from(if velocity { d[c] } else { v[c] }))
-                                })
-                                .collect();
-                            lines.push(Line {
-                                label,
-                                colour: 4 * i + c,
-                                points,
-                            });
-                        }
-                    }
-                    let mut marks = Marks::default();
-                    key_marks(
-                        &|d, s| {
-                            let (v, dv) = at(d, s);
-                            (if velocity { dv } else { v })
-                                .iter()
-                                .map(|x| f64::from(*x))
-                                .collect()
-                        },
-                        &mut marks,
-                        0,
-                    );
-                    let y = if velocity {
-                        "d/dt of the components (per second)"
-                    } else {
-                        "quaternion components"
-                    };
-                    chart(
-                        &root,
-                        Some(&title),
-                        "time (s)",
-                        y,
-                        &lines,
-                        &marks,
-                        Some((from, to)),
-                        &shaded,
-                        false,
-                    )?;
-                } else {
-                    // Angle above, axis below.
+                // Angle above, axis below.
+                {
                     let h = plot.size.1;
                     let (top, bottom) = root.split_vertically(h * 11 / 20);
                     let mut angle = Vec::new();
