@@ -55,6 +55,20 @@ pub mod batch;
 pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
 pub use instance::{Instance, Playback, PlaybackError};
+
+/// The `mint` crate (feature `mint`): poses' glam values convert with
+/// `.into()`, so an engine on another glam version, nalgebra or cgmath
+/// converts at the boundary.
+///
+/// ```
+/// # #[cfg(feature = "mint")] {
+/// let q: tcb_runtime::mint::Quaternion<f32> = glam::Quat::IDENTITY.into();
+/// let v: glam::Vec3 = tcb_runtime::mint::Vector3 { x: 1.0, y: 2.0, z: 3.0 }.into();
+/// assert_eq!((q.s, v.z), (1.0, 3.0));
+/// # }
+/// ```
+#[cfg(feature = "mint")]
+pub use mint;
 pub use pose::Pose;
 pub use rig::{Rig, RigError, RigTrack};
 pub use skeleton::SkeletonBinding;
