@@ -61,6 +61,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut clock = 0.0f64;
     let mut spent = std::time::Duration::ZERO;
     let mut head_height = 0.0f32;
+    // Look joints up once, not per frame.
+    let head = bvh.skeleton.joint("Head").unwrap_or(0);
     for _ in 0..frames {
         clock += dt;
         let started = Instant::now();
@@ -76,8 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 None,
             )?;
             binding.model_transforms(&pose, &mut local, &mut model);
-            head_height =
-                head_height.max(model[bvh.skeleton.joint("Head").unwrap_or(0)].translation.y);
+            head_height = head_height.max(model[head].translation.y);
         }
         spent += started.elapsed();
     }

@@ -106,11 +106,7 @@ pub fn run_extra(name: &str, bvh: &Path) -> Result<(), Box<dyn std::error::Error
         _ => {
             let s = crate::scenarios::crowd(bvh)?;
             println!("bytes: {}", s.clip.memory_bytes());
-            let mut instances: Vec<Instance> = s
-                .phases
-                .iter()
-                .map(|_| Instance::new(s.clip.clone(), false))
-                .collect();
+            let mut instances = s.instances();
             let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
             pool.install(|| batch_frames(&s, &mut instances));
         }
@@ -133,12 +129,7 @@ pub fn pass(s: &Scenario, instances: &mut [Instance]) {
 /// valgrind), and print the compiled clip's bytes for [`count`] to read.
 pub fn run_pass(s: &Scenario) {
     println!("bytes: {}", s.clip.memory_bytes());
-    let mut instances: Vec<Instance> = s
-        .phases
-        .iter()
-        .map(|_| Instance::new(s.clip.clone(), false))
-        .collect();
-    pass(s, &mut instances);
+    pass(s, &mut s.instances());
 }
 
 /// Counts of one scenario.

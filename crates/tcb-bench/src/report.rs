@@ -33,11 +33,6 @@ pub fn flags() -> String {
     )
 }
 
-/// The CPU model and the number of threads rayon uses.
-pub fn machine() -> String {
-    format!("{}, {} threads", cpu_model(), rayon::current_num_threads())
-}
-
 /// The CPU model (`/proc/cpuinfo`), or the architecture where there is none.
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")

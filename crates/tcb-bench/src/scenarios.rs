@@ -109,13 +109,17 @@ impl Scenario {
         }
     }
 
-    /// One pass of the runtime, one thread.
-    pub fn runtime_pass(&self) -> impl FnMut() + '_ {
-        let mut instances: Vec<Instance> = self
-            .phases
+    /// One instance per phase, without velocities.
+    pub fn instances(&self) -> Vec<Instance> {
+        self.phases
             .iter()
             .map(|_| Instance::new(self.clip.clone(), false))
-            .collect();
+            .collect()
+    }
+
+    /// One pass of the runtime, one thread.
+    pub fn runtime_pass(&self) -> impl FnMut() + '_ {
+        let mut instances = self.instances();
         move || {
             for &t in &self.times {
                 for (inst, &p) in instances.iter_mut().zip(&self.phases) {
@@ -130,11 +134,7 @@ impl Scenario {
     /// game's job system would). The frame loop runs inside the pool, so
     /// the calling thread works rather than sleeping on every frame.
     pub fn parallel_pass(&self) -> impl FnMut() + '_ {
-        let mut instances: Vec<Instance> = self
-            .phases
-            .iter()
-            .map(|_| Instance::new(self.clip.clone(), false))
-            .collect();
+        let mut instances = self.instances();
         let chunk = instances
             .len()
             .div_ceil(rayon::current_num_threads())

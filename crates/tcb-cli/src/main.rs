@@ -754,12 +754,12 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
 }
 
 fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
-    std::fs::create_dir_all(&args.output).map_err(|e| format!("{}: {e}", args.output.display()))?;
-    // Draw them all before writing any.
+    // Draw them all before creating or writing anything.
     let all = tcb_plot::figures()
         .into_iter()
         .map(|f| Ok((f.name, f.render(&args.root)?)))
         .collect::<Result<Vec<_>, tcb_plot::PlotError>>()?;
+    std::fs::create_dir_all(&args.output).map_err(|e| format!("{}: {e}", args.output.display()))?;
     for (name, svg) in &all {
         tcb_io::write_atomically(&args.output.join(name), svg.as_bytes())?;
     }

@@ -796,3 +796,19 @@ fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.exists());
 }
+
+#[test]
+fn figures_from_a_wrong_root_create_nothing() {
+    let dir = temp_clip("x", "").parent().unwrap().join("never-figures");
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = tcb(&[
+        "figures",
+        "-o",
+        dir.to_str().unwrap(),
+        "--root",
+        "/no/such/repo",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("tension.json"), "{}", stderr(&o));
+    assert!(!dir.exists());
+}

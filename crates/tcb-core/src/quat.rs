@@ -4,6 +4,7 @@
 //! ```text
 //! a b   Hamilton product
 //! q = p / |p|              q' = (p' - q (q . p')) / |p|      normalize, with velocity
+//! omega = 2 vec(q' conj(q))                                  angular velocity
 //! ```
 
 use crate::basis::Real;
@@ -38,4 +39,20 @@ pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 
         std::array::from_fn(|i| (dp[i] - q[i] * qd) * inv)
     });
     (q, qv)
+}
+
+/// The angular velocity of a unit quaternion `q` with component derivative
+/// `dq`, as a vector in the frame `q` maps into: `2 vec(dq conj(q))`
+/// (radians per unit of time).
+///
+/// ```
+/// // A quarter turn about z per second, at the identity.
+/// let w = tcb_core::quat::angular_velocity(&[0.0f64, 0.0, 0.0, 1.0], &[0.0, 0.0, 0.25 * std::f64::consts::PI, 0.0]);
+/// assert!((w[2] - std::f64::consts::FRAC_PI_2).abs() < 1e-15 && w[0] == 0.0);
+/// ```
+#[inline(always)]
+pub fn angular_velocity<R: Real>(q: &[R; 4], dq: &[R; 4]) -> [R; 3] {
+    let zero = R::splat(0.0);
+    let w = mul(dq, &[zero - q[0], zero - q[1], zero - q[2], q[3]]);
+    [w[0] + w[0], w[1] + w[1], w[2] + w[2]]
 }

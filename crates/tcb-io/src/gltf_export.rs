@@ -27,6 +27,8 @@
 
 use crate::Error;
 use gltf::json;
+use json::accessor::Type as AccessorType;
+use json::animation::Interpolation;
 use json::validation::{Checked, USize64};
 use std::path::Path;
 use tcb_core::skeleton::Skeleton;
@@ -64,10 +66,11 @@ impl ExportReport {
 /// One sampler's data.
 struct Sampler {
     times: Vec<f32>,
-    interpolation: &'static str,
+    interpolation: Interpolation,
     /// Output elements (for CUBICSPLINE: in, value, out per key).
     output: Vec<f32>,
-    kind: &'static str,
+    /// The output accessor's element type.
+    kind: AccessorType,
 }
 
 /// Keys with values and time-unit tangents, `dim` components each.
@@ -231,7 +234,7 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
     (out, worst)
 }
 
-fn cubic_sampler(c: &Cubic, kind: &'static str) -> Sampler {
+fn cubic_sampler(c: &Cubic, kind: AccessorType) -> Sampler {
     let width = c.values[0].len();
     let mut output = Vec::with_capacity(c.times.len() * width * 3);
     for k in 0..c.times.len() {
@@ -241,7 +244,7 @@ fn cubic_sampler(c: &Cubic, kind: &'static str) -> Sampler {
     }
     Sampler {
         times: c.times.iter().map(|&t| t as f32).collect(),
-        interpolation: "CUBICSPLINE",
+        interpolation: Interpolation::CubicSpline,
         output,
         kind,
     }
@@ -455,9 +458,9 @@ pub fn export(
 
 fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
     let kind = match data.kind().dim() {
-        1 => "SCALAR",
-        3 => "VEC3",
-        _ => "VEC4",
+        1 => AccessorType::Scalar,
+        3 => AccessorType::Vec3,
+        _ => AccessorType::Vec4,
     };
     let shape = match data {
         TrackData::Scalar(t) => exact_shape(t),
@@ -489,9 +492,9 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
             let sampler = Sampler {
                 times: data.times().iter().map(|&t| t as f32).collect(),
                 interpolation: if shape == Shape::Step {
-                    "STEP"
+                    Interpolation::Step
                 } else {
-                    "LINEAR"
+                    Interpolation::Linear
                 },
                 output,
                 kind,
@@ -517,7 +520,7 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
 
 fn merge(samplers: &[&Sampler]) -> Sampler {
     let targets = samplers.len();
-    let per_key = if samplers[0].interpolation == "CUBICSPLINE" {
+    let per_key = if samplers[0].interpolation == Interpolation::CubicSpline {
         3
     } else {
         1
@@ -533,7 +536,7 @@ fn merge(samplers: &[&Sampler]) -> Sampler {
         times: samplers[0].times.clone(),
         interpolation: samplers[0].interpolation,
         output,
-        kind: "SCALAR",
+        kind: AccessorType::Scalar,
     }
 }
 
@@ -653,22 +656,13 @@ fn write(
     let mut anim_channels = Vec::new();
     for (node, path, s) in channels {
         let input = b.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
-        let (count, ty) = match s.kind {
-            "SCALAR" => (s.output.len(), Type::Scalar),
-            "VEC3" => (s.output.len() / 3, Type::Vec3),
-            _ => (s.output.len() / 4, Type::Vec4),
-        };
-        let output = b.accessor(&s.output, count, ty, false, false);
-        let interpolation = match s.interpolation {
-            "STEP" => json::animation::Interpolation::Step,
-            "LINEAR" => json::animation::Interpolation::Linear,
-            _ => json::animation::Interpolation::CubicSpline,
-        };
+        let count = s.output.len() / s.kind.multiplicity();
+        let output = b.accessor(&s.output, count, s.kind, false, false);
         samplers.push(json::animation::Sampler {
             extensions: None,
             extras: Default::default(),
             input,
-            interpolation: Checked::Valid(interpolation),
+            interpolation: Checked::Valid(s.interpolation),
             output,
         });
         let property = match *path {

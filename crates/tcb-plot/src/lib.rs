@@ -71,7 +71,8 @@ pub struct Plot {
     /// What to draw.
     pub mode: Mode,
     /// Inbetween dots per segment, at equal time steps (default: 8 for
-    /// `Path`, none otherwise).
+    /// `Path`, none otherwise; none for a track with more than
+    /// [`MAX_MARKED_KEYS`] keys in range, whose keys are not marked either).
     pub inbetweens: Option<usize>,
     /// The title (for example the file's name).
     pub title: String,
@@ -135,6 +136,11 @@ const SHADE: RGBColor = RGBColor(232, 232, 232);
 const HANDLE: RGBColor = RGBColor(110, 110, 110);
 const NAMES: [&str; 4] = ["x", "y", "z", "w"];
 
+/// Above this many keys of one track in the time range, keys are not
+/// marked, tangent handles are not drawn and inbetweens are off by default
+/// (motion capture).
+pub const MAX_MARKED_KEYS: usize = 300;
+
 /// The tracks a plot draws, checked.
 fn chosen<'a>(clip: &'a Clip, plot: &Plot) -> Result<Vec<&'a NamedTrack>, PlotError> {
     if clip.tracks.is_empty() {
@@ -194,28 +200,25 @@ fn at(data: &TrackData, t: f64) -> ([f32; 4], [f32; 4]) {
     (v, d)
 }
 
-/// A rotation's angle (degrees, 0 to 180) and unit axis.
+/// A rotation's angle (degrees, 0 to 180) and unit axis, from its `log`
+/// on the `w >= 0` hemisphere (`v th/2`).
 fn angle_axis(q: [f32; 4]) -> (f64, [f64; 3]) {
-    let q = q.map(f64::from);
-    let s = if q[3] < 0.0 { -1.0 } else { 1.0 };
-    let v = [s * q[0], s * q[1], s * q[2]];
-    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let angle = 2.0 * len.atan2(s * q[3]);
-    let axis = if len > 1e-12 {
-        v.map(|c| c / len)
+    let q = glam::Quat::from_array(q).as_dquat();
+    let log = tcb_core::rotation::quat_log(if q.w < 0.0 { -q } else { q });
+    let half = log.length();
+    let axis = if half > 1e-12 {
+        (log / half).to_array()
     } else {
         [0.0; 3]
     };
-    (angle.to_degrees(), axis)
+    ((2.0 * half).to_degrees(), axis)
 }
 
 /// Angular speed (degrees per second) of a unit quaternion with component
-/// derivative `d`: `2 |vec(conj(q) d)|`.
+/// derivative `d` ([`tcb_core::quat::angular_velocity`]).
 fn angular_speed(q: [f32; 4], d: [f32; 4]) -> f64 {
-    let q = glam::DQuat::from_array(q.map(f64::from));
-    let d = glam::DQuat::from_array(d.map(f64::from));
-    let w = q.conjugate() * d;
-    2.0 * glam::DVec3::new(w.x, w.y, w.z).length().to_degrees()
+    let w = tcb_core::quat::angular_velocity(&q.map(f64::from), &d.map(f64::from));
+    glam::DVec3::from_array(w).length().to_degrees()
 }
 
 /// The speed of a track at `t`: the length of its velocity, or for a
@@ -439,13 +442,29 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
         plot.title.clone()
     };
     let times = sample_times(&tracks, from, to, 800);
-    let inbetweens = plot.inbetweens.unwrap_or(if path { 8 } else { 0 });
-    let key_marks = |f: &dyn Fn(&TrackData, f64) -> Vec<f64>, marks: &mut Marks, base: usize| {
-        let mut colour = base;
+    // Dense clips (motion capture: a key per frame) are their own line:
+    // marking every key and inbetween would only thicken it into a blob.
+    let keys_in_range = tracks
+        .iter()
+        .map(|t| {
+            t.data
+                .times()
+                .iter()
+                .filter(|k| (from..=to).contains(*k))
+                .count()
+        })
+        .max()
+        .unwrap_or(0);
+    let dense = keys_in_range > MAX_MARKED_KEYS;
+    let inbetweens = plot
+        .inbetweens
+        .unwrap_or(if path && !dense { 8 } else { 0 });
+    let key_marks = |f: &dyn Fn(&TrackData, f64) -> Vec<f64>, marks: &mut Marks| {
+        let mut colour = 0;
         for t in &tracks {
             let keys = t.data.times();
             let n = f(&t.data, keys[0]).len();
-            for &k in keys.iter().filter(|k| (from..=to).contains(*k)) {
+            for &k in keys.iter().filter(|k| !dense && (from..=to).contains(*k)) {
                 for (c, y) in f(&t.data, k).into_iter().enumerate() {
                     marks.keys.push((k, y, colour + c));
                 }
@@ -491,7 +510,7 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                         points: times.iter().map(|&s| xy(at(&t.data, s).0)).collect(),
                     });
                     let keys = t.data.times();
-                    for &k in keys.iter().filter(|k| (from..=to).contains(*k)) {
+                    for &k in keys.iter().filter(|k| !dense && (from..=to).contains(*k)) {
                         let p = xy(at(&t.data, k).0);
                         marks.keys.push((p.0, p.1, i));
                     }
@@ -504,11 +523,13 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                             }
                         }
                     }
-                    marks.handles.extend(
-                        handles(&t.data, a, b, from, to)
-                            .into_iter()
-                            .map(|(p, q)| (p, q, i)),
-                    );
+                    if !dense {
+                        marks.handles.extend(
+                            handles(&t.data, a, b, from, to)
+                                .into_iter()
+                                .map(|(p, q)| (p, q, i)),
+                        );
+                    }
                 }
                 let x_desc = format!("{} (component {})", NAMES[a], NAMES[a]);
                 let y_desc = format!("{} (component {})", NAMES[b], NAMES[b]);
@@ -573,7 +594,6 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                             .collect()
                     },
                     &mut marks,
-                    0,
                 );
                 let y = match (velocity, rotations > 0) {
                     (true, false) => "d/dt (value units per second)",
@@ -607,7 +627,7 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                     });
                 }
                 let mut marks = Marks::default();
-                key_marks(&|d, s| vec![speed(d, s)], &mut marks, 0);
+                key_marks(&|d, s| vec![speed(d, s)], &mut marks);
                 let y = if rotations > 0 {
                     "angular speed (degrees per second)"
                 } else {
@@ -654,7 +674,7 @@ pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
                         }
                     }
                     let mut marks = Marks::default();
-                    key_marks(&|d, s| vec![angle_axis(at(d, s).0).0], &mut marks, 0);
+                    key_marks(&|d, s| vec![angle_axis(at(d, s).0).0], &mut marks);
                     chart(
                         &top,
                         Some(&title),

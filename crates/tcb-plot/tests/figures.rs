@@ -84,3 +84,29 @@ fn bad_requests_are_one_clear_line() {
     assert!(tcb_plot::parse_components("x,x").is_err());
     assert_eq!(tcb_plot::parse_components("x,z").unwrap(), [0, 2]);
 }
+
+#[test]
+fn dense_capture_is_drawn_as_a_line_without_marks() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let cmu = tcb_io::load(&root.join("data/cmu-01_01.bvh")).unwrap();
+    let path = |clip: &tcb_core::Clip, track: &str| {
+        let plot = tcb_plot::Plot {
+            tracks: vec![track.into()],
+            mode: tcb_plot::Mode::Path { components: [0, 2] },
+            ..tcb_plot::Plot::new("t")
+        };
+        tcb_plot::render(clip, &plot).unwrap()
+    };
+    // 2752 keys: no key dots, handles or inbetweens thickening the line.
+    let svg = path(&cmu.clip, "Hips.translation");
+    assert_eq!(svg.matches("<circle").count(), 0);
+    // A handful of keys keeps them.
+    let careen = tcb_io::load(&root.join("examples/clips/careen.json")).unwrap();
+    let plot = tcb_plot::Plot {
+        tracks: vec!["ball.path".into()],
+        mode: tcb_plot::Mode::Path { components: [0, 1] },
+        ..tcb_plot::Plot::new("t")
+    };
+    let svg = tcb_plot::render(&careen.clip, &plot).unwrap();
+    assert!(svg.matches("<circle").count() > 20);
+}

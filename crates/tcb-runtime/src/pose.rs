@@ -114,8 +114,10 @@ impl Pose {
     /// ```
     pub fn angular_velocity(&self, track: TrackId) -> Vec3 {
         let (q, dq) = (self.quat(track), self.quat_velocity(track));
-        let w = dq * q.conjugate();
-        2.0 * Vec3::new(w.x, w.y, w.z)
+        Vec3::from_array(tcb_core::quat::angular_velocity(
+            &q.to_array(),
+            &dq.to_array(),
+        ))
     }
 
     /// Every track's components in file order (the CSV columns of

@@ -193,15 +193,20 @@ impl Scene {
     }
 }
 
-/// Export the bundled CMU clip in `mode`, read it back here, and return the
-/// worst relative model-space position difference over the clip.
-fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
+/// The bundled CMU clip, rotations in `mode`.
+fn load_cmu(mode: tcb_core::RotationMode) -> tcb_io::Loaded {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
     let options = tcb_io::ImportOptions {
         rotation: mode,
         ..Default::default()
     };
-    let loaded = tcb_io::load_with(std::path::Path::new(path), &options).unwrap();
+    tcb_io::load_with(std::path::Path::new(path), &options).unwrap()
+}
+
+/// Export the bundled CMU clip in `mode`, read it back here, and return the
+/// worst relative model-space position difference over the clip.
+fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
+    let loaded = load_cmu(mode);
     let skeleton = loaded.skeleton.clone().expect("BVH has a skeleton");
     let export = tcb_io::gltf_export::ExportOptions {
         max_error,
@@ -278,12 +283,7 @@ fn threejs_positions_match_skeleton_binding() {
     };
     let text = std::fs::read_to_string(&file).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
-    let options = tcb_io::ImportOptions {
-        rotation: mode,
-        ..Default::default()
-    };
-    let loaded = tcb_io::load_with(std::path::Path::new(path), &options).unwrap();
+    let loaded = load_cmu(mode);
     let skeleton = loaded.skeleton.clone().unwrap();
     let clip = Arc::new(Clip::compile(&loaded.clip));
     let binding = SkeletonBinding::new(skeleton.clone(), &clip);
