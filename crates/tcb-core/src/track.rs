@@ -49,8 +49,9 @@ pub fn locate(times: &[f64], time: f64) -> (usize, f64) {
 /// Segment `k` with `times[k] <= time < times[k+1]`, clamped to
 /// `0..=n-2` (times before the first key and NaN give 0, times from the
 /// last key on give n-2), for `times` with at least 2 strictly increasing
-/// entries. Segments `hint` and `hint + 1` are tried first, so forward
-/// playback finds its segment in O(1); anything else is a binary search.
+/// entries. Segment `hint` is tried first, then later ones at offsets 1,
+/// 2, 4, ... from it, so forward playback finds its segment in O(1) and a
+/// jump of d keys forward in O(log d); going back is a binary search.
 /// The one segment search of the reference and the runtime.
 ///
 /// ```
@@ -68,9 +69,18 @@ pub fn segment_from(times: &[f64], time: f64, hint: usize) -> usize {
         if time < times[k + 1] {
             return k;
         }
-        if k < last && time < times[k + 2] {
-            return k + 1;
+        // Gallop forward from the hint (offsets 1, 2, 4, ...), then search
+        // between the last two probes: a cursor that moves several keys per
+        // call (capture at 120 fps played at 60) costs O(log distance), not
+        // a search over the whole track.
+        let rest = &times[k..];
+        let mut hi = 1;
+        while hi < rest.len() && rest[hi] <= time {
+            hi *= 2;
         }
+        let lo = hi / 2;
+        let p = lo + rest[lo..hi.min(rest.len())].partition_point(|&t| t <= time);
+        return (k + p - 1).min(last);
     }
     times
         .partition_point(|&t| t <= time)

@@ -83,6 +83,27 @@ proptest! {
     #![proptest_config(config(200))]
 
     #[test]
+    fn segment_search_from_any_hint_is_the_binary_search(
+        n in 2..70usize,
+        seed in prop::collection::vec(0.05..3.0f64, 70),
+        hint in 0..80usize,
+        time in -10.0..200.0f64,
+    ) {
+        let mut times = vec![0.0];
+        for g in &seed[..n - 1] {
+            let next = times[times.len() - 1] + g;
+            times.push(next);
+        }
+        let plain = times.partition_point(|&t| t <= time).saturating_sub(1).min(n - 2);
+        prop_assert_eq!(tcb_core::track::segment_from(&times, time, hint), plain);
+        for &t in &times {
+            let plain = times.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2);
+            prop_assert_eq!(tcb_core::track::segment_from(&times, t, hint), plain);
+        }
+        prop_assert_eq!(tcb_core::track::segment_from(&times, f64::NAN, hint), 0);
+    }
+
+    #[test]
     fn passes_through_every_key((t, v, c) in track3(8), rule in 0..4usize, ends in 0..3usize) {
         let settings = TrackSettings {
             tangent_rule: RULES[rule],

@@ -146,27 +146,32 @@ impl LooseLane {
         error
     }
 
-    /// `[P0, P1, M0, M1]` of each component on stored segment `seg` into
-    /// lane `i` of `out` (4 planes per component).
-    #[inline]
-    fn segment(&self, seg: usize, out: &mut [f32x8], i: usize) {
-        let (ka, kb) = key_pair(&self.grid, seg);
-        let n = self.grid.times.len();
-        // A step segment reads its first key twice; that key's TI belongs
-        // to the segment before.
-        let step = (1..n).contains(&seg) && self.grid.is_step(seg - 1);
+    /// `[P0, P1, M0, M1]` of each component from keys `ka` and `kb` (see
+    /// [`key_pair`]) into lane `i` of `out` (4 planes per component, `dim`
+    /// components); `step` zeroes `M1` (a step segment reads its first key
+    /// twice, and that key's TI belongs to the segment before).
+    #[inline(always)]
+    fn segment(&self, ka: usize, kb: usize, step: bool, out: &mut [f32x8], i: usize) {
         let dim = self.dim;
-        let (ka, kb) = (ka * dim, kb * dim);
-        for c in 0..dim {
-            let (a, b) = match &self.keys {
-                Keys::F32(k) => (k[ka + c], k[kb + c]),
-                Keys::U16 { .. } => (self.key(ka + c), self.key(kb + c)),
-            };
-            let o = &mut out[4 * c..4 * c + 4];
+        let write = |o: &mut [f32x8], a: [f32; KEY_STRIDE], b: [f32; KEY_STRIDE]| {
             o[0].as_mut_array()[i] = a[0];
             o[1].as_mut_array()[i] = b[0];
             o[2].as_mut_array()[i] = a[1];
             o[3].as_mut_array()[i] = if step { 0.0 } else { b[2] };
+        };
+        let out = out.chunks_exact_mut(4).take(dim);
+        match &self.keys {
+            Keys::F32(k) => {
+                let (a, b) = (&k[ka * dim..][..dim], &k[kb * dim..][..dim]);
+                for ((o, &a), &b) in out.zip(a).zip(b) {
+                    write(o, a, b);
+                }
+            }
+            Keys::U16 { .. } => {
+                for (c, o) in out.enumerate() {
+                    write(o, self.key(ka * dim + c), self.key(kb * dim + c));
+                }
+            }
         }
     }
 }
@@ -371,32 +376,65 @@ impl LooseState {
         }
     }
 
-    /// Load stored segment `seg` of lane `l` into its window, ease and controls.
+    /// Load stored segment `seg` of lane `l` into its window, ease and
+    /// controls (what [`key_pair`] says, without its general match: this runs
+    /// each time a lane crosses a key).
     #[inline]
     fn load(&mut self, loose: &Loose, l: usize, seg: usize) {
         let lane = &loose.lanes[l];
         let t = lane.grid.times.as_slice();
         let n = t.len();
-        let (ws, we, d, ease) = if seg.wrapping_sub(1) < n - 1 {
-            let (a, b) = (t[seg - 1], t[seg]);
-            (a, b, b - a, lane.grid.ease(seg - 1))
+        let (ws, we, d, ease, ka, kb, step) = if let Some(&[a, b]) = seg
+            .checked_sub(1)
+            .and_then(|k| t.get(k..k + 2))
+            .map(|w| <&[f64; 2]>::try_from(w).expect("two times"))
+        {
+            let k = seg - 1;
+            let step = lane.grid.is_step(k);
+            (
+                a,
+                b,
+                b - a,
+                lane.grid.ease(k),
+                k,
+                if step { k } else { seg },
+                step,
+            )
         } else if seg == 0 {
-            (f64::NEG_INFINITY, t[0], 1.0, Default::default())
+            (
+                f64::NEG_INFINITY,
+                t[0],
+                1.0,
+                Default::default(),
+                n,
+                n + 1,
+                false,
+            )
         } else {
-            (t[n - 1], f64::INFINITY, 1.0, Default::default())
+            (
+                t[n - 1],
+                f64::INFINITY,
+                1.0,
+                Default::default(),
+                n + 2,
+                n + 3,
+                false,
+            )
         };
+        debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
         let (h, i) = (l / 4, l % 4);
-        self.win[h][0].as_mut_array()[i] = ws;
-        self.win[h][1].as_mut_array()[i] = d;
-        let more = &mut self.more[h];
-        more[0].as_mut_array()[i] = we;
-        more[1].as_mut_array()[i] = ease.from;
-        more[2].as_mut_array()[i] = ease.to;
+        let [w0, w1] = &mut self.win[h];
+        w0.as_mut_array()[i] = ws;
+        w1.as_mut_array()[i] = d;
+        let [m0, m1, m2] = &mut self.more[h];
+        m0.as_mut_array()[i] = we;
+        m1.as_mut_array()[i] = ease.from;
+        m2.as_mut_array()[i] = ease.to;
         let (b, i) = (l / 8, l % 8);
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
         self.rate[b].as_mut_array()[i] = (1.0 / d) as f32;
         self.seg[l] = seg;
-        lane.segment(seg, &mut self.ctl[loose.ctl_at[b]..], i);
+        lane.segment(ka, kb, step, &mut self.ctl[loose.ctl_at[b]..], i);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -442,8 +480,14 @@ impl LooseState {
                 return self.seek(loose, time);
             }
             budget -= 1;
-            let [l, seg] = loose.order[self.next];
-            self.load(loose, l as usize, seg as usize);
+            let [l, seg] = loose.order[self.next].map(|x| x as usize);
+            // A lane that also passed the segment's end has its next entry
+            // due in this same loop (dense keys, sampled at a lower rate):
+            // only the last one is loaded.
+            let t = &loose.lanes[l].grid.times;
+            if t.get(seg).is_none_or(|&end| time < end) {
+                self.load(loose, l, seg);
+            }
             self.next += 1;
             self.next_time = loose.order_time(self.next);
         }

@@ -795,6 +795,64 @@ fn scrubbing_equals_random_access() {
     }
 }
 
+/// Tracks on key times of their own, keyed far more densely than they are
+/// sampled (capture at 100 to 200 fps played at 60, 25 and 7 fps): forward
+/// playback passes several keys of a lane per frame, loads only the last,
+/// and must equal both a fresh instance and the reference.
+#[test]
+fn dense_own_keys_played_at_a_lower_rate() {
+    for seed in 0..12u64 {
+        let mut rng = Rng(seed * 7 + 3);
+        let tracks = (0..(3 + rng.below(14)))
+            .map(|i| {
+                let n = 20 + rng.below(180);
+                let mut t = vec![rng.f(0.0, 0.05)];
+                for _ in 1..n {
+                    let next = t[t.len() - 1] + rng.f(0.005, 0.01);
+                    t.push(next);
+                }
+                let s = settings(&mut rng, i % 3 == 2);
+                let data = match i % 3 {
+                    0 => TrackData::Scalar(vector_track(&mut rng, &t, &s)),
+                    1 => TrackData::Vec3(vector_track::<Vec3>(&mut rng, &t, &s)),
+                    _ => TrackData::Quat(rotation_track(&mut rng, &t, &s)),
+                };
+                NamedTrack {
+                    name: format!("dense{i}"),
+                    data,
+                }
+            })
+            .collect();
+        let clip = tcb_core::Clip {
+            name: "dense".into(),
+            tracks,
+        };
+        let compiled = Arc::new(Clip::compile(&clip));
+        assert!(compiled.loose_track_count() > 0, "seed {seed}");
+        let (a, b) = clip.time_range().unwrap();
+        let n = clip.channel_count();
+        let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
+        let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
+        for fps in [60.0, 25.0, 7.0] {
+            let mut playing = Instance::new(compiled.clone(), true);
+            let frames = ((b - a + 0.5) * fps) as usize;
+            for f in 0..=frames {
+                let t = a - 0.1 + f as f64 / fps;
+                let mut fresh = Instance::new(compiled.clone(), true);
+                let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
+                assert_eq!(
+                    p.as_slice(),
+                    q.as_slice(),
+                    "seed {seed}, {fps} fps, time {t}"
+                );
+                p.write_row(&mut got, Some(&mut got_v));
+                clip.sample_into(t, &mut want, Some(&mut want_v));
+                assert_rows_match(&clip, t, (&got, &got_v), (&want, &want_v));
+            }
+        }
+    }
+}
+
 #[cfg(feature = "rayon")]
 #[test]
 fn batch_equals_sequential() {
