@@ -31,6 +31,7 @@ use crate::clip::{Clip, TrackId};
 use crate::kernel::normalize;
 use crate::pose::{Pose, PoseLayout};
 use std::fmt;
+use std::ops::Range;
 use std::sync::Arc;
 use tcb_core::quat::mul as quat_mul;
 use wide::f32x8;
@@ -136,21 +137,35 @@ fn same_layout(a: &Arc<PoseLayout>, b: &Arc<PoseLayout>) -> bool {
     Arc::ptr_eq(a, b) || **a == **b
 }
 
-/// The pose blocks that are not x/y/z/w planes of rotations, walking
-/// `quat_blocks` (sorted) alongside: no search per block.
+/// The runs of pose blocks that are not x/y/z/w planes of rotations: the
+/// gaps between `quat_blocks` (sorted), so that vector blocks are walked as
+/// slices, without a test per block.
 #[inline]
-fn vector_blocks(layout: &PoseLayout) -> impl Iterator<Item = usize> + '_ {
-    let mut q = layout.quat_blocks.iter().peekable();
-    (0..layout.blocks).filter(move |&b| {
-        while q.next_if(|&&s| b >= s + 4).is_some() {}
-        q.peek().is_none_or(|&&s| b < s)
-    })
+fn vector_runs(layout: &PoseLayout) -> impl Iterator<Item = Range<usize>> + '_ {
+    let starts = std::iter::once(0).chain(layout.quat_blocks.iter().map(|&q| q + 4));
+    let ends = layout
+        .quat_blocks
+        .iter()
+        .copied()
+        .chain(std::iter::once(layout.blocks));
+    starts.zip(ends).filter(|(a, b)| a < b).map(|(a, b)| a..b)
+}
+
+/// `acc += w(b) * x` over blocks `r` (`acc` and `x` are those blocks).
+#[inline(always)]
+fn accumulate(acc: &mut [f32x8], x: &[f32x8], r: Range<usize>, w: impl Fn(usize) -> f32x8) {
+    for ((a, &x), b) in acc.iter_mut().zip(x).zip(r) {
+        *a += w(b) * x;
+    }
 }
 
 /// Blend `layers` (pose, weight) into `out`, with an optional mask per layer.
 ///
 /// Every pose and mask must have `out`'s layout; otherwise nothing is
 /// written and the first mismatch is returned.
+///
+/// Layers are summed one after another into `out` (in layer order, as the
+/// formulas in the module docs read), so each pass streams through slices.
 pub fn blend(
     out: &mut Pose,
     layers: &[(&Pose, f32)],
@@ -174,67 +189,98 @@ pub fn blend(
     let Some(&(base, _)) = layers.first() else {
         return Ok(());
     };
-    let weight = |i: usize, block: usize| {
+    let with_velocity = out.velocities.is_some() && layers.iter().all(|l| l.0.velocities.is_some());
+    let Pose {
+        values: out_v,
+        velocities: out_dv,
+        ..
+    } = out;
+    let mut out_dv = out_dv.as_mut().filter(|_| with_velocity);
+    let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+    // The weight of layer i in block b, and the sum over layers.
+    let w_at = |i: usize, b: usize| {
         let w = f32x8::splat(layers[i].1);
         match masks {
-            Some(m) => w * m[i].lanes[block],
+            Some(m) => w * m[i].lanes[b],
             None => w,
         }
     };
-    let with_velocity = out.velocities.is_some() && layers.iter().all(|l| l.0.velocities.is_some());
+    let flat_sum = f32x8::splat(layers.iter().map(|l| l.1).sum());
+    let sum_at = |b: usize| match masks {
+        Some(_) => (0..layers.len()).fold(zero, |s, i| s + w_at(i, b)),
+        None => flat_sum,
+    };
 
-    // Vectors.
-    for b in vector_blocks(&layout) {
-        let mut sum = f32x8::ZERO;
-        let mut acc = f32x8::ZERO;
-        let mut vacc = f32x8::ZERO;
+    // Vectors: sum w_i x_i, then divide by sum w_i.
+    for r in vector_runs(&layout) {
+        out_v[r.clone()].fill(zero);
         for (i, (pose, _)) in layers.iter().enumerate() {
-            let w = weight(i, b);
-            sum += w;
-            acc += w * pose.values[b];
-            if with_velocity {
-                vacc += w * pose.velocities.as_ref().expect("checked")[b];
+            let x = &pose.values[r.clone()];
+            accumulate(&mut out_v[r.clone()], x, r.clone(), |b| w_at(i, b));
+        }
+        let mut dv = out_dv.as_deref_mut().map(|v| &mut v[r.clone()]);
+        if let Some(dv) = dv.as_deref_mut() {
+            dv.fill(zero);
+            for (i, (pose, _)) in layers.iter().enumerate() {
+                let x = &pose.velocities.as_ref().expect("checked")[r.clone()];
+                accumulate(dv, x, r.clone(), |b| w_at(i, b));
             }
         }
-        let none = sum.simd_eq(f32x8::ZERO);
-        let inv = none.select(f32x8::ZERO, f32x8::ONE / sum);
-        out.values[b] = none.select(base.values[b], acc * inv);
-        if with_velocity {
-            let v = base.velocities.as_ref().expect("checked")[b];
-            out.velocities.as_mut().expect("checked")[b] = none.select(v, vacc * inv);
+        let base_v = &base.values[r.clone()];
+        for ((b, o), &x0) in r.clone().zip(&mut out_v[r.clone()]).zip(base_v) {
+            let sum = sum_at(b);
+            let none = sum.simd_eq(zero);
+            let inv = none.select(zero, one / sum);
+            *o = none.select(x0, *o * inv);
+        }
+        if let Some(dv) = dv {
+            let base_dv = &base.velocities.as_ref().expect("checked")[r.clone()];
+            for ((b, o), &v0) in r.clone().zip(dv).zip(base_dv) {
+                let sum = sum_at(b);
+                let none = sum.simd_eq(zero);
+                *o = none.select(v0, *o * none.select(zero, one / sum));
+            }
         }
     }
     // Rotations in planes of 8: nlerp with hemisphere correction against
     // the first layer.
     for &block in &layout.quat_blocks {
-        let get = |d: &[f32x8], c: usize| d[block + c];
-        let q0: [f32x8; 4] = std::array::from_fn(|c| get(&base.values, c));
-        let mut acc = [f32x8::ZERO; 4];
-        let mut vacc = [f32x8::ZERO; 4];
-        let mut sum = f32x8::ZERO;
+        let planes = |d: &[f32x8]| -> [f32x8; 4] {
+            let p = &d[block..block + 4];
+            [p[0], p[1], p[2], p[3]]
+        };
+        let q0 = planes(&base.values);
+        let mut acc = [zero; 4];
+        let mut vacc = [zero; 4];
+        let mut sum = zero;
         for (i, (p, _)) in layers.iter().enumerate() {
-            let qi: [f32x8; 4] = std::array::from_fn(|c| get(&p.values, c));
+            let qi = planes(&p.values);
             let dot = q0[0] * qi[0] + q0[1] * qi[1] + q0[2] * qi[2] + q0[3] * qi[3];
-            let sign = dot.simd_lt(f32x8::ZERO).select(-f32x8::ONE, f32x8::ONE);
-            let w = weight(i, block) * sign;
-            sum += weight(i, block);
+            let sign = dot.simd_lt(zero).select(-one, one);
+            let wi = w_at(i, block);
+            let ws = wi * sign;
+            sum += wi;
             for c in 0..4 {
-                acc[c] += w * qi[c];
-                if with_velocity {
-                    vacc[c] += w * get(p.velocities.as_ref().expect("checked"), c);
+                acc[c] += ws * qi[c];
+            }
+            if with_velocity {
+                let dq = planes(p.velocities.as_ref().expect("checked"));
+                for c in 0..4 {
+                    vacc[c] += ws * dq[c];
                 }
             }
         }
         let len = (acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2] + acc[3] * acc[3]).sqrt();
-        let keep = sum.simd_eq(f32x8::ZERO) | len.simd_eq(f32x8::ZERO);
-        let inv = keep.select(f32x8::ZERO, f32x8::ONE / len);
-        let inv_sum = keep.select(f32x8::ZERO, f32x8::ONE / sum);
-        for c in 0..4 {
-            out.values[block + c] = keep.select(q0[c], acc[c] * inv);
-            if with_velocity {
-                let v0 = get(base.velocities.as_ref().expect("checked"), c);
-                out.velocities.as_mut().expect("checked")[block + c] =
-                    keep.select(v0, vacc[c] * inv_sum);
+        let keep = sum.simd_eq(zero) | len.simd_eq(zero);
+        let inv = keep.select(zero, one / len);
+        let inv_sum = keep.select(zero, one / sum);
+        for (c, o) in out_v[block..block + 4].iter_mut().enumerate() {
+            *o = keep.select(q0[c], acc[c] * inv);
+        }
+        if let Some(dv) = out_dv.as_deref_mut() {
+            let v0 = planes(base.velocities.as_ref().expect("checked"));
+            for (c, o) in dv[block..block + 4].iter_mut().enumerate() {
+                *o = keep.select(v0[c], vacc[c] * inv_sum);
             }
         }
     }
@@ -289,7 +335,7 @@ pub fn add(
         Some(l) if pose.velocities.is_some() => Some((l, reference.velocities.as_ref())),
         _ => None,
     };
-    for b in vector_blocks(&layout) {
+    for b in vector_runs(&layout).flatten() {
         let w = w_at(b);
         pose.values[b] += w * (layer.values[b] - reference.values[b]);
         if let (Some((l, r)), Some(v)) = (vel, pose.velocities.as_mut()) {

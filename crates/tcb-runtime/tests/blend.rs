@@ -164,3 +164,42 @@ fn layers_of_another_clip_with_the_same_layout_blend_others_are_refused() {
     );
     assert_eq!(out.as_slice(), before.as_slice());
 }
+
+/// Velocities blend with the values' weights, masks included: vectors
+/// `sum w_i m_i v_i / sum w_i m_i`, rotations the weighted sum of their
+/// derivatives (signs as the values) over the same sum.
+#[test]
+fn masked_velocities_by_hand() {
+    let clip = clip();
+    let (pos, rot, x) = ["pos", "rot", "x"].map(|n| clip.track(n).unwrap()).into();
+    let mut a = Instance::new(clip.clone(), true);
+    let mut b = Instance::new(clip.clone(), true);
+    a.sample(0.3);
+    b.sample(1.6);
+    let half_pos = BlendMask::new(&clip, |t| if t == pos { 0.5 } else { 1.0 });
+    let all = BlendMask::new(&clip, |_| 1.0);
+    let mut out = a.pose().clone();
+    let (wa, wb) = (0.25f32, 0.75f32);
+    blend(
+        &mut out,
+        &[(a.pose(), wa), (b.pose(), wb)],
+        Some(&[&all, &half_pos]),
+    )
+    .unwrap();
+    let (pa, pb) = (a.pose(), b.pose());
+    let want = (pa.vec3_velocity(pos) * wa + pb.vec3_velocity(pos) * wb * 0.5) / (wa + wb * 0.5);
+    assert!((out.vec3_velocity(pos) - want).abs().max_element() < 1e-5);
+    let want = (pa.scalar_velocity(x) * wa + pb.scalar_velocity(x) * wb) / (wa + wb);
+    assert!((out.scalar_velocity(x) - want).abs() < 1e-5);
+    let sign = pa.quat(rot).dot(pb.quat(rot)).signum();
+    let want = (pa.quat_velocity(rot) * wa + pb.quat_velocity(rot) * wb * sign) / (wa + wb);
+    assert!(
+        (out.quat_velocity(rot) - want).length() < 1e-5,
+        "{} {}",
+        out.quat_velocity(rot),
+        want
+    );
+    // Values too, with the mask.
+    let want = (pa.vec3(pos) * wa + pb.vec3(pos) * wb * 0.5) / (wa + wb * 0.5);
+    assert!((out.vec3(pos) - want).abs().max_element() < 1e-5);
+}
