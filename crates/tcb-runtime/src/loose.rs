@@ -152,26 +152,45 @@ impl LooseLane {
     /// twice, and that key's TI belongs to the segment before).
     #[inline(always)]
     fn segment(&self, ka: usize, kb: usize, step: bool, out: &mut [f32x8], i: usize) {
-        let dim = self.dim;
-        let write = |o: &mut [f32x8], a: [f32; KEY_STRIDE], b: [f32; KEY_STRIDE]| {
+        // One copy per dimension, so that each is straight-line code.
+        match self.dim {
+            1 => self.segment_of::<1>(ka, kb, step, out, i),
+            2 => self.segment_of::<2>(ka, kb, step, out, i),
+            3 => self.segment_of::<3>(ka, kb, step, out, i),
+            _ => self.segment_of::<4>(ka, kb, step, out, i),
+        }
+    }
+
+    #[inline(always)]
+    fn segment_of<const N: usize>(
+        &self,
+        ka: usize,
+        kb: usize,
+        step: bool,
+        out: &mut [f32x8],
+        i: usize,
+    ) {
+        let (a, b): ([[f32; KEY_STRIDE]; N], [[f32; KEY_STRIDE]; N]) = match &self.keys {
+            Keys::F32(k) => (
+                k[ka * N..][..N].try_into().expect("N components"),
+                k[kb * N..][..N].try_into().expect("N components"),
+            ),
+            Keys::U16 { .. } => (
+                std::array::from_fn(|c| self.key(ka * N + c)),
+                std::array::from_fn(|c| self.key(kb * N + c)),
+            ),
+        };
+        let out: &mut [[f32x8; 4]; N] = out
+            .as_chunks_mut::<4>()
+            .0
+            .get_mut(..N)
+            .and_then(|o| o.try_into().ok())
+            .expect("4 planes per component");
+        for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
             o[0].as_mut_array()[i] = a[0];
             o[1].as_mut_array()[i] = b[0];
             o[2].as_mut_array()[i] = a[1];
             o[3].as_mut_array()[i] = if step { 0.0 } else { b[2] };
-        };
-        let out = out.chunks_exact_mut(4).take(dim);
-        match &self.keys {
-            Keys::F32(k) => {
-                let (a, b) = (&k[ka * dim..][..dim], &k[kb * dim..][..dim]);
-                for ((o, &a), &b) in out.zip(a).zip(b) {
-                    write(o, a, b);
-                }
-            }
-            Keys::U16 { .. } => {
-                for (c, o) in out.enumerate() {
-                    write(o, self.key(ka * dim + c), self.key(kb * dim + c));
-                }
-            }
         }
     }
 }
@@ -190,20 +209,27 @@ pub(crate) struct Loose {
     post: Vec<ModeLanes<f64x4>>,
     /// `P_{n-1} - P_0` per block and component plane (offset-repeat).
     delta: Vec<f32x8>,
-    /// Whether any lane of a block has an eased segment.
-    eased: Vec<bool>,
-    /// Component planes in use per block (the widest track's dimension).
-    dims: Vec<usize>,
-    /// Per block, its first plane in the instance's controls
-    /// (`[P0, P1, M0, M1]` per component in use); one more entry, the total.
-    ctl_at: Vec<usize>,
-    /// Per block, the latest first key and the earliest last key of its
-    /// lanes: at times between them every lane is inside its keys.
-    inner: Vec<[f64; 2]>,
+    /// What each frame reads of a block.
+    block: Vec<Block>,
+    /// The instance's controls: planes in all.
+    ctl_planes: usize,
     /// Every `(lane, stored segment)` in the order forward playback needs
     /// them: segment `k + 1` (the post sentinel for the last key) at key
     /// time `t_k`, ordered by that time.
     order: Vec<[u32; 2]>,
+}
+
+/// The constants of one block of 8 loose lanes that every frame reads.
+#[derive(Clone, Debug)]
+struct Block {
+    /// The latest first key and the earliest last key of its lanes: at
+    /// times between them every lane is inside its keys.
+    inner: [f64; 2],
+    /// Whether any lane has an eased segment.
+    eased: bool,
+    /// Its planes in the instance's controls (`[P0, P1, M0, M1]` per
+    /// component in use, the widest track's dimension).
+    ctl: std::ops::Range<usize>,
 }
 
 /// Lane or segment index as stored in [`Loose::order`].
@@ -232,10 +258,7 @@ impl Loose {
             + size_of_val(self.pre.as_slice())
             + size_of_val(self.post.as_slice())
             + size_of_val(self.delta.as_slice())
-            + size_of_val(self.eased.as_slice())
-            + size_of_val(self.dims.as_slice())
-            + size_of_val(self.ctl_at.as_slice())
-            + size_of_val(self.inner.as_slice())
+            + size_of_val(self.block.as_slice())
             + size_of_val(self.order.as_slice())
     }
 
@@ -279,21 +302,19 @@ impl Loose {
             }
         }
         let block_lanes = |b: usize| (8 * b..8 * b + 8).filter_map(lane);
-        let eased = (0..blocks)
-            .map(|b| block_lanes(b).any(|l| l.grid.eases.iter().any(|e| !e.is_none())))
-            .collect();
-        let dims: Vec<usize> = (0..blocks)
-            .map(|b| block_lanes(b).map(|l| l.dim).max().unwrap_or(0))
-            .collect();
-        let mut ctl_at = vec![0];
-        for d in &dims {
-            ctl_at.push(ctl_at[ctl_at.len() - 1] + 4 * d);
-        }
-        let inner = (0..blocks)
+        let mut ctl_planes = 0;
+        let block = (0..blocks)
             .map(|b| {
-                let lo = block_lanes(b).map(first).fold(f64::NEG_INFINITY, f64::max);
-                let hi = block_lanes(b).map(last).fold(f64::INFINITY, f64::min);
-                [lo, hi]
+                let planes = 4 * block_lanes(b).map(|l| l.dim).max().unwrap_or(0);
+                ctl_planes += planes;
+                Block {
+                    inner: [
+                        block_lanes(b).map(first).fold(f64::NEG_INFINITY, f64::max),
+                        block_lanes(b).map(last).fold(f64::INFINITY, f64::min),
+                    ],
+                    eased: block_lanes(b).any(|l| l.grid.eases.iter().any(|e| !e.is_none())),
+                    ctl: ctl_planes - planes..ctl_planes,
+                }
             })
             .collect();
         let mut order: Vec<(f64, u32, u32)> = lanes
@@ -306,11 +327,9 @@ impl Loose {
             .collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         Loose {
-            dims,
-            ctl_at,
-            inner,
+            block,
+            ctl_planes,
             order: order.into_iter().map(|(_, l, s)| [l, s]).collect(),
-            eased,
             lanes,
             blocks,
             out,
@@ -333,22 +352,32 @@ impl Loose {
     }
 }
 
+/// The segments four lanes have loaded.
+#[derive(Clone, Copy, Debug)]
+struct Half {
+    /// Window start and width (`t_{k+1} - t_k`, 1 on sentinels): what
+    /// every frame reads.
+    ws: f64x4,
+    d: f64x4,
+    /// Window end, ease from and to.
+    we: f64x4,
+    from: f64x4,
+    to: f64x4,
+}
+
 /// Per-instance state of the loose tracks: each lane's window, width,
 /// ease, rate and controls, written lane by lane only when a lane crosses a
 /// key and read four or eight lanes at a time; and where forward playback is
 /// in [`Loose::order`].
 #[derive(Clone, Debug)]
 pub(crate) struct LooseState {
-    /// Per half block (4 lanes): window start and width (`t_{k+1} - t_k`,
-    /// 1 on sentinels), what every frame reads.
-    win: Vec<[f64x4; 2]>,
-    /// Per half block: window end, ease from and to.
-    more: Vec<[f64x4; 3]>,
+    /// Per half block (4 lanes): the segments loaded.
+    half: Vec<Half>,
     /// Per block: `1 / D` in f32 per lane, the rate of uneased segments.
     rate: Vec<f32x8>,
     /// Per lane: the stored segment loaded.
     seg: Vec<usize>,
-    /// Per block from `Loose::ctl_at`: `[P0, P1, M0, M1]` per component.
+    /// Per block (`Block::ctl`): `[P0, P1, M0, M1]` per component.
     ctl: Vec<f32x8>,
     /// The next entry of `Loose::order` and its time.
     next: usize,
@@ -365,11 +394,19 @@ impl LooseState {
         // first sample (a seek).
         let halves = lanes / 4;
         LooseState {
-            win: vec![[f64x4::splat(-PAD_SPAN), f64x4::splat(2.0 * PAD_SPAN)]; halves],
-            more: vec![[f64x4::splat(PAD_SPAN), f64x4::ZERO, f64x4::ZERO]; halves],
+            half: vec![
+                Half {
+                    ws: f64x4::splat(-PAD_SPAN),
+                    d: f64x4::splat(2.0 * PAD_SPAN),
+                    we: f64x4::splat(PAD_SPAN),
+                    from: f64x4::ZERO,
+                    to: f64x4::ZERO,
+                };
+                halves
+            ],
             rate: vec![f32x8::ZERO; loose.blocks],
             seg: vec![usize::MAX; lanes],
-            ctl: vec![f32x8::ZERO; loose.ctl_at.last().copied().unwrap_or(0)],
+            ctl: vec![f32x8::ZERO; loose.ctl_planes],
             next: 0,
             next_time: loose.order_time(0),
             last: f64::NAN,
@@ -379,8 +416,14 @@ impl LooseState {
     /// Load stored segment `seg` of lane `l` into its window, ease and
     /// controls (what [`key_pair`] says, without its general match: this runs
     /// each time a lane crosses a key).
-    #[inline]
+    #[inline(never)]
     fn load(&mut self, loose: &Loose, l: usize, seg: usize) {
+        self.load_inline(loose, l, seg);
+    }
+
+    /// [`Self::load`], inlined where forward playback loads.
+    #[inline(always)]
+    fn load_inline(&mut self, loose: &Loose, l: usize, seg: usize) {
         let lane = &loose.lanes[l];
         let t = lane.grid.times.as_slice();
         let n = t.len();
@@ -422,19 +465,18 @@ impl LooseState {
             )
         };
         debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
-        let (h, i) = (l / 4, l % 4);
-        let [w0, w1] = &mut self.win[h];
-        w0.as_mut_array()[i] = ws;
-        w1.as_mut_array()[i] = d;
-        let [m0, m1, m2] = &mut self.more[h];
-        m0.as_mut_array()[i] = we;
-        m1.as_mut_array()[i] = ease.from;
-        m2.as_mut_array()[i] = ease.to;
+        let half = &mut self.half[l / 4];
+        let i = l % 4;
+        half.ws.as_mut_array()[i] = ws;
+        half.d.as_mut_array()[i] = d;
+        half.we.as_mut_array()[i] = we;
+        half.from.as_mut_array()[i] = ease.from;
+        half.to.as_mut_array()[i] = ease.to;
         let (b, i) = (l / 8, l % 8);
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
         self.rate[b].as_mut_array()[i] = (1.0 / d) as f32;
         self.seg[l] = seg;
-        lane.segment(ka, kb, step, &mut self.ctl[loose.ctl_at[b]..], i);
+        lane.segment(ka, kb, step, &mut self.ctl[loose.block[b].ctl.clone()], i);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -486,7 +528,7 @@ impl LooseState {
             // only the last one is loaded.
             let t = &loose.lanes[l].grid.times;
             if t.get(seg).is_none_or(|&end| time < end) {
-                self.load(loose, l, seg);
+                self.load_inline(loose, l, seg);
             }
             self.next += 1;
             self.next_time = loose.order_time(self.next);
@@ -544,7 +586,7 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
 /// Reload the lanes of half block `i` whose window does not hold `tm`.
 #[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
-    let ok = st.win[i][0].simd_le(tm) & tm.simd_lt(st.more[i][0]);
+    let ok = st.half[i].ws.simd_le(tm) & tm.simd_lt(st.half[i].we);
     let stale = !ok.to_bitmask() & 0xf;
     if stale != 0 {
         load_stale(loose, st, i, tm, stale);
@@ -565,28 +607,26 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
     }
 }
 
-/// `s` and the rate of block `b` when every lane is inside its keys,
-/// `t_0 <= time < t_{n-1}`, and so (after [`LooseState::advance`]) inside
-/// the segment it holds: `u` and the ease, nothing else.
+/// `s` and the rate of a block (its two halves, its rates of uneased
+/// segments) when every lane is inside its keys, `t_0 <= time < t_{n-1}`,
+/// and so (after [`LooseState::advance`]) inside the segment it holds: `u`
+/// and the ease, nothing else.
 #[inline(always)]
-fn inside(loose: &Loose, st: &LooseState, b: usize, time: f64) -> (f32x8, f32x8) {
+fn inside(eased: bool, half: &[Half; 2], rate: f32x8, time: f64) -> (f32x8, f32x8) {
     let t = f64x4::splat(time);
-    let [w0, w1] = [st.win[2 * b], st.win[2 * b + 1]];
     debug_assert!(
-        (0..2).all(|h| (st.win[2 * b + h][0].simd_le(t) & t.simd_lt(st.more[2 * b + h][0])).all())
+        half.iter()
+            .all(|h| (h.ws.simd_le(t) & t.simd_lt(h.we)).all())
     );
     // `t - ws` is at least 0 and at most `we - ws = D`, so `u` is already
     // within the [0, 1] the reference clamps it to.
-    let u = [(t - w0[0]) / w0[1], (t - w1[0]) / w1[1]];
-    if loose.eased[b] {
-        let e = [0, 1].map(|h| {
-            let m = &st.more[2 * b + h];
-            ease(u[h], m[1], m[2])
-        });
-        let rate = [e[0].1 / w0[1], e[1].1 / w1[1]];
+    let u = half.map(|h| (t - h.ws) / h.d);
+    if eased {
+        let e = [0, 1].map(|i| ease(u[i], half[i].from, half[i].to));
+        let rate = [e[0].1 / half[0].d, e[1].1 / half[1].d];
         (f32x8_of(e[0].0, e[1].0), f32x8_of(rate[0], rate[1]))
     } else {
-        (f32x8_of(u[0], u[1]), st.rate[b])
+        (f32x8_of(u[0], u[1]), rate)
     }
 }
 
@@ -629,11 +669,17 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
     let mut real = [zero; 2];
     for h in 0..2 {
         let i = 2 * b + h;
-        let ([ws, d], [we, a, e]) = (st.win[i], st.more[i]);
+        let Half {
+            ws,
+            d,
+            we,
+            from: a,
+            to: e,
+        } = st.half[i];
         let is_real =
             ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
         let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
-        let (ss, dsdu) = if loose.eased[b] {
+        let (ss, dsdu) = if loose.block[b].eased {
             ease(u, a, e)
         } else {
             (u, one)
@@ -676,15 +722,18 @@ pub(crate) fn sample(
     st: &mut LooseState,
     time: f64,
     values: &mut [f32x8],
-    mut velocities: Option<&mut [f32x8]>,
+    velocities: Option<&mut [f32x8]>,
 ) {
     st.advance(loose, time);
-    for b in 0..loose.blocks {
-        let [lo, hi] = loose.inner[b];
-        let out = loose.out + 4 * b..loose.out + 4 * b + 4;
-        if time >= lo && time < hi {
-            let (s, rate) = inside(loose, st, b, time);
-            let ctl = &st.ctl[loose.ctl_at[b]..loose.ctl_at[b + 1]];
+    let planes = loose.out..loose.out + 4 * loose.blocks;
+    let values = &mut values[planes.clone()];
+    let mut velocities = velocities.map(|v| &mut v[planes]);
+    for (b, info) in loose.block.iter().enumerate() {
+        let out = 4 * b..4 * b + 4;
+        if time >= info.inner[0] && time < info.inner[1] {
+            let half = st.half[2 * b..2 * b + 2].try_into().expect("two halves");
+            let (s, rate) = inside(info.eased, half, st.rate[b], time);
+            let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
                 *o = hermite(&h, k[0], k[1], k[2], k[3]);
@@ -698,7 +747,7 @@ pub(crate) fn sample(
             continue;
         }
         let rows = rows_mapped(loose, st, b, time, velocities.is_some());
-        let ctl = &st.ctl[loose.ctl_at[b]..loose.ctl_at[b + 1]];
+        let ctl = &st.ctl[info.ctl.clone()];
         for (c, k) in ctl.chunks_exact(4).enumerate() {
             let mut v = hermite(&rows.h, k[0], k[1], k[2], k[3]);
             if rows.any_cycles {
