@@ -365,18 +365,25 @@ struct Half {
     to: f64x4,
 }
 
+/// The segments the 8 lanes of a block have loaded, as every frame reads them.
+#[derive(Clone, Copy, Debug)]
+struct BlockState {
+    /// Lanes 0-3 and 4-7.
+    half: [Half; 2],
+    /// `1 / D` in f32 per lane, the rate of uneased segments.
+    rate: f32x8,
+    /// The stored segment each lane has loaded.
+    seg: [usize; 8],
+}
+
 /// Per-instance state of the loose tracks: each lane's window, width,
 /// ease, rate and controls, written lane by lane only when a lane crosses a
 /// key and read four or eight lanes at a time; and where forward playback is
 /// in [`Loose::order`].
 #[derive(Clone, Debug)]
 pub(crate) struct LooseState {
-    /// Per half block (4 lanes): the segments loaded.
-    half: Vec<Half>,
-    /// Per block: `1 / D` in f32 per lane, the rate of uneased segments.
-    rate: Vec<f32x8>,
-    /// Per lane: the stored segment loaded.
-    seg: Vec<usize>,
+    /// Per block: the segments its lanes have loaded.
+    block: Vec<BlockState>,
     /// Per block (`Block::ctl`): `[P0, P1, M0, M1]` per component.
     ctl: Vec<f32x8>,
     /// The next entry of `Loose::order` and its time.
@@ -388,24 +395,23 @@ pub(crate) struct LooseState {
 
 impl LooseState {
     pub fn new(loose: &Loose) -> Self {
-        let lanes = loose.blocks * 8;
         // Every lane starts on a window spanning all time with zero
         // controls: padding lanes keep it, real lanes are loaded by the
         // first sample (a seek).
-        let halves = lanes / 4;
+        let half = Half {
+            ws: f64x4::splat(-PAD_SPAN),
+            d: f64x4::splat(2.0 * PAD_SPAN),
+            we: f64x4::splat(PAD_SPAN),
+            from: f64x4::ZERO,
+            to: f64x4::ZERO,
+        };
+        let block = BlockState {
+            half: [half; 2],
+            rate: f32x8::ZERO,
+            seg: [usize::MAX; 8],
+        };
         LooseState {
-            half: vec![
-                Half {
-                    ws: f64x4::splat(-PAD_SPAN),
-                    d: f64x4::splat(2.0 * PAD_SPAN),
-                    we: f64x4::splat(PAD_SPAN),
-                    from: f64x4::ZERO,
-                    to: f64x4::ZERO,
-                };
-                halves
-            ],
-            rate: vec![f32x8::ZERO; loose.blocks],
-            seg: vec![usize::MAX; lanes],
+            block: vec![block; loose.blocks],
             ctl: vec![f32x8::ZERO; loose.ctl_planes],
             next: 0,
             next_time: loose.order_time(0),
@@ -465,17 +471,18 @@ impl LooseState {
             )
         };
         debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
-        let half = &mut self.half[l / 4];
-        let i = l % 4;
-        half.ws.as_mut_array()[i] = ws;
-        half.d.as_mut_array()[i] = d;
-        half.we.as_mut_array()[i] = we;
-        half.from.as_mut_array()[i] = ease.from;
-        half.to.as_mut_array()[i] = ease.to;
         let (b, i) = (l / 8, l % 8);
+        let block = &mut self.block[b];
+        let half = &mut block.half[i / 4];
+        let j = i % 4;
+        half.ws.as_mut_array()[j] = ws;
+        half.d.as_mut_array()[j] = d;
+        half.we.as_mut_array()[j] = we;
+        half.from.as_mut_array()[j] = ease.from;
+        half.to.as_mut_array()[j] = ease.to;
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
-        self.rate[b].as_mut_array()[i] = (1.0 / d) as f32;
-        self.seg[l] = seg;
+        block.rate.as_mut_array()[i] = (1.0 / d) as f32;
+        block.seg[i] = seg;
         lane.segment(ka, kb, step, &mut self.ctl[loose.block[b].ctl.clone()], i);
     }
 
@@ -544,7 +551,7 @@ impl LooseState {
         });
         self.next_time = loose.order_time(self.next);
         for (l, lane) in loose.lanes.iter().enumerate() {
-            let seg = Self::segment_for(lane, self.seg[l], time);
+            let seg = Self::segment_for(lane, self.block[l / 8].seg[l % 8], time);
             self.load(loose, l, seg);
         }
     }
@@ -586,7 +593,8 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
 /// Reload the lanes of half block `i` whose window does not hold `tm`.
 #[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
-    let ok = st.half[i].ws.simd_le(tm) & tm.simd_lt(st.half[i].we);
+    let half = &st.block[i / 2].half[i % 2];
+    let ok = half.ws.simd_le(tm) & tm.simd_lt(half.we);
     let stale = !ok.to_bitmask() & 0xf;
     if stale != 0 {
         load_stale(loose, st, i, tm, stale);
@@ -601,7 +609,8 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
         stale &= stale - 1;
         let l = 4 * i + k;
         if l < loose.lanes.len() {
-            let seg = LooseState::segment_for(&loose.lanes[l], st.seg[l], tm.to_array()[k]);
+            let current = st.block[l / 8].seg[l % 8];
+            let seg = LooseState::segment_for(&loose.lanes[l], current, tm.to_array()[k]);
             st.load(loose, l, seg);
         }
     }
@@ -668,14 +677,13 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
     let mut rate = [zero; 2];
     let mut real = [zero; 2];
     for h in 0..2 {
-        let i = 2 * b + h;
         let Half {
             ws,
             d,
             we,
             from: a,
             to: e,
-        } = st.half[i];
+        } = st.block[b].half[h];
         let is_real =
             ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
         let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
@@ -731,8 +739,8 @@ pub(crate) fn sample(
     for (b, info) in loose.block.iter().enumerate() {
         let out = 4 * b..4 * b + 4;
         if time >= info.inner[0] && time < info.inner[1] {
-            let half = st.half[2 * b..2 * b + 2].try_into().expect("two halves");
-            let (s, rate) = inside(info.eased, half, st.rate[b], time);
+            let block = &st.block[b];
+            let (s, rate) = inside(info.eased, &block.half, block.rate, time);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
