@@ -319,7 +319,7 @@ impl KeyCache {
 /// Keys `ka` and `kb` (`n` vectors each) of a group's controls: slices of
 /// the f32 storage, or, when quantized, expanded into the cache (only the
 /// keys it does not hold yet).
-#[inline]
+#[inline(always)]
 fn keys<'a>(
     plain: &'a [f32x8],
     quantized: Option<&Quantized>,

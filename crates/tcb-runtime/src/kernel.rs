@@ -24,7 +24,11 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
 /// [`tcb_core::basis::hermite`] itself.
 #[inline]
 pub(crate) fn vectors(a: &[f32x8], b: &[f32x8], h: &[f32x8; 4], out: &mut [f32x8]) {
-    let keys = a.chunks_exact(KEY_STRIDE).zip(b.chunks_exact(KEY_STRIDE));
+    let keys = a
+        .as_chunks::<KEY_STRIDE>()
+        .0
+        .iter()
+        .zip(b.as_chunks::<KEY_STRIDE>().0);
     for ((a, b), o) in keys.zip(out) {
         *o = hermite(h, a[0], b[0], a[1], b[2]);
     }
@@ -39,7 +43,11 @@ pub(crate) fn vector_velocities(
     rate: f32x8,
     out: &mut [f32x8],
 ) {
-    let keys = a.chunks_exact(KEY_STRIDE).zip(b.chunks_exact(KEY_STRIDE));
+    let keys = a
+        .as_chunks::<KEY_STRIDE>()
+        .0
+        .iter()
+        .zip(b.as_chunks::<KEY_STRIDE>().0);
     for ((a, b), o) in keys.zip(out) {
         *o = hermite(dh, a[0], b[0], a[1], b[2]) * rate;
     }
@@ -63,23 +71,52 @@ pub(crate) fn hermite_quats(
     dh: &[f32x8; 4],
     rate: f32x8,
     out: &mut [f32x8],
-    mut vel: Option<&mut [f32x8]>,
+    vel: Option<&mut [f32x8]>,
 ) {
-    let keys = a.chunks_exact(HQ_STRIDE).zip(b.chunks_exact(HQ_STRIDE));
-    for (i, (a, b)) in keys.enumerate() {
-        let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, a[c], b[c], a[4 + c], b[8 + c]));
-        let dp = vel
-            .is_some()
-            .then(|| std::array::from_fn(|c| hermite(dh, a[c], b[c], a[4 + c], b[8 + c]) * rate));
-        let (q, qv) = normalize(p, dp);
-        out[4 * i..4 * i + 4].copy_from_slice(&q);
-        if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
-            vel[4 * i..4 * i + 4].copy_from_slice(&qv);
+    let keys = a
+        .as_chunks::<HQ_STRIDE>()
+        .0
+        .iter()
+        .zip(b.as_chunks::<HQ_STRIDE>().0);
+    let out = out.as_chunks_mut::<4>().0;
+    // One loop with velocities and one without, the block written once.
+    match vel {
+        None => {
+            for ((a, b), o) in keys.zip(out) {
+                hermite_quat_block(a, b, h, None, o, None);
+            }
         }
-        if !in_range(&p) {
-            let v = vel.as_deref_mut().map(|v| &mut v[4 * i..4 * i + 4]);
-            renormalize_scaled(&p, dp.as_ref(), &mut out[4 * i..4 * i + 4], v);
+        Some(vel) => {
+            let vel = vel.as_chunks_mut::<4>().0;
+            for (((a, b), o), v) in keys.zip(out).zip(vel) {
+                hermite_quat_block(a, b, h, Some((dh, rate)), o, Some(v));
+            }
         }
+    }
+}
+
+/// One block of [`hermite_quats`]: 8 rotations.
+#[inline(always)]
+fn hermite_quat_block(
+    a: &[f32x8; HQ_STRIDE],
+    b: &[f32x8; HQ_STRIDE],
+    h: &[f32x8; 4],
+    dh: Option<(&[f32x8; 4], f32x8)>,
+    out: &mut [f32x8; 4],
+    vel: Option<&mut [f32x8; 4]>,
+) {
+    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, a[c], b[c], a[4 + c], b[8 + c]));
+    let dp = dh.map(|(dh, rate)| {
+        std::array::from_fn(|c| hermite(dh, a[c], b[c], a[4 + c], b[8 + c]) * rate)
+    });
+    let (q, qv) = normalize(p, dp);
+    *out = q;
+    let mut vel = vel;
+    if let (Some(v), Some(qv)) = (vel.as_deref_mut(), qv) {
+        *v = qv;
+    }
+    if !in_range(&p) {
+        renormalize_scaled(&p, dp.as_ref(), out, vel.map(|v| v.as_mut_slice()));
     }
 }
 
@@ -116,21 +153,31 @@ pub(crate) fn renormalize_scaled(
 
 /// [`normalize`] in place over blocks of 4 planes (rotations sampled as
 /// loose lanes: the curve and its derivative, then normalized).
-pub(crate) fn normalize_blocks(values: &mut [f32x8], mut vel: Option<&mut [f32x8]>) {
-    for (b, v) in values.chunks_exact_mut(4).enumerate() {
-        let p: [f32x8; 4] = [v[0], v[1], v[2], v[3]];
-        let dp = vel
-            .as_deref()
-            .map(|d| [d[4 * b], d[4 * b + 1], d[4 * b + 2], d[4 * b + 3]]);
-        let (q, qv) = normalize(p, dp);
-        v.copy_from_slice(&q);
-        if let (Some(vel), Some(qv)) = (vel.as_deref_mut(), qv) {
-            vel[4 * b..4 * b + 4].copy_from_slice(&qv);
+pub(crate) fn normalize_blocks(values: &mut [f32x8], vel: Option<&mut [f32x8]>) {
+    let values = values.as_chunks_mut::<4>().0;
+    match vel {
+        None => values.iter_mut().for_each(|v| normalize_block(v, None)),
+        Some(vel) => {
+            let vel = vel.as_chunks_mut::<4>().0;
+            for (v, d) in values.iter_mut().zip(vel) {
+                normalize_block(v, Some(d));
+            }
         }
-        if !in_range(&p) {
-            let dv = vel.as_deref_mut().map(|d| &mut d[4 * b..4 * b + 4]);
-            renormalize_scaled(&p, dp.as_ref(), v, dv);
-        }
+    }
+}
+
+/// One block of [`normalize_blocks`].
+#[inline(always)]
+fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
+    let p = *v;
+    let dp = vel.as_deref().copied();
+    let (q, qv) = normalize(p, dp);
+    *v = q;
+    if let (Some(d), Some(qv)) = (vel.as_deref_mut(), qv) {
+        *d = qv;
+    }
+    if !in_range(&p) {
+        renormalize_scaled(&p, dp.as_ref(), v, vel.map(|d| d.as_mut_slice()));
     }
 }
 
