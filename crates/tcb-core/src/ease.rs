@@ -41,6 +41,7 @@ impl SegmentEase {
     }
 
     /// No easing on this segment.
+    #[inline]
     pub fn is_none(&self) -> bool {
         self.from == 0.0 && self.to == 0.0
     }
@@ -54,6 +55,7 @@ impl SegmentEase {
     /// assert_eq!(e.apply(0.5).0, 1.0 / 3.0);
     /// assert_eq!(e.apply(1.0).0, 1.0);
     /// ```
+    #[inline]
     pub fn apply(&self, u: f64) -> (f64, f64) {
         if self.is_none() {
             return (u, 1.0); // what `ease` selects for no ease, without the rest

@@ -64,6 +64,7 @@ pub enum Mapped {
 /// // m = 1 (odd): backwards from t_{n-1}
 /// assert_eq!(m, Mapped::Inside { time: 0.5, direction: -1.0, cycles: 0.0 });
 /// ```
+#[inline]
 pub fn map_time(time: f64, t0: f64, tn: f64, pre: Extrapolation, post: Extrapolation) -> Mapped {
     // Inside the keys `map_lanes` passes the time through unchanged; say so
     // without computing every mode's answer (one lane has nothing to share).

@@ -110,11 +110,40 @@ impl TimeGrid {
         cursor.0
     }
 
+    /// Stored segment, eased `s`, rate (times `dir`) and whether it is
+    /// `step`, for a `time` inside the keys (`t_0 <= time < t_{n-1}`).
+    #[inline(always)]
+    fn real(&self, time: f64, cursor: &mut Cursor, dir: f32) -> (usize, f64, f32, bool) {
+        let k = self.locate(time, cursor);
+        let d = self.times[k + 1] - self.times[k];
+        let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
+        let (eased, ds_du) = self.ease(k).apply(u);
+        (k + 1, eased, (ds_du / d) as f32 * dir, self.is_step(k))
+    }
+
     /// The basis for `time` (any f64), advancing `cursor`.
     #[inline]
     pub fn frame(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
         let n = self.times.len();
         let (t0, tn) = (self.times[0], self.times[n - 1]);
+        // Most frames are inside the keys, where every mode passes the time
+        // through (`map_time`'s own first answer): the rows of a real
+        // segment, the table below with its other rows known to be off.
+        if t0 <= time && time < tn {
+            let (segment, s, rate, step) = self.real(time, cursor, 1.0);
+            let (h, dh, rate) = sentinel_rows(
+                true, false, false, false, step, s as f32, rate, 1.0, 0.0, true,
+            );
+            return FrameBasis {
+                segment,
+                s,
+                h,
+                dh,
+                rate,
+                cycles: 0.0,
+                reset: false,
+            };
+        }
         // Which row of the table (module docs), and the stored segment.
         let (mut real, mut line, mut reset, mut hold, mut step) =
             (false, false, false, false, false);
@@ -130,13 +159,10 @@ impl TimeGrid {
                 if time >= tn {
                     n
                 } else {
-                    let k = self.locate(time, cursor);
-                    let d = self.times[k + 1] - self.times[k];
-                    let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
-                    let (eased, ds_du) = self.ease(k).apply(u);
-                    (real, step, s) = (true, self.is_step(k), eased);
-                    rate = (ds_du / d) as f32 * dir;
-                    k + 1
+                    let segment;
+                    (segment, s, rate, step) = self.real(time, cursor, dir);
+                    real = true;
+                    segment
                 }
             }
             Mapped::Hold { last } => {
