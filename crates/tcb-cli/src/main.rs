@@ -598,11 +598,12 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     }
     writeln!(
         out,
-        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation segment(s) evaluated exactly (f64 squad)",
+        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation segment(s) evaluated exactly (f64 squad; {} of them only when velocities are sampled)",
         stats.grids.len(),
         stats.loose_vector_tracks,
         stats.loose_rotation_tracks,
-        stats.exact_segments
+        stats.exact_segments,
+        stats.exact_for_velocity_only
     )?;
     for (i, g) in stats.grids.iter().enumerate() {
         writeln!(

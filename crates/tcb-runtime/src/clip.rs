@@ -72,6 +72,9 @@ pub struct ClipStats {
     /// Rotation segments (per track) evaluated exactly, in f64 squad,
     /// because the compiled cubic would miss the reference there.
     pub exact_segments: usize,
+    /// Of those, the segments whose cubic misses only the velocity: an
+    /// instance without velocities takes the cubic there.
+    pub exact_for_velocity_only: usize,
     /// [`Clip::memory_bytes`].
     pub bytes: usize,
     /// [`Clip::bytes_per_frame`].
@@ -104,11 +107,16 @@ pub(crate) struct Group {
 
 /// One rotation block on one stored segment, evaluated exactly: the lanes
 /// of `mask` take squad in f64 from `controls` (two halves of 4 lanes; the
-/// other lanes hold the identity and are not used).
+/// other lanes hold the identity and are not used). The lanes of
+/// `value_mask` are those whose cubic misses the values; the others miss
+/// only the velocities, so an instance without velocities leaves them to
+/// the cubic (and skips entries whose `value_mask` is empty).
 #[derive(Clone, Debug)]
 pub(crate) struct Exact {
     pub block: usize,
     pub mask: f32x8,
+    pub value_mask: f32x8,
+    pub values: bool,
     pub controls: [f64x4; 2 * SQ_STRIDE],
 }
 
@@ -129,9 +137,14 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
                 continue;
             }
             let lane = |l: usize| block.get(l).and_then(|r| r.1.exact[seg]);
-            let mask = f32x8::new(std::array::from_fn(|l| {
-                f32::from_bits(if lane(l).is_some() { u32::MAX } else { 0 })
-            }));
+            let values = |l: usize| lane(l).is_some() && !block[l].1.velocity_only[seg];
+            let mask_of = |f: &dyn Fn(usize) -> bool| {
+                f32x8::new(std::array::from_fn(|l| {
+                    f32::from_bits(if f(l) { u32::MAX } else { 0 })
+                }))
+            };
+            let mask = mask_of(&|l| lane(l).is_some());
+            let value_mask = mask_of(&values);
             let controls = std::array::from_fn(|k| {
                 let (half, j) = (k / SQ_STRIDE, k % SQ_STRIDE);
                 f64x4::new(std::array::from_fn(|l| {
@@ -141,6 +154,8 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
             out.push(Exact {
                 block: b,
                 mask,
+                value_mask,
+                values: value_mask.any(),
                 controls,
             });
         }
@@ -342,6 +357,9 @@ pub(crate) fn key_pair(grid: &TimeGrid, seg: usize) -> (usize, usize) {
 struct RotationControls {
     comps: Vec<Controls>,
     exact: Vec<Option<[f64; SQ_STRIDE]>>,
+    /// Per stored segment: its cubic holds the values, and misses only
+    /// the velocities (meaningful where `exact` is set).
+    velocity_only: Vec<bool>,
 }
 
 /// Largest rotation component error the compiled cubic may have (the
@@ -368,6 +386,7 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         None => vec![vec![[0.0; 4]; n + 1]; 4],
     };
     let mut exact = vec![None; n + 1];
+    let mut velocity_only = vec![false; n + 1];
     let squad = t.squad_segments();
     for k in 0..n - 1 {
         let c = match squad {
@@ -388,8 +407,10 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
             comp[k + 1] = ctl[i];
         }
         let max_rate = 2.0 / (t.times()[k + 1] - t.times()[k]);
-        if !cubic_holds(&c, &ctl, max_rate, (0.0, 1.0)) {
+        let holds = cubic_holds(&c, &ctl, max_rate, (0.0, 1.0));
+        if !holds.both() {
             exact[k + 1] = Some(c);
+            velocity_only[k + 1] = holds.values;
         }
     }
     // Sentinels: hold the end keys; the post one carries the velocity
@@ -402,7 +423,11 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         let arrive = finite_f32(f64::from(comp[n - 1][3]) * f64::from(end_rate));
         comp[n] = [last[i] as f32, last[i] as f32, 0.0, arrive];
     }
-    RotationControls { comps, exact }
+    RotationControls {
+        comps,
+        exact,
+        velocity_only,
+    }
 }
 
 /// How much normalizing can grow an error of a rotation's cubic:
@@ -416,7 +441,7 @@ fn normalize_gain(rot: &RotationControls) -> f32 {
     let n = rot.comps[0].len();
     let mut least = 1.0f32;
     for s in 1..n - 1 {
-        if rot.exact[s].is_some() {
+        if rot.exact[s].is_some() && !rot.velocity_only[s] {
             continue; // evaluated exactly, not as this cubic
         }
         for j in 0..=32 {
@@ -446,17 +471,35 @@ fn finite_f32(x: f64) -> f32 {
     }
 }
 
+/// What [`cubic_holds`] found.
+#[derive(Clone, Copy, Debug)]
+struct Holds {
+    values: bool,
+    velocities: bool,
+}
+
+impl Holds {
+    fn both(self) -> bool {
+        self.values && self.velocities
+    }
+}
+
 /// Whether the normalized cubic `ctl` (per component `[P0, P1, M0, M1]`,
 /// evaluated as the kernel does, in f32) follows the squad `c` from `s = a`
-/// to `b` within [`CUBIC_VALUE_TOL`] and [`CUBIC_VELOCITY_TOL`] at 17 points.
+/// to `b` within [`CUBIC_VALUE_TOL`] and [`CUBIC_VELOCITY_TOL`] at 17
+/// points: values and velocities apart.
 fn cubic_holds(
     c: &[f64; SQ_STRIDE],
     ctl: &[[f32; 4]; 4],
     max_rate: f64,
     (a, b): (f64, f64),
-) -> bool {
+) -> Holds {
     use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
-    (0..=16).all(|j| {
+    let mut holds = Holds {
+        values: true,
+        velocities: true,
+    };
+    for j in 0..=16 {
         let s = j as f64 / 16.0;
         let (q, dq) = tcb_core::squad::squad_with_derivative(c, a + (b - a) * s);
         let dq = dq.map(|x| x * (b - a));
@@ -471,11 +514,14 @@ fn cubic_holds(
         let speed = (0..4)
             .map(|i| (dq[i] as f32 * rate).abs())
             .fold(1.0f32, f32::max);
-        (0..4).all(|i| {
-            (a[i] - q[i] as f32).abs() <= CUBIC_VALUE_TOL
-                && ((da[i] - dq[i] as f32) * rate).abs() <= CUBIC_VELOCITY_TOL * speed
-        })
-    })
+        holds.values &= (0..4).all(|i| (a[i] - q[i] as f32).abs() <= CUBIC_VALUE_TOL);
+        holds.velocities &=
+            (0..4).all(|i| ((da[i] - dq[i] as f32) * rate).abs() <= CUBIC_VELOCITY_TOL * speed);
+        if !holds.values && !holds.velocities {
+            break;
+        }
+    }
+    holds
 }
 
 /// A rotation on key times of its own whose segments the cubic misses
@@ -525,7 +571,9 @@ fn split_rotation(grid: &TimeGrid, rot: &RotationControls) -> Option<(TimeGrid, 
                         };
                         [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
                     });
-                    cubic_holds(c, &ctl, 2.0 / (w * (t1 - t0)), (a, b)).then_some(ctl)
+                    cubic_holds(c, &ctl, 2.0 / (w * (t1 - t0)), (a, b))
+                        .both()
+                        .then_some(ctl)
                 })
                 .collect::<Option<Vec<_>>>()
         })?;
@@ -966,6 +1014,12 @@ impl Clip {
                 .iter()
                 .flat_map(|g| &g.exact)
                 .map(|e| e.mask.to_bitmask().count_ones() as usize)
+                .sum(),
+            exact_for_velocity_only: self
+                .groups
+                .iter()
+                .flat_map(|g| &g.exact)
+                .map(|e| (e.mask.to_bitmask() & !e.value_mask.to_bitmask()).count_ones() as usize)
                 .sum(),
             bytes: self.memory_bytes(),
             bytes_per_frame: self.bytes_per_frame(),

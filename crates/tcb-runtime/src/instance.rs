@@ -273,9 +273,17 @@ pub(crate) fn sample_into(
                     None => &[],
                 };
                 for e in exact {
+                    // Without velocities, lanes whose cubic misses only the
+                    // velocity keep the cubic.
+                    let mask = match velocities {
+                        Some(_) => e.mask,
+                        None if e.values => e.value_mask,
+                        None => continue,
+                    };
                     let planes = g.hq_out + 4 * e.block..g.hq_out + 4 * e.block + 4;
                     kernel::exact_quats(
                         e,
+                        mask,
                         f.s,
                         f.rate,
                         &mut values[planes.clone()],

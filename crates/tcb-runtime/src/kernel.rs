@@ -181,7 +181,8 @@ fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
     }
 }
 
-/// The lanes of `e.mask` in one rotation block (4 planes), exactly: squad
+/// The lanes of `mask` (`e.mask`, or `e.value_mask` without velocities) in
+/// one rotation block (4 planes), exactly: squad
 /// in f64 ([`tcb_core::squad`]) at `s`, normalized, velocity times `rate`.
 ///
 /// This runs in f64 (four lanes per [`f64x4`], two halves per block): the
@@ -190,6 +191,7 @@ fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
 #[inline]
 pub(crate) fn exact_quats(
     e: &crate::clip::Exact,
+    mask: f32x8,
     s: f64,
     rate: f32,
     out: &mut [f32x8],
@@ -222,11 +224,11 @@ pub(crate) fn exact_quats(
         }
     }
     for i in 0..4 {
-        out[i] = e.mask.select(f32x8::new(q[i]), out[i]);
+        out[i] = mask.select(f32x8::new(q[i]), out[i]);
     }
     if let Some(vel) = vel {
         for i in 0..4 {
-            vel[i] = e.mask.select(f32x8::new(dq[i]), vel[i]);
+            vel[i] = mask.select(f32x8::new(dq[i]), vel[i]);
         }
     }
 }

@@ -350,15 +350,21 @@ fn describe(data: &TrackData, time: f64) -> String {
 
 fn check_clip(clip: &tcb_core::Clip, seed: u64) {
     let compiled = Arc::new(Clip::compile(clip));
-    let mut inst = Instance::new(compiled, true);
+    let mut inst = Instance::new(compiled.clone(), true);
+    // Without velocities the runtime may take other paths (segments whose
+    // cubic misses only the velocity keep the cubic): values alone.
+    let mut plain = Instance::new(compiled, false);
     let n = clip.channel_count();
     let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
     let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
+    let zeros = vec![0.0; n];
     let mut rng = Rng(seed | 1);
     for time in sample_times(&mut rng, clip) {
         inst.sample(time).write_row(&mut got, Some(&mut got_v));
         clip.sample_into(time, &mut want, Some(&mut want_v));
         assert_rows_match(clip, time, (&got, &got_v), (&want, &want_v));
+        plain.sample(time).write_row(&mut got, None);
+        assert_rows_match(clip, time, (&got, &zeros), (&want, &zeros));
     }
 }
 
@@ -381,7 +387,7 @@ fn edge_channel_counts() {
 #[test]
 fn wild_rotations_stay_within_1e_6() {
     let mut worst = 0.0f32;
-    let (mut exact_segments, mut cubic_segments) = (0, 0);
+    let (mut exact_segments, mut cubic_segments, mut velocity_only) = (0, 0, 0);
     for seed in 0..300u64 {
         let mut rng = Rng(seed * 7919 + 1);
         let t = times(&mut rng, 6);
@@ -410,16 +416,27 @@ fn wild_rotations_stay_within_1e_6() {
         let compiled = Arc::new(Clip::compile(&clip));
         let exact = compiled.stats().exact_segments;
         exact_segments += exact;
+        velocity_only += compiled.stats().exact_for_velocity_only;
         cubic_segments += 5 - exact;
-        let mut inst = Instance::new(compiled, true);
+        let mut inst = Instance::new(compiled.clone(), true);
+        let mut plain = Instance::new(compiled, false);
         let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
         let (mut got_v, mut want_v) = ([0.0f32; 4], [0.0f32; 4]);
-        for i in 0..200 {
-            let time = t[0] - 1.0 + (t[5] - t[0] + 2.0) * i as f64 / 200.0;
-            inst.sample(time).write_row(&mut got, Some(&mut got_v));
-            clip.sample_into(time, &mut want, Some(&mut want_v));
+        let off = |got: &[f32; 4], want: &[f32; 4]| {
             let d = (0..4).map(|c| (got[c] - want[c]).abs()).fold(0.0, f32::max);
             let e = (0..4).map(|c| (got[c] + want[c]).abs()).fold(0.0, f32::max);
+            (d, e)
+        };
+        for i in 0..200 {
+            let time = t[0] - 1.0 + (t[5] - t[0] + 2.0) * i as f64 / 200.0;
+            // Values alone (without velocities the cubic may stand in
+            // where only its velocity misses).
+            plain.sample(time).write_row(&mut got, None);
+            clip.sample_into(time, &mut want, Some(&mut want_v));
+            let (d, e) = off(&got, &want);
+            worst = worst.max(d.min(e));
+            inst.sample(time).write_row(&mut got, Some(&mut got_v));
+            let (d, e) = off(&got, &want);
             worst = worst.max(d.min(e));
             let sign = if d <= e { 1.0 } else { -1.0 };
             for c in 0..4 {
@@ -437,7 +454,40 @@ fn wild_rotations_stay_within_1e_6() {
     // Both the compiled cubic and the exact f64 path were exercised.
     assert!(
         exact_segments > 100 && cubic_segments > 100,
-        "exact {exact_segments}, cubic {cubic_segments}"
+        "exact {exact_segments} ({velocity_only} for velocities only), cubic {cubic_segments}"
+    );
+}
+
+/// Motion-capture-like squad rotations on one 120 fps grid (small turns
+/// between keys): many segments whose cubic holds the values and misses
+/// only the velocity, which an instance without velocities leaves to the
+/// cubic. Both instances against the reference.
+#[test]
+fn dense_squad_without_velocities() {
+    let mut velocity_only = 0;
+    for seed in 0..6u64 {
+        let mut rng = Rng(seed * 131 + 17);
+        let t: Vec<f64> = (0..240).map(|k| k as f64 / 120.0).collect();
+        let s = TrackSettings {
+            rotation: RotationMode::Squad,
+            ..TrackSettings::default()
+        };
+        let tracks = (0..(9 + rng.below(9)))
+            .map(|i| NamedTrack {
+                name: format!("q{i}"),
+                data: TrackData::Quat(rotation_track_with(&mut rng, &t, &s, 0.05)),
+            })
+            .collect();
+        let clip = tcb_core::Clip {
+            name: "capture".into(),
+            tracks,
+        };
+        velocity_only += Clip::compile(&clip).stats().exact_for_velocity_only;
+        check_clip(&clip, seed);
+    }
+    assert!(
+        velocity_only > 20,
+        "{velocity_only} segments for velocities only"
     );
 }
 
