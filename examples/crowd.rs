@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let end = clip.time_range().map_or(1.0, |r| r.1);
     let clip = Arc::new(Clip::compile(&clip));
     let n = 1000;
-    let mut crowd: Vec<Instance> = (0..n).map(|_| Instance::new(clip.clone(), false)).collect();
+    let mut crowd: Vec<Instance> = (0..n).map(|_| Instance::new(clip.clone())).collect();
     let phases: Vec<f64> = (0..n).map(|i| (i as f64 * 0.618_034 * end) % end).collect();
     let mut times = vec![0.0; n];
     for (name, parallel) in [("one thread", false), ("rayon", true)] {

@@ -46,13 +46,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut characters: Vec<Character> = (0..4)
         .map(|i| {
             Ok(Character {
-                walk: Instance::with_rig(walk.clone(), &rig, false)?,
-                run: Instance::with_rig(run.clone(), &rig, false)?,
+                walk: Instance::with_rig(walk.clone(), &rig)?,
+                run: Instance::with_rig(run.clone(), &rig)?,
                 phase: 1.7 * f64::from(i),
             })
         })
         .collect::<Result<_, tcb_runtime::RigError>>()?;
-    let mut pose = rig.rest_pose(false);
+    let mut pose = rig.rest_pose();
     let mut local = vec![Default::default(); joints];
     let mut model = vec![glam::Affine3A::IDENTITY; joints];
 

@@ -88,8 +88,11 @@ pub fn blend(data: &[u8]) {
     };
     let clip = Arc::new(tcb_runtime::Clip::compile(&clip));
     let velocities = bool::arbitrary(&mut u).unwrap_or(false);
-    let mut a = Instance::new(clip.clone(), velocities);
-    let mut b = Instance::new(clip.clone(), velocities);
+    let make = || {
+        let i = Instance::new(clip.clone());
+        if velocities { i.with_velocities() } else { i }
+    };
+    let (mut a, mut b) = (make(), make());
     let (Ok(ta), Ok(tb)) = (arbitrary_time(&mut u), arbitrary_time(&mut u)) else {
         return;
     };
@@ -98,7 +101,7 @@ pub fn blend(data: &[u8]) {
     let weight = |u: &mut Unstructured| arbitrary_f32(u).unwrap_or(0.5);
     let (wa, wb) = (weight(&mut u), weight(&mut u));
     let mask_weights: Vec<f32> = (0..clip.tracks().len()).map(|_| weight(&mut u)).collect();
-    let mask = BlendMask::new(&clip, |t| mask_weights[t.0]);
+    let mask = BlendMask::new(&clip, |t| mask_weights[t.index()]);
     let layers = [(a.pose(), wa), (b.pose(), wb)];
     tcb_runtime::blend::blend(&mut out, &layers, None).expect("same layout");
     tcb_runtime::blend::blend(&mut out, &layers, Some(&[&mask, &mask])).expect("same layout");
@@ -127,12 +130,12 @@ fn play(clip: &tcb_core::Clip) {
 fn check(clip: &tcb_core::Clip, times: &[f64]) {
     let compiled = Arc::new(tcb_runtime::Clip::compile(clip));
     let n = clip.channel_count();
-    let mut playing = Instance::new(compiled.clone(), true);
+    let mut playing = Instance::new(compiled.clone()).with_velocities();
     let (mut got, mut got_v) = (vec![0.0f32; n], vec![0.0f32; n]);
     let (mut want, mut want_v) = (vec![0.0f32; n], vec![0.0f32; n]);
     for &t in times {
         let pose = playing.sample(t).clone();
-        let mut fresh = Instance::new(compiled.clone(), true);
+        let mut fresh = Instance::new(compiled.clone()).with_velocities();
         assert!(
             same(pose.as_slice(), fresh.sample(t).as_slice()),
             "forward playback differs from a seek at {t}"

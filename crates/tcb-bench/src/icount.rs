@@ -92,15 +92,15 @@ pub fn run_extra(name: &str, bvh: &Path) -> Result<(), Box<dyn std::error::Error
                 Arc::new(tcb_runtime::Clip::compile(&b.clip)),
             );
             println!("bytes: {}", ca.memory_bytes() + cb.memory_bytes());
-            let mut ia = Instance::with_rig(ca, &rig, false)?;
-            let mut ib = Instance::with_rig(cb, &rig, false)?;
+            let mut ia = Instance::with_rig(ca, &rig)?;
+            let mut ib = Instance::with_rig(cb, &rig)?;
             let pairs: Vec<_> = (0..16)
                 .map(|i| {
                     let t = f64::from(i) * 1.3;
                     (ia.sample(t).clone(), ib.sample(t + 0.7).clone())
                 })
                 .collect();
-            let mut out = rig.rest_pose(false);
+            let mut out = rig.rest_pose();
             blend_frames(&pairs, &mut out, 1376);
         }
         _ => {

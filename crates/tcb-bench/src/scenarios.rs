@@ -113,7 +113,7 @@ impl Scenario {
     pub fn instances(&self) -> Vec<Instance> {
         self.phases
             .iter()
-            .map(|_| Instance::new(self.clip.clone(), false))
+            .map(|_| Instance::new(self.clip.clone()))
             .collect()
     }
 

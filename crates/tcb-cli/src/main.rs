@@ -571,7 +571,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
         "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
         "name", "kind", "keys", "first", "last"
     )?;
-    for (i, t) in clip.tracks.iter().enumerate() {
+    for (t, id) in clip.tracks.iter().zip(runtime.layout().ids()) {
         let times = t.data.times();
         let (mode, settings) = match &t.data {
             tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
@@ -592,7 +592,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
             settings.post.name()
         )?;
         if args.quantize {
-            let e = runtime.quantization_error(tcb_runtime::TrackId(i));
+            let e = runtime.quantization_error(id).unwrap_or(0.0);
             writeln!(out, "    quantization error at most {e:e}")?;
         }
     }
@@ -786,7 +786,10 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
         })?;
     } else {
         let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile(&clip));
-        let mut instance = tcb_runtime::Instance::new(runtime, args.velocity);
+        let mut instance = tcb_runtime::Instance::new(runtime);
+        if args.velocity {
+            instance = instance.with_velocities();
+        }
         write_csv(&mut out, &clip, &times, args.velocity, |t, v, d| {
             instance.sample(t).write_row(v, d)
         })?;

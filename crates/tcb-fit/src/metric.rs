@@ -25,7 +25,7 @@ pub fn check_times(clip: &Clip) -> Vec<f64> {
 /// `times`: one row of [`Clip::channel_count`] values per time, concatenated.
 pub fn play(clip: &Arc<tcb_runtime::Clip>, times: &[f64]) -> Vec<f32> {
     let channels = clip.channel_count();
-    let mut instance = Instance::new(clip.clone(), false);
+    let mut instance = Instance::new(clip.clone());
     let mut rows = vec![0.0f32; times.len() * channels];
     for (row, &t) in rows.chunks_exact_mut(channels.max(1)).zip(times) {
         instance.sample(t).write_row(row, None);
@@ -110,8 +110,8 @@ pub fn shell_error(
 ) -> Measured {
     let bind_a = SkeletonBinding::new(skeleton.clone(), reference);
     let bind_b = SkeletonBinding::new(skeleton.clone(), reduced);
-    let mut ia = Instance::new(reference.clone(), false);
-    let mut ib = Instance::new(reduced.clone(), false);
+    let mut ia = Instance::new(reference.clone());
+    let mut ib = Instance::new(reduced.clone());
     let n = skeleton.joints.len();
     let mut local = vec![Transform::IDENTITY; n];
     let (mut ma, mut mb) = (vec![DAffine3::IDENTITY; n], vec![DAffine3::IDENTITY; n]);

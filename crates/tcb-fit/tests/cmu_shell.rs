@@ -96,8 +96,7 @@ fn locals(rig: &Rig, columns: &[String], row: &[f32]) -> Vec<(DVec3, DQuat)> {
 }
 
 fn play(clip: &tcb_core::Clip, times: &[f64]) -> Vec<Vec<f32>> {
-    let mut instance =
-        tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(clip)), false);
+    let mut instance = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(clip)));
     times
         .iter()
         .map(|&t| {

@@ -136,7 +136,7 @@ fn play_with(
     let (a, b) = clip.time_range().unwrap();
     let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(channels));
-    let mut inst = Instance::new(compiled, false);
+    let mut inst = Instance::new(compiled);
     let mut frame = 0u64;
     g.bench_function(BenchmarkId::new("runtime", channels), |bench| {
         bench.iter(|| {
@@ -209,10 +209,10 @@ fn rig_and_blend(c: &mut Criterion) {
     let mut g = c.benchmark_group("rig");
     g.throughput(Throughput::Elements(31));
     let (mut a, mut b) = (
-        Instance::with_rig(compiled.clone(), &rig, false).unwrap(),
-        Instance::with_rig(compiled.clone(), &rig, false).unwrap(),
+        Instance::with_rig(compiled.clone(), &rig).unwrap(),
+        Instance::with_rig(compiled.clone(), &rig).unwrap(),
     );
-    let mut plain = Instance::new(compiled, false);
+    let mut plain = Instance::new(compiled);
     let mut frame = 0u64;
     g.bench_function("sample_plain", |bench| {
         bench.iter(|| {
@@ -228,7 +228,7 @@ fn rig_and_blend(c: &mut Criterion) {
     });
     a.sample(1.0);
     b.sample(2.0);
-    let mut out = rig.rest_pose(false);
+    let mut out = rig.rest_pose();
     g.bench_function("blend_two", |bench| {
         bench.iter(|| blend(&mut out, &[(a.pose(), 0.3), (b.pose(), 0.7)], None).unwrap())
     });

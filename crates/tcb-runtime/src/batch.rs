@@ -10,7 +10,7 @@ use rayon::prelude::*;
 /// # use std::sync::Arc;
 /// # let text = r#"{"format": "tcb-clip/1", "tracks": [{"name": "x", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#;
 /// # let clip = Arc::new(tcb_runtime::Clip::compile(&tcb_io::ClipDoc::parse(text).unwrap().build().unwrap()));
-/// let mut crowd: Vec<_> = (0..100).map(|_| tcb_runtime::Instance::new(clip.clone(), false)).collect();
+/// let mut crowd: Vec<_> = (0..100).map(|_| tcb_runtime::Instance::new(clip.clone())).collect();
 /// let times: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
 /// tcb_runtime::batch::sample_all(&mut crowd, &times);
 /// ```

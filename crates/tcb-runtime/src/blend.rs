@@ -55,7 +55,7 @@ impl BlendMask {
     pub fn for_layout(layout: &Arc<PoseLayout>, weight: impl Fn(TrackId) -> f32) -> Self {
         let mut flat = vec![0.0f32; layout.blocks * 8];
         for (i, slot) in layout.slots.iter().enumerate() {
-            let w = weight(TrackId(i));
+            let w = weight(layout.id(i));
             for &j in &slot.index[..slot.kind.dim()] {
                 flat[j] = w;
             }
@@ -298,14 +298,14 @@ pub fn blend(
 /// # let text = r#"{"format": "tcb-clip/1", "tracks": [{"name": "x", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#;
 /// # let clip = Arc::new(tcb_runtime::Clip::compile(&tcb_io::ClipDoc::parse(text).unwrap().build().unwrap()));
 /// let x = clip.track("x").unwrap();
-/// let mut base = tcb_runtime::Instance::new(clip.clone(), false);
-/// let mut breathe = tcb_runtime::Instance::new(clip.clone(), false);
-/// let mut reference = tcb_runtime::Instance::new(clip.clone(), false);
+/// let mut base = tcb_runtime::Instance::new(clip.clone());
+/// let mut breathe = tcb_runtime::Instance::new(clip.clone());
+/// let mut reference = tcb_runtime::Instance::new(clip.clone());
 /// let mut out = base.sample(0.5).clone();
 /// breathe.sample(0.75);
 /// reference.sample(0.25);
 /// tcb_runtime::blend::add(&mut out, breathe.pose(), reference.pose(), 0.5, None).unwrap();
-/// assert!((out.scalar(x) - (0.5 + 0.5 * (0.75 - 0.25))).abs() < 1e-6);
+/// assert!((out.scalar(x).unwrap() - (0.5 + 0.5 * (0.75 - 0.25))).abs() < 1e-6);
 /// ```
 pub fn add(
     pose: &mut Pose,

@@ -34,19 +34,43 @@ use tcb_core::rotation::RotationTrack;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value};
 use wide::{f32x8, f64x4};
 
-/// Index of a track in its clip (file order).
+/// A track of one pose layout (a clip's, or a [`Rig`](crate::Rig)'s), as
+/// [`Clip::track`], [`PoseLayout::track`] or [`PoseLayout::ids`] give it.
+/// It remembers its layout: a [`crate::Pose`] of another layout answers
+/// `None` to it rather than another track's values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct TrackId(pub usize);
+pub struct TrackId {
+    pub(crate) index: usize,
+    pub(crate) layout: u64,
+}
 
-/// Where a track's components live in a [`crate::Pose`] (flat `f32` indices).
-#[derive(Clone, Debug, PartialEq)]
+impl TrackId {
+    /// Its position in the layout's tracks (file order for a clip).
+    pub fn index(self) -> usize {
+        self.index
+    }
+}
+
+/// A track of a pose layout: its name and kind (and, inside the crate,
+/// where its components live in a [`crate::Pose`]).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct TrackSlot {
-    /// Name from the clip.
-    pub name: String,
-    /// Kind.
-    pub kind: TrackKind,
+    pub(crate) name: String,
+    pub(crate) kind: TrackKind,
     /// Flat index of each component (`kind.dim()` used).
-    pub index: [usize; 4],
+    pub(crate) index: [usize; 4],
+}
+
+impl TrackSlot {
+    /// Name from the clip (or the rig).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Kind.
+    pub fn kind(&self) -> TrackKind {
+        self.kind
+    }
 }
 
 /// One shared key grid of a compiled clip (see [`Clip::stats`]).
@@ -653,7 +677,7 @@ impl Clip {
     ///   {"name": "x", "kind": "vec3", "times": [0, 1], "values": [[0, 0, 0], [1, 2, 3]]}]}"#)
     ///     .unwrap().build().unwrap();
     /// let clip = tcb_runtime::Clip::compile(&clip);
-    /// assert_eq!(clip.track("x").map(|t| t.0), Some(0));
+    /// assert_eq!(clip.track("x").map(|t| t.index()), Some(0));
     /// ```
     pub fn compile(source: &tcb_core::Clip) -> Self {
         Clip::compile_with(source, &CompileOptions::default())
@@ -672,7 +696,7 @@ impl Clip {
     /// let small = tcb_runtime::Clip::compile_with(&source, &options);
     /// assert!(small.memory_bytes() * 3 < plain.memory_bytes() * 2);
     /// let hips = small.track("Hips.translation").unwrap();
-    /// assert!(small.quantization_error(hips) < 1e-3); // in the clip's units
+    /// assert!(small.quantization_error(hips).unwrap() < 1e-3); // in the clip's units
     /// ```
     pub fn compile_with(source: &tcb_core::Clip, options: &CompileOptions) -> Self {
         let mut group_of: HashMap<GridKey, usize> = HashMap::new();
@@ -897,11 +921,7 @@ impl Clip {
         Clip {
             name: source.name.clone(),
             groups,
-            layout: Arc::new(PoseLayout {
-                slots,
-                blocks: at,
-                quat_blocks,
-            }),
+            layout: Arc::new(PoseLayout::new(slots, at, quat_blocks)),
             loose,
             loose_rot,
             loose_rot_tracks,
@@ -942,10 +962,11 @@ impl Clip {
     }
 
     /// The bound on what quantization moves `track`'s samples inside its
-    /// keys, in the track's units (0 for a clip compiled without it); see
-    /// [`crate::quant`].
-    pub fn quantization_error(&self, track: TrackId) -> f32 {
-        self.quant_error.get(track.0).copied().unwrap_or(0.0)
+    /// keys, in the track's units (0 for a clip compiled without it; `None`
+    /// for a track of another layout); see [`crate::quant`].
+    pub fn quantization_error(&self, track: TrackId) -> Option<f32> {
+        self.layout.slot(track)?;
+        Some(self.quant_error.get(track.index).copied().unwrap_or(0.0))
     }
 
     /// First and last key time over all tracks.

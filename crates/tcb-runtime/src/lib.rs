@@ -16,8 +16,8 @@
 //! let ball = clip.track("ball.position").unwrap();
 //!
 //! // Instances: a cursor per time grid and a pose each; no allocation after this.
-//! let mut walk = Instance::new(clip.clone(), false);
-//! let mut run = Instance::new(clip.clone(), false);
+//! let mut walk = Instance::new(clip.clone());
+//! let mut run = Instance::new(clip.clone());
 //! let mut out = walk.pose().clone();
 //!
 //! // Fixed-step loop: sample both, cross-fade.
@@ -28,7 +28,7 @@
 //!     run.sample(t + 0.5);
 //!     let fade = (frame as f32 / 120.0).min(1.0);
 //!     blend(&mut out, &[(walk.pose(), 1.0 - fade), (run.pose(), fade)], None).unwrap();
-//!     let p = out.vec3(ball);
+//!     let p = out.vec3(ball).unwrap(); // None if `ball` were not a vec3 of this clip
 //!     assert!(p.is_finite());
 //! }
 //! ```

@@ -1,22 +1,68 @@
 //! Sampled values in structure-of-arrays form, with typed accessors.
 
 use crate::clip::{Clip, TrackId, TrackSlot};
+use tcb_core::TrackKind;
 
 /// Where every track lives in a pose; shared by a clip and its poses. Poses
 /// can be blended when their layouts are equal.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PoseLayout {
     /// Each track's flat component indices.
-    pub slots: Vec<TrackSlot>,
+    pub(crate) slots: Vec<TrackSlot>,
     /// Total f32x8 blocks.
-    pub blocks: usize,
+    pub(crate) blocks: usize,
     /// First block of each group of 4 blocks holding x, y, z, w planes of 8 rotations.
-    pub quat_blocks: Vec<usize>,
+    pub(crate) quat_blocks: Vec<usize>,
+    /// A digest of the above, carried by every [`TrackId`] of this layout
+    /// (equal layouts have equal keys).
+    pub(crate) key: u64,
 }
+
 impl PoseLayout {
+    pub(crate) fn new(slots: Vec<TrackSlot>, blocks: usize, quat_blocks: Vec<usize>) -> Self {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (&slots, blocks, &quat_blocks).hash(&mut h);
+        PoseLayout {
+            slots,
+            blocks,
+            quat_blocks,
+            key: h.finish(),
+        }
+    }
+
     /// The track called `name`.
     pub fn track(&self, name: &str) -> Option<TrackId> {
-        self.slots.iter().position(|s| s.name == name).map(TrackId)
+        self.slots
+            .iter()
+            .position(|s| s.name == name)
+            .map(|i| self.id(i))
+    }
+
+    /// Every track, in order (file order for a clip).
+    pub fn tracks(&self) -> &[TrackSlot] {
+        &self.slots
+    }
+
+    /// Every track's id, in the order of [`tracks`](Self::tracks).
+    pub fn ids(&self) -> impl Iterator<Item = TrackId> + '_ {
+        (0..self.slots.len()).map(|i| self.id(i))
+    }
+
+    /// The slot of `track`, or `None` for a track of another layout.
+    pub fn slot(&self, track: TrackId) -> Option<&TrackSlot> {
+        if track.layout != self.key {
+            return None;
+        }
+        self.slots.get(track.index)
+    }
+
+    /// The id of track `i` (`i` below the track count).
+    pub(crate) fn id(&self, index: usize) -> TrackId {
+        TrackId {
+            index,
+            layout: self.key,
+        }
     }
 }
 
@@ -36,31 +82,44 @@ pub struct Pose {
 }
 
 macro_rules! accessors {
-    ($($value:ident, $velocity:ident, $t:ty, $n:literal, $make:expr;)+) => {$(
-        #[doc = concat!("The value of a `", stringify!($value), "` track.")]
-        pub fn $value(&self, track: TrackId) -> $t {
-            let a = self.components(&self.values, track);
-            ($make)(a)
+    ($($value:ident, $velocity:ident, $kind:ident, $t:ty, $make:expr;)+) => {$(
+        #[doc = concat!("The value of a `", stringify!($value), "` track; `None` when `track` is of another kind or of another layout.")]
+        pub fn $value(&self, track: TrackId) -> Option<$t> {
+            self.components(&self.values, track, TrackKind::$kind).map($make)
         }
 
-        #[doc = concat!("The d/dt of a `", stringify!($value), "` track (zero without velocities).")]
-        pub fn $velocity(&self, track: TrackId) -> $t {
+        #[doc = concat!("The d/dt of a `", stringify!($value), "` track (zero without velocities); `None` when `track` is of another kind or of another layout.")]
+        pub fn $velocity(&self, track: TrackId) -> Option<$t> {
             match &self.velocities {
-                Some(v) => ($make)(self.components(v, track)),
-                None => ($make)([0.0; 4]),
+                Some(v) => self.components(v, track, TrackKind::$kind).map($make),
+                None => self.components(&self.values, track, TrackKind::$kind).map(|_| ($make)([0.0; 4])),
             }
         }
     )+};
 }
 
 impl Pose {
-    /// A pose for `clip`, with room for velocities if asked.
-    pub fn new(clip: &Clip, velocities: bool) -> Self {
-        let blocks = clip.layout.blocks;
+    /// A pose for `clip` (zeros), without velocities.
+    pub fn new(clip: &Clip) -> Self {
         Pose {
             layout: clip.layout.clone(),
-            values: vec![f32x8::ZERO; blocks],
-            velocities: velocities.then(|| vec![f32x8::ZERO; blocks]),
+            values: vec![f32x8::ZERO; clip.layout.blocks],
+            velocities: None,
+        }
+    }
+
+    /// This pose with room for velocities (zero until sampled), so that
+    /// blending into it carries them.
+    #[must_use]
+    pub fn with_velocities(mut self) -> Self {
+        self.add_velocities();
+        self
+    }
+
+    /// Room for velocities, zero, unless there is already.
+    pub(crate) fn add_velocities(&mut self) {
+        if self.velocities.is_none() {
+            self.velocities = Some(vec![f32x8::ZERO; self.values.len()]);
         }
     }
 
@@ -79,9 +138,15 @@ impl Pose {
         bytemuck::cast_slice(&self.values)
     }
 
-    fn components(&self, data: &[f32x8], track: TrackId) -> [f32; 4] {
+    /// The components of `track` in `data` if it is of this layout and of `kind`.
+    fn components(&self, data: &[f32x8], track: TrackId, kind: TrackKind) -> Option<[f32; 4]> {
+        let slot = self.layout.slot(track).filter(|s| s.kind == kind)?;
+        Some(Self::slot_components(data, slot))
+    }
+
+    /// The components of a slot of this pose's layout.
+    pub(crate) fn slot_components(data: &[f32x8], slot: &TrackSlot) -> [f32; 4] {
         let flat: &[f32] = bytemuck::cast_slice(data);
-        let slot = &self.layout.slots[track.0];
         let mut out = [0.0; 4];
         for (o, &i) in out.iter_mut().zip(&slot.index).take(slot.kind.dim()) {
             *o = flat[i];
@@ -90,11 +155,11 @@ impl Pose {
     }
 
     accessors! {
-        scalar, scalar_velocity, f32, 1, |a: [f32; 4]| a[0];
-        vec2, vec2_velocity, Vec2, 2, |a: [f32; 4]| Vec2::new(a[0], a[1]);
-        vec3, vec3_velocity, Vec3, 3, |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-        vec4, vec4_velocity, Vec4, 4, Vec4::from_array;
-        quat, quat_velocity, Quat, 4, Quat::from_array;
+        scalar, scalar_velocity, Scalar, f32, |a: [f32; 4]| a[0];
+        vec2, vec2_velocity, Vec2, Vec2, |a: [f32; 4]| Vec2::new(a[0], a[1]);
+        vec3, vec3_velocity, Vec3, Vec3, |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        vec4, vec4_velocity, Vec4, Vec4, Vec4::from_array;
+        quat, quat_velocity, Quat, Quat, Quat::from_array;
     }
 
     /// The angular velocity of a rotation track in rad/s, as a vector in
@@ -108,16 +173,16 @@ impl Pose {
     ///   "values": [[0, 0, 0, 1], [0, 0, 0.70710678, 0.70710678]],
     ///   "keys": [{"interp": "linear"}, {"interp": "linear"}]}]}"#;
     /// let clip = Arc::new(tcb_runtime::Clip::compile(&tcb_io::ClipDoc::parse(text).unwrap().build().unwrap()));
-    /// let mut inst = tcb_runtime::Instance::new(clip.clone(), true);
-    /// let w = inst.sample(0.3).angular_velocity(clip.track("r").unwrap());
+    /// let mut inst = tcb_runtime::Instance::new(clip.clone()).with_velocities();
+    /// let w = inst.sample(0.3).angular_velocity(clip.track("r").unwrap()).unwrap();
     /// assert!((w - glam::Vec3::new(0.0, 0.0, std::f32::consts::FRAC_PI_2)).length() < 1e-5);
     /// ```
-    pub fn angular_velocity(&self, track: TrackId) -> Vec3 {
-        let (q, dq) = (self.quat(track), self.quat_velocity(track));
-        Vec3::from_array(tcb_core::quat::angular_velocity(
+    pub fn angular_velocity(&self, track: TrackId) -> Option<Vec3> {
+        let (q, dq) = (self.quat(track)?, self.quat_velocity(track)?);
+        Some(Vec3::from_array(tcb_core::quat::angular_velocity(
             &q.to_array(),
             &dq.to_array(),
-        ))
+        )))
     }
 
     /// Every track's components in file order (the CSV columns of

@@ -23,14 +23,14 @@
 //! let loaded = tcb_io::load(path.as_ref()).unwrap();
 //! let rig = Arc::new(Rig::from_skeleton(loaded.skeleton.as_ref().unwrap()).unwrap());
 //! let clip = Arc::new(Clip::compile(&loaded.clip));
-//! let mut walk = Instance::with_rig(clip.clone(), &rig, false).unwrap();
-//! let mut later = Instance::with_rig(clip, &rig, false).unwrap();
-//! let mut out = rig.rest_pose(false);
+//! let mut walk = Instance::with_rig(clip.clone(), &rig).unwrap();
+//! let mut later = Instance::with_rig(clip, &rig).unwrap();
+//! let mut out = rig.rest_pose();
 //! walk.sample(1.0);
 //! later.sample(2.0);
 //! blend(&mut out, &[(walk.pose(), 0.5), (later.pose(), 0.5)], None).unwrap();
 //! let hips = rig.track("Hips.rotation").unwrap();
-//! assert!((out.quat(hips).length() - 1.0).abs() < 1e-6);
+//! assert!((out.quat(hips).unwrap().length() - 1.0).abs() < 1e-6);
 //! ```
 
 use crate::clip::{Clip, TrackId, TrackSlot};
@@ -163,11 +163,7 @@ impl Rig {
             .map(|c| f32x8::new(c.try_into().expect("8 lanes")))
             .collect();
         Ok(Rig {
-            layout: Arc::new(PoseLayout {
-                slots,
-                blocks: vec_blocks + rot_blocks,
-                quat_blocks,
-            }),
+            layout: Arc::new(PoseLayout::new(slots, vec_blocks + rot_blocks, quat_blocks)),
             tracks,
             rest,
             by_name,
@@ -227,7 +223,7 @@ impl Rig {
 
     /// The rig track called `name`, to read rig poses with.
     pub fn track(&self, name: &str) -> Option<TrackId> {
-        self.by_name.get(name).copied().map(TrackId)
+        self.by_name.get(name).map(|&i| self.layout.id(i))
     }
 
     /// The layout every pose of this rig has.
@@ -235,12 +231,13 @@ impl Rig {
         &self.layout
     }
 
-    /// A pose holding every track's rest value (zero velocities if asked).
-    pub fn rest_pose(&self, velocities: bool) -> Pose {
+    /// A pose holding every track's rest value, without velocities (add
+    /// zero ones with [`Pose::with_velocities`]).
+    pub fn rest_pose(&self) -> Pose {
         Pose {
             layout: self.layout.clone(),
             values: self.rest.clone(),
-            velocities: velocities.then(|| vec![f32x8::ZERO; self.rest.len()]),
+            velocities: None,
         }
     }
 
@@ -341,10 +338,17 @@ mod tests {
             track("p", TrackKind::Vec3, [1.0, 2.0, 3.0, 0.0]),
         ])
         .unwrap();
-        let pose = rig.rest_pose(true);
-        assert_eq!(rig.track("p"), Some(TrackId(1)));
-        assert_eq!(pose.quat(TrackId(0)), glam::Quat::IDENTITY);
-        assert_eq!(pose.vec3(TrackId(1)), glam::Vec3::new(1.0, 2.0, 3.0));
+        let pose = rig.rest_pose().with_velocities();
+        let (r, p) = (rig.track("r").unwrap(), rig.track("p").unwrap());
+        assert_eq!((r.index(), p.index()), (0, 1));
+        assert_eq!(pose.quat(r), Some(glam::Quat::IDENTITY));
+        assert_eq!(pose.vec3(p), Some(glam::Vec3::new(1.0, 2.0, 3.0)));
+        // Of another kind, or of another layout: no answer.
+        assert_eq!(pose.vec3(r), None);
+        assert_eq!(pose.quat(p), None);
+        let other = Rig::new(vec![track("p", TrackKind::Vec3, [0.0; 4])]).unwrap();
+        assert_eq!(pose.vec3(other.track("p").unwrap()), None);
+        assert_eq!(other.rest_pose().vec3(p), None);
         // Padding rotation lanes are the identity.
         let w = pose.as_slice()[rig.layout().quat_blocks[0] * 8 + 24 + 7];
         assert_eq!(w, 1.0);

@@ -20,7 +20,7 @@ use tcb_core::skeleton::{Skeleton, Transform};
 /// let loaded = tcb_io::load(path.as_ref()).unwrap();
 /// let clip = Arc::new(tcb_runtime::Clip::compile(&loaded.clip));
 /// let binding = tcb_runtime::SkeletonBinding::new(loaded.skeleton.unwrap(), &clip);
-/// let mut instance = tcb_runtime::Instance::new(clip, false);
+/// let mut instance = tcb_runtime::Instance::new(clip);
 /// let mut local = vec![Default::default(); binding.skeleton().joints.len()];
 /// let mut model = vec![glam::Affine3A::IDENTITY; local.len()];
 /// binding.model_transforms(instance.sample(1.0), &mut local, &mut model);
@@ -45,7 +45,7 @@ impl SkeletonBinding {
         let find = |name: String, kind: TrackKind| {
             layout
                 .track(&name)
-                .filter(|t| layout.slots[t.0].kind == kind)
+                .filter(|&t| layout.slot(t).is_some_and(|s| s.kind == kind))
         };
         let tracks = skeleton
             .joints
@@ -74,15 +74,21 @@ impl SkeletonBinding {
             .count()
     }
 
-    /// Each joint's transform relative to its parent. `out` has one entry per joint.
+    /// Each joint's transform relative to its parent. `out` has one entry
+    /// per joint. Parts the binding's layout does not animate keep the rest
+    /// transform's, as does everything of a `pose` of another layout.
     #[inline]
     pub fn local_transforms(&self, pose: &Pose, out: &mut [Transform]) {
         for ((joint, tracks), o) in self.skeleton.joints.iter().zip(&self.tracks).zip(out) {
             let rest = &joint.rest;
             *o = Transform {
-                translation: tracks[0].map_or(rest.translation, |t| pose.vec3(t)),
-                rotation: tracks[1].map_or(rest.rotation, |t| pose.quat(t)),
-                scale: tracks[2].map_or(rest.scale, |t| pose.vec3(t)),
+                translation: tracks[0]
+                    .and_then(|t| pose.vec3(t))
+                    .unwrap_or(rest.translation),
+                rotation: tracks[1]
+                    .and_then(|t| pose.quat(t))
+                    .unwrap_or(rest.rotation),
+                scale: tracks[2].and_then(|t| pose.vec3(t)).unwrap_or(rest.scale),
             };
         }
     }

@@ -350,10 +350,10 @@ fn describe(data: &TrackData, time: f64) -> String {
 
 fn check_clip(clip: &tcb_core::Clip, seed: u64) {
     let compiled = Arc::new(Clip::compile(clip));
-    let mut inst = Instance::new(compiled.clone(), true);
+    let mut inst = Instance::new(compiled.clone()).with_velocities();
     // Without velocities the runtime may take other paths (segments whose
     // cubic misses only the velocity keep the cubic): values alone.
-    let mut plain = Instance::new(compiled, false);
+    let mut plain = Instance::new(compiled);
     let n = clip.channel_count();
     let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
     let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
@@ -418,8 +418,8 @@ fn wild_rotations_stay_within_1e_6() {
         exact_segments += exact;
         velocity_only += compiled.stats().exact_for_velocity_only;
         cubic_segments += 5 - exact;
-        let mut inst = Instance::new(compiled.clone(), true);
-        let mut plain = Instance::new(compiled, false);
+        let mut inst = Instance::new(compiled.clone()).with_velocities();
+        let mut plain = Instance::new(compiled);
         let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
         let (mut got_v, mut want_v) = ([0.0f32; 4], [0.0f32; 4]);
         let off = |got: &[f32; 4], want: &[f32; 4]| {
@@ -612,11 +612,11 @@ proptest! {
         let clip = random_clip(seed, channels);
         let compiled = Arc::new(Clip::compile(&clip));
         let (a, b) = clip.time_range().unwrap();
-        let mut playing = Instance::new(compiled.clone(), true);
+        let mut playing = Instance::new(compiled.clone()).with_velocities();
         let frames = ((b - a + 2.0) * fps) as usize;
         for f in 0..frames.min(2000) {
             let t = a - 1.0 + f as f64 / fps;
-            let mut fresh = Instance::new(compiled.clone(), true);
+            let mut fresh = Instance::new(compiled.clone()).with_velocities();
             let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
             prop_assert_eq!(p.as_slice(), q.as_slice());
         }
@@ -654,7 +654,7 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
                 data: TrackData::Quat(track),
             }],
         };
-        let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+        let mut inst = Instance::new(Arc::new(Clip::compile(&clip)));
         let mut want = [0.0f32; 4];
         // A vector track with the same keys' parameters, reset before its
         // keys and held after: bit for bit there, where the reference is
@@ -682,7 +682,7 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
                 data: TrackData::Vec3(v),
             }],
         };
-        let mut vinst = Instance::new(Arc::new(Clip::compile(&vclip)), true);
+        let mut vinst = Instance::new(Arc::new(Clip::compile(&vclip))).with_velocities();
         for time in [-1.0, 3.5, 1e9] {
             let (mut got, mut want) = ([0.0f32; 3], [0.0f32; 3]);
             vinst.sample(time).write_row(&mut got, None);
@@ -743,7 +743,7 @@ fn rotations_with_huge_tangents_stay_unit() {
             data: TrackData::Quat(track),
         }],
     };
-    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), false);
+    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)));
     for time in [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0] {
         let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
         inst.sample(time).write_row(&mut got, None);
@@ -800,7 +800,7 @@ fn mapped_times_rounded_below_the_first_key() {
     };
     assert_eq!(Clip::compile(&clip).loose_track_count(), 1);
     check_clip(&clip, 5);
-    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)), true);
+    let mut inst = Instance::new(Arc::new(Clip::compile(&clip))).with_velocities();
     for time in [6.7080078125, 0.0, -1e10, 15.0] {
         let (mut got, mut got_v) = ([0.0f32; 2], [0.0f32; 2]);
         let (mut want, mut want_v) = ([0.0f32; 2], [0.0f32; 2]);
@@ -821,7 +821,7 @@ fn scrubbing_equals_random_access() {
         let compiled = Arc::new(Clip::compile(&clip));
         let (a, b) = clip.time_range().unwrap();
         let mut rng = Rng(seed | 1);
-        let mut playing = Instance::new(compiled.clone(), true);
+        let mut playing = Instance::new(compiled.clone()).with_velocities();
         let mut t = a - 0.5;
         for _ in 0..400 {
             let r = rng.f(0.0, 1.0);
@@ -838,7 +838,7 @@ fn scrubbing_equals_random_access() {
             } else {
                 [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][rng.below(3)]
             };
-            let mut fresh = Instance::new(compiled.clone(), true);
+            let mut fresh = Instance::new(compiled.clone()).with_velocities();
             let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
             assert_eq!(p.as_slice(), q.as_slice(), "seed {seed}, time {t}");
         }
@@ -884,11 +884,11 @@ fn dense_own_keys_played_at_a_lower_rate() {
         let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
         let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
         for fps in [60.0, 25.0, 7.0] {
-            let mut playing = Instance::new(compiled.clone(), true);
+            let mut playing = Instance::new(compiled.clone()).with_velocities();
             let frames = ((b - a + 0.5) * fps) as usize;
             for f in 0..=frames {
                 let t = a - 0.1 + f as f64 / fps;
-                let mut fresh = Instance::new(compiled.clone(), true);
+                let mut fresh = Instance::new(compiled.clone()).with_velocities();
                 let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
                 assert_eq!(
                     p.as_slice(),
@@ -909,7 +909,7 @@ fn batch_equals_sequential() {
     let clip = Arc::new(Clip::compile(&random_clip(42, 65)));
     let make = || {
         (0..257)
-            .map(|_| Instance::new(clip.clone(), true))
+            .map(|_| Instance::new(clip.clone()).with_velocities())
             .collect::<Vec<_>>()
     };
     let (mut par, mut seq) = (make(), make());
@@ -938,10 +938,7 @@ fn quantized_clips_stay_within_their_stated_bound() {
         assert!(
             small.memory_bytes() <= plain.memory_bytes() || clip.tracks.is_empty() || channels < 8
         );
-        let (mut a, mut b) = (
-            Instance::new(plain, false),
-            Instance::new(small.clone(), false),
-        );
+        let (mut a, mut b) = (Instance::new(plain), Instance::new(small.clone()));
         let n = clip.channel_count();
         let (mut got, mut want) = (vec![0.0; n], vec![0.0; n]);
         let mut rng = Rng(seed | 1);
@@ -953,10 +950,10 @@ fn quantized_clips_stay_within_their_stated_bound() {
             b.sample(time).write_row(&mut got, None);
             a.sample(time).write_row(&mut want, None);
             let mut at = 0;
-            for (i, t) in clip.tracks.iter().enumerate() {
+            for (t, id) in clip.tracks.iter().zip(small.layout().ids()) {
                 let dim = t.data.kind().dim();
                 let (lo, hi) = (t.data.times()[0], *t.data.times().last().unwrap());
-                let bound = small.quantization_error(tcb_runtime::TrackId(i));
+                let bound = small.quantization_error(id).unwrap();
                 if bound > 0.0 {
                     bounded += 1;
                 }
@@ -995,11 +992,11 @@ fn quantized_forward_playback_equals_random_access() {
     for seed in 0..20u64 {
         let clip = random_clip(seed + 77, 9 + seed as usize);
         let small = Arc::new(Clip::compile_with(&clip, &options));
-        let mut playing = Instance::new(small.clone(), true);
+        let mut playing = Instance::new(small.clone()).with_velocities();
         let (t0, tn) = clip.time_range().unwrap();
         for i in 0..300 {
             let t = t0 - 0.5 + (tn - t0 + 1.0) * i as f64 / 300.0;
-            let mut fresh = Instance::new(small.clone(), true);
+            let mut fresh = Instance::new(small.clone()).with_velocities();
             let (p, q) = (playing.sample(t).clone(), fresh.sample(t));
             assert_eq!(p.as_slice(), q.as_slice(), "seed {seed} t={t}");
         }

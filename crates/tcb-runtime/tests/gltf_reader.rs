@@ -225,7 +225,7 @@ fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
     }
     let clip = Arc::new(Clip::compile(&loaded.clip));
     let binding = SkeletonBinding::new(skeleton.clone(), &clip);
-    let mut instance = Instance::new(clip, false);
+    let mut instance = Instance::new(clip);
     let n = skeleton.joints.len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];
@@ -287,7 +287,7 @@ fn threejs_positions_match_skeleton_binding() {
     let skeleton = loaded.skeleton.clone().unwrap();
     let clip = Arc::new(Clip::compile(&loaded.clip));
     let binding = SkeletonBinding::new(skeleton.clone(), &clip);
-    let mut instance = Instance::new(clip, false);
+    let mut instance = Instance::new(clip);
     let n = skeleton.joints.len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];

@@ -16,10 +16,10 @@ fn pose_values_convert_to_mint_and_back() {
     .unwrap();
     let clip = Arc::new(Clip::compile(&clip));
     let (p, r) = (clip.track("p").unwrap(), clip.track("r").unwrap());
-    let mut inst = Instance::new(clip, false);
+    let mut inst = Instance::new(clip);
     let pose = inst.sample(0.5);
-    let v: mint::Vector3<f32> = pose.vec3(p).into();
-    let q: mint::Quaternion<f32> = pose.quat(r).into();
+    let v: mint::Vector3<f32> = pose.vec3(p).unwrap().into();
+    let q: mint::Quaternion<f32> = pose.quat(r).unwrap().into();
     assert_eq!([v.x, v.y, v.z], [1.0, 2.0, 3.0]);
-    assert_eq!(glam::Quat::from(q), pose.quat(r));
+    assert_eq!(glam::Quat::from(q), pose.quat(r).unwrap());
 }

@@ -63,13 +63,14 @@ fn steady_playback_and_blending_allocate_nothing() {
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
     }
     for clip in clips {
-        let mut a = tcb_runtime::Instance::new(clip.clone(), true);
-        let mut b = tcb_runtime::Instance::new(clip.clone(), true);
+        let mut a = tcb_runtime::Instance::new(clip.clone()).with_velocities();
+        let mut b = tcb_runtime::Instance::new(clip.clone()).with_velocities();
         // Playback at the instance: ping-pong at 1.5x, velocities scaled.
         b.set_playback(tcb_runtime::Playback::PingPong, 1.5)
             .unwrap();
         let mut out = a.pose().clone();
-        let mask = tcb_runtime::BlendMask::new(&clip, |t| if t.0 % 2 == 0 { 1.0 } else { 0.25 });
+        let mask =
+            tcb_runtime::BlendMask::new(&clip, |t| if t.index() % 2 == 0 { 1.0 } else { 0.25 });
         // Through a rig (every track, plus one the clip lacks).
         let mut tracks = tcb_runtime::Rig::from_clip(&clip).tracks().to_vec();
         tracks.push(tcb_runtime::RigTrack {
@@ -78,8 +79,10 @@ fn steady_playback_and_blending_allocate_nothing() {
             rest: [0.0, 0.0, 0.0, 1.0],
         });
         let rig = Arc::new(tcb_runtime::Rig::new(tracks).unwrap());
-        let mut r = tcb_runtime::Instance::with_rig(clip.clone(), &rig, true).unwrap();
-        let mut rest = rig.rest_pose(true);
+        let mut r = tcb_runtime::Instance::with_rig(clip.clone(), &rig)
+            .unwrap()
+            .with_velocities();
+        let mut rest = rig.rest_pose().with_velocities();
         r.sample(0.0);
         // Warm up once.
         a.sample(0.0);

@@ -46,10 +46,10 @@ fn every_mode_and_speed_matches_the_clip_at_the_mapped_time() {
         Playback::PingPong,
     ] {
         for speed in [1.0, 2.0, -0.5] {
-            let mut played = Instance::new(clip.clone(), true);
+            let mut played = Instance::new(clip.clone()).with_velocities();
             played.set_playback(mode, speed).unwrap();
             assert_eq!(played.playback(), (mode, speed));
-            let mut plain = Instance::new(clip.clone(), true);
+            let mut plain = Instance::new(clip.clone()).with_velocities();
             let (mut gv, mut gd, mut wv, mut wd) =
                 (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             for &t in &times {
@@ -70,7 +70,7 @@ fn looping_far_from_zero_is_as_exact_as_near_it() {
     let source = tcb_io::ClipDoc::parse(BOUNCE).unwrap().build().unwrap();
     let clip = Arc::new(Clip::compile(&source));
     let (a, b) = clip.time_range().unwrap();
-    let mut inst = Instance::new(clip, false);
+    let mut inst = Instance::new(clip);
     inst.set_playback(Playback::Loop, 1.0).unwrap();
     let n = source.channel_count();
     let (mut near, mut far) = (vec![0.0; n], vec![0.0; n]);
@@ -87,7 +87,7 @@ fn looping_far_from_zero_is_as_exact_as_near_it() {
 #[test]
 fn a_speed_that_is_not_finite_is_refused() {
     let source = tcb_io::ClipDoc::parse(BOUNCE).unwrap().build().unwrap();
-    let mut inst = Instance::new(Arc::new(Clip::compile(&source)), false);
+    let mut inst = Instance::new(Arc::new(Clip::compile(&source)));
     for bad in [f64::NAN, f64::INFINITY] {
         let e = inst.set_playback(Playback::Loop, bad).unwrap_err();
         assert!(e.to_string().contains("not a finite number"), "{e}");

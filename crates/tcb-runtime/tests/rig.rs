@@ -59,7 +59,7 @@ fn reference(rig: &Rig, clip: &tcb_core::Clip, name: &str, time: f64) -> [f64; 4
     let mut v = [0.0f32; 4];
     match clip.tracks.iter().find(|t| t.name == name) {
         Some(t) => t.data.sample_into(time, &mut v, None),
-        None => v = rig.tracks()[rig.track(name).unwrap().0].rest,
+        None => v = rig.tracks()[rig.track(name).unwrap().index()].rest,
     }
     v.map(f64::from)
 }
@@ -90,10 +90,15 @@ fn by_hand(kind: TrackKind, layers: &[([f64; 4], f64)]) -> [f64; 4] {
 }
 
 /// A rig track's value (the skeleton's vector tracks are all vec3).
+/// The id of rig track `i`.
+fn id_of(rig: &Rig, i: usize) -> TrackId {
+    rig.layout().ids().nth(i).unwrap()
+}
+
 fn got(pose: &tcb_runtime::Pose, id: TrackId, kind: TrackKind) -> [f64; 4] {
     let v = match kind {
-        TrackKind::Quat => pose.quat(id).to_array(),
-        _ => pose.vec3(id).extend(0.0).to_array(),
+        TrackKind::Quat => pose.quat(id).unwrap().to_array(),
+        _ => pose.vec3(id).unwrap().extend(0.0).to_array(),
     };
     v.map(f64::from)
 }
@@ -109,10 +114,10 @@ fn distance(kind: TrackKind, a: [f64; 4], b: [f64; 4]) -> f64 {
 #[test]
 fn clips_of_one_rig_cross_fade_as_their_reference_samples_do() {
     let s = setup();
-    let mut ia = Instance::with_rig(s.ca.clone(), &s.rig, false).unwrap();
-    let mut ib = Instance::with_rig(s.cb.clone(), &s.rig, false).unwrap();
+    let mut ia = Instance::with_rig(s.ca.clone(), &s.rig).unwrap();
+    let mut ib = Instance::with_rig(s.cb.clone(), &s.rig).unwrap();
     assert!(Arc::ptr_eq(ia.pose().layout(), ib.pose().layout()));
-    let mut out = s.rig.rest_pose(false);
+    let mut out = s.rig.rest_pose();
     let mask_b = ib.coverage_mask();
     let missing = s.rig.track(MISSING).unwrap();
     let mut worst = 0.0f64;
@@ -127,7 +132,7 @@ fn clips_of_one_rig_cross_fade_as_their_reference_samples_do() {
             let masks = [&all, &mask_b];
             blend(&mut out, &layers, masked.then_some(&masks[..])).unwrap();
             for (i, t) in s.rig.tracks().iter().enumerate() {
-                let wb = if masked && TrackId(i) == missing {
+                let wb = if masked && id_of(&s.rig, i) == missing {
                     0.0
                 } else {
                     fade
@@ -139,12 +144,12 @@ fn clips_of_one_rig_cross_fade_as_their_reference_samples_do() {
                         (reference(&s.rig, &s.b, &t.name, tb), wb),
                     ],
                 );
-                let e = distance(t.kind, got(&out, TrackId(i), t.kind), want);
+                let e = distance(t.kind, got(&out, id_of(&s.rig, i), t.kind), want);
                 assert!(
                     e < 2e-5,
                     "{} at fade {fade} (masked {masked}): {:?} vs {want:?}",
                     t.name,
-                    got(&out, TrackId(i), t.kind)
+                    got(&out, id_of(&s.rig, i), t.kind)
                 );
                 worst = worst.max(e);
             }
@@ -156,12 +161,19 @@ fn clips_of_one_rig_cross_fade_as_their_reference_samples_do() {
 #[test]
 fn additive_layers_match_by_hand_and_carry_velocity() {
     let s = setup();
-    let mut base = Instance::with_rig(s.ca.clone(), &s.rig, true).unwrap();
-    let mut layer = Instance::with_rig(s.cb.clone(), &s.rig, true).unwrap();
+    let mut base = Instance::with_rig(s.ca.clone(), &s.rig)
+        .unwrap()
+        .with_velocities();
+    let mut layer = Instance::with_rig(s.cb.clone(), &s.rig)
+        .unwrap()
+        .with_velocities();
     // A fixed reference pose: no velocities, so a constant.
-    let mut refer = Instance::with_rig(s.cb.clone(), &s.rig, false).unwrap();
+    let mut refer = Instance::with_rig(s.cb.clone(), &s.rig).unwrap();
     let (tr, w) = (0.5, 0.6);
-    let mask = BlendMask::for_layout(s.rig.layout(), |t| if t.0 % 5 == 0 { 0.5 } else { 1.0 });
+    let mask = BlendMask::for_layout(
+        s.rig.layout(),
+        |t| if t.index() % 5 == 0 { 0.5 } else { 1.0 },
+    );
     let run = |base: &mut Instance, layer: &mut Instance, refer: &mut Instance, t: f64| {
         let mut out = base.sample(t).clone();
         layer.sample(t + 0.7);
@@ -187,7 +199,7 @@ fn additive_layers_match_by_hand_and_carry_velocity() {
             } else {
                 std::array::from_fn(|c| a[c] + wm * (l[c] - r[c]))
             };
-            let e = distance(rt.kind, got(&out, TrackId(i), rt.kind), want);
+            let e = distance(rt.kind, got(&out, id_of(&s.rig, i), rt.kind), want);
             assert!(e < 2e-5, "{} at {t}: {e}", rt.name);
         }
         // Velocities: against a central difference of the added pose (mocap
@@ -197,18 +209,18 @@ fn additive_layers_match_by_hand_and_carry_velocity() {
         let after = run(&mut b2, &mut l2, &mut r2, t + h);
         let before = run(&mut b2, &mut l2, &mut r2, t - h);
         for (i, rt) in s.rig.tracks().iter().enumerate() {
-            let id = TrackId(i);
+            let id = id_of(&s.rig, i);
             let (v, fd) = if rt.kind == TrackKind::Quat {
-                let (p, m) = (after.quat(id), before.quat(id));
+                let (p, m) = (after.quat(id).unwrap(), before.quat(id).unwrap());
                 let m = if p.dot(m) < 0.0 { -m } else { m };
-                (out.quat_velocity(id), (p - m) * (0.5 / h as f32))
+                (out.quat_velocity(id).unwrap(), (p - m) * (0.5 / h as f32))
             } else {
-                let fd = (after.vec3(id) - before.vec3(id)) * (0.5 / h as f32);
+                let fd = (after.vec3(id).unwrap() - before.vec3(id).unwrap()) * (0.5 / h as f32);
                 (
                     Quat::from_xyzw(
-                        out.vec3_velocity(id).x,
-                        out.vec3_velocity(id).y,
-                        out.vec3_velocity(id).z,
+                        out.vec3_velocity(id).unwrap().x,
+                        out.vec3_velocity(id).unwrap().y,
+                        out.vec3_velocity(id).unwrap().z,
                         0.0,
                     ),
                     Quat::from_xyzw(fd.x, fd.y, fd.z, 0.0),
@@ -224,13 +236,15 @@ fn additive_layers_match_by_hand_and_carry_velocity() {
 #[test]
 fn angular_velocity_matches_the_turn_between_frames() {
     let s = setup();
-    let mut inst = Instance::with_rig(s.ca.clone(), &s.rig, true).unwrap();
+    let mut inst = Instance::with_rig(s.ca.clone(), &s.rig)
+        .unwrap()
+        .with_velocities();
     let id = s.rig.track("LeftForeArm.rotation").unwrap();
     let h = 1e-4;
     for t in [0.5, 1.0, 2.0] {
-        let w = inst.sample(t).angular_velocity(id);
-        let q1 = inst.sample(t + h).quat(id).as_dquat();
-        let q0 = inst.sample(t - h).quat(id).as_dquat();
+        let w = inst.sample(t).angular_velocity(id).unwrap();
+        let q1 = inst.sample(t + h).quat(id).unwrap().as_dquat();
+        let q0 = inst.sample(t - h).quat(id).unwrap().as_dquat();
         let (axis, angle) = (q1 * q0.conjugate()).to_axis_angle();
         let fd = (axis * angle / (2.0 * h)).as_vec3();
         assert!(
@@ -259,9 +273,9 @@ fn other_rigs_and_unknown_tracks_are_refused() {
             &tcb_io::ClipDoc::parse(&t).unwrap().build().unwrap(),
         ))
     };
-    let err = Instance::with_rig(compile(text("scalar", "blink")), &s.rig, false).err();
+    let err = Instance::with_rig(compile(text("scalar", "blink")), &s.rig).err();
     assert_eq!(err, Some(RigError::NotInRig("blink".into())));
-    let err = Instance::with_rig(compile(text("scalar", "Hips.rotation")), &s.rig, false).err();
+    let err = Instance::with_rig(compile(text("scalar", "Hips.rotation")), &s.rig).err();
     assert_eq!(
         err,
         Some(RigError::Kind {
@@ -273,9 +287,9 @@ fn other_rigs_and_unknown_tracks_are_refused() {
     // A pose of another rig (here: the tracks of clip b, no End Sites or
     // scales) is refused, by blend and by add, and nothing is written.
     let other = Arc::new(Rig::from_clip(&s.cb));
-    let mut ia = Instance::with_rig(s.ca.clone(), &s.rig, false).unwrap();
-    let mut ib = Instance::with_rig(s.cb.clone(), &other, false).unwrap();
-    let mut out = s.rig.rest_pose(false);
+    let mut ia = Instance::with_rig(s.ca.clone(), &s.rig).unwrap();
+    let mut ib = Instance::with_rig(s.cb.clone(), &other).unwrap();
+    let mut out = s.rig.rest_pose();
     let before = out.clone();
     ia.sample(1.0);
     ib.sample(1.0);

@@ -16,7 +16,7 @@ fn cmu_model_space_positions_match_the_bvh() {
     let clip = Arc::new(Clip::compile(&doc.build().unwrap()));
     let binding = SkeletonBinding::new(bvh.skeleton.clone(), &clip);
     assert_eq!(binding.animated_joints(), 31);
-    let mut instance = Instance::new(clip, false);
+    let mut instance = Instance::new(clip);
     let n = bvh.skeleton.joints.len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];
