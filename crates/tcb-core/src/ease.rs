@@ -17,18 +17,23 @@
 
 use crate::lane::Lane;
 
-/// The ease of one segment, normalized so that `from + to <= 1`.
+/// The ease of one segment, normalized so that `from + to <= 1` (its
+/// fields are private so that nothing makes one that is not).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct SegmentEase {
     /// `a`: ease leaving the segment's first key.
-    pub from: f64,
+    from: f64,
     /// `e`: ease arriving at the segment's second key.
-    pub to: f64,
+    to: f64,
 }
 
 impl SegmentEase {
-    /// From `from_k` of the first key and `to_{k+1}` of the second, each in [0, 1].
+    /// From `from_k` of the first key and `to_{k+1}` of the second, each
+    /// taken into [0, 1] (NaN as 0; track building refuses such eases
+    /// before they get here), then normalized.
     pub fn new(from: f64, to: f64) -> Self {
+        let unit = |x: f64| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        let (from, to) = (unit(from), unit(to));
         let sum = from + to;
         if sum > 1.0 {
             SegmentEase {
@@ -38,6 +43,18 @@ impl SegmentEase {
         } else {
             SegmentEase { from, to }
         }
+    }
+
+    /// `a`: ease leaving the segment's first key.
+    #[inline]
+    pub fn from(&self) -> f64 {
+        self.from
+    }
+
+    /// `e`: ease arriving at the segment's second key.
+    #[inline]
+    pub fn to(&self) -> f64 {
+        self.to
     }
 
     /// No easing on this segment.
@@ -103,6 +120,30 @@ mod tests {
         assert_eq!(e.apply(1.0), (1.0, 0.0));
         // Middle speed 2K = 4/3.
         assert!((e.apply(0.5).1 - 4.0 / 3.0).abs() < 1e-15);
+    }
+
+    /// What `new` used to pass through (a public field or argument out of
+    /// [0, 1], NaN) ends up as a normalized ease whose `apply` stays in
+    /// [0, 1].
+    #[test]
+    fn out_of_range_arguments_stay_an_ease() {
+        for (a, e) in [
+            (-1.0, 0.5),
+            (2.0, 3.0),
+            (f64::NAN, 0.2),
+            (0.3, f64::INFINITY),
+        ] {
+            let ease = SegmentEase::new(a, e);
+            assert!((0.0..=1.0).contains(&ease.from()) && (0.0..=1.0).contains(&ease.to()));
+            assert!(ease.from() + ease.to() <= 1.0);
+            for u in [0.0, 0.3, 0.7, 1.0] {
+                let (s, d) = ease.apply(u);
+                assert!(
+                    (0.0..=1.0).contains(&s) && d.is_finite(),
+                    "{a} {e} {u}: {s} {d}"
+                );
+            }
+        }
     }
 
     #[test]

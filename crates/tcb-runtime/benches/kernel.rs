@@ -205,7 +205,7 @@ fn benches(c: &mut Criterion) {
 fn rig_and_blend(c: &mut Criterion) {
     let clip = skeleton(31, 200, RotationMode::Hermite);
     let compiled = Arc::new(Clip::compile(&clip));
-    let rig = Arc::new(Rig::from_clip(&compiled));
+    let rig = Arc::new(Rig::from_clip(&compiled).unwrap());
     let mut g = c.benchmark_group("rig");
     g.throughput(Throughput::Elements(31));
     let (mut a, mut b) = (

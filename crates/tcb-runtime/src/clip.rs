@@ -316,7 +316,7 @@ fn grid_key(g: &TimeGrid) -> GridKey {
         g.times.iter().map(|t| t.to_bits()).collect(),
         g.eases
             .iter()
-            .map(|e| (e.from.to_bits(), e.to.to_bits()))
+            .map(|e| (e.from().to_bits(), e.to().to_bits()))
             .collect(),
         g.steps.clone(),
         g.pre,

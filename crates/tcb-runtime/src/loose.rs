@@ -478,8 +478,8 @@ impl LooseState {
         half.ws.as_mut_array()[j] = ws;
         half.d.as_mut_array()[j] = d;
         half.we.as_mut_array()[j] = we;
-        half.from.as_mut_array()[j] = ease.from;
-        half.to.as_mut_array()[j] = ease.to;
+        half.from.as_mut_array()[j] = ease.from();
+        half.to.as_mut_array()[j] = ease.to();
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
         block.rate.as_mut_array()[i] = (1.0 / d) as f32;
         block.seg[i] = seg;

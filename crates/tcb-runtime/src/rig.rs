@@ -198,8 +198,9 @@ impl Rig {
     }
 
     /// The tracks of `clip`, in file order, resting at zero (rotations at
-    /// the identity).
-    pub fn from_clip(clip: &Clip) -> Self {
+    /// the identity). Fails when two tracks share a name (a hand-built
+    /// `tcb_core::Clip`; the clip file and the importers refuse that).
+    pub fn from_clip(clip: &Clip) -> Result<Self, RigError> {
         let tracks = clip
             .tracks()
             .iter()
@@ -213,7 +214,7 @@ impl Rig {
                 },
             })
             .collect();
-        Rig::new(tracks).expect("a clip's track names are unique")
+        Rig::new(tracks)
     }
 
     /// The tracks, in rig order ([`TrackId`]s of rig poses index them).
@@ -329,6 +330,29 @@ mod tests {
             )])
             .is_ok()
         );
+    }
+
+    /// A hand-built clip with two tracks of one name: `from_clip` used to
+    /// panic on it.
+    #[test]
+    fn a_clip_with_a_repeated_name_is_refused() {
+        let track = |v: f32| tcb_core::NamedTrack {
+            name: "x".into(),
+            data: tcb_core::TrackData::Scalar(
+                tcb_core::Track::new(
+                    vec![0.0, 1.0],
+                    vec![v, v],
+                    vec![Default::default(); 2],
+                    &Default::default(),
+                )
+                .unwrap(),
+            ),
+        };
+        let clip = Clip::compile(&tcb_core::Clip {
+            name: "twice".into(),
+            tracks: vec![track(1.0), track(2.0)],
+        });
+        assert!(matches!(Rig::from_clip(&clip), Err(RigError::Duplicate(_))));
     }
 
     #[test]

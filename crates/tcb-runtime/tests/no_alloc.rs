@@ -72,7 +72,10 @@ fn steady_playback_and_blending_allocate_nothing() {
         let mask =
             tcb_runtime::BlendMask::new(&clip, |t| if t.index() % 2 == 0 { 1.0 } else { 0.25 });
         // Through a rig (every track, plus one the clip lacks).
-        let mut tracks = tcb_runtime::Rig::from_clip(&clip).tracks().to_vec();
+        let mut tracks = tcb_runtime::Rig::from_clip(&clip)
+            .unwrap()
+            .tracks()
+            .to_vec();
         tracks.push(tcb_runtime::RigTrack {
             name: "extra".into(),
             kind: tcb_core::TrackKind::Quat,

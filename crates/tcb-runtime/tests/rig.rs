@@ -286,7 +286,7 @@ fn other_rigs_and_unknown_tracks_are_refused() {
     );
     // A pose of another rig (here: the tracks of clip b, no End Sites or
     // scales) is refused, by blend and by add, and nothing is written.
-    let other = Arc::new(Rig::from_clip(&s.cb));
+    let other = Arc::new(Rig::from_clip(&s.cb).unwrap());
     let mut ia = Instance::with_rig(s.ca.clone(), &s.rig).unwrap();
     let mut ib = Instance::with_rig(s.cb.clone(), &other).unwrap();
     let mut out = s.rig.rest_pose();
