@@ -148,6 +148,9 @@ impl Bvh {
         }
         // Joints open and not yet closed.
         let mut stack: Vec<usize> = Vec::new();
+        // Names so far (a search of the joints per joint is quadratic in a
+        // wide hierarchy).
+        let mut names = std::collections::HashSet::new();
         while let Some((line, tok)) = t.next() {
             match tok {
                 "ROOT" | "JOINT" => {
@@ -171,7 +174,7 @@ impl Bvh {
                     if name.is_empty() {
                         return Err(Error::syntax(line, format!("{tok} without a name")));
                     }
-                    if self.skeleton.joint(&name).is_some() {
+                    if !names.insert(name.clone()) {
                         return Err(Error::syntax(
                             line,
                             format!("a second joint named '{name}'"),
@@ -395,7 +398,13 @@ impl Bvh {
     /// Yrotation` is `qz * qx * qy`), in f64.
     pub fn local(&self, frame: usize, joint: usize) -> (DVec3, DQuat) {
         let first: usize = self.channels[..joint].iter().map(Vec::len).sum();
-        let row = &self.values[frame * self.channel_count()..];
+        self.local_at(frame * self.channel_count(), first, joint)
+    }
+
+    /// [`Self::local`] of the frame whose row starts at value `row` and of
+    /// the joint whose channels start at `first` in it.
+    fn local_at(&self, row: usize, first: usize, joint: usize) -> (DVec3, DQuat) {
+        let row = &self.values[row..];
         let mut t = self.skeleton.joints[joint].rest.translation.as_dvec3();
         let mut q = DQuat::IDENTITY;
         for (i, c) in self.channels[joint].iter().enumerate() {
@@ -423,8 +432,12 @@ impl Bvh {
         }
         let times: Vec<f64> = (0..frames).map(|f| f as f64 * self.frame_time).collect();
         let mut tracks = Vec::new();
+        let count = self.channel_count();
+        let mut first = 0;
         for (j, joint) in self.skeleton.joints.iter().enumerate() {
             let ch = &self.channels[j];
+            let at = first;
+            first += ch.len();
             let has_pos = ch.iter().any(|c| matches!(c, Channel::Position(_)));
             let has_rot = ch.iter().any(|c| matches!(c, Channel::Rotation(_)));
             let track = |suffix: &str, kind: TrackKind, values: Vec<[f32; 4]>| TrackDoc {
@@ -439,7 +452,9 @@ impl Bvh {
                 continue;
             }
             // Each frame's local transform once, for both tracks.
-            let locals: Vec<(DVec3, DQuat)> = (0..frames).map(|f| self.local(f, j)).collect();
+            let locals: Vec<(DVec3, DQuat)> = (0..frames)
+                .map(|f| self.local_at(f * count, at, j))
+                .collect();
             if has_pos {
                 let values = locals
                     .iter()
@@ -472,14 +487,17 @@ impl Bvh {
     /// several, or the name is taken).
     pub fn skeleton_with_end_sites(&self) -> Skeleton {
         let mut out = self.skeleton.clone();
+        let mut names: std::collections::HashSet<String> =
+            out.joints.iter().map(|j| j.name.clone()).collect();
         for &(parent, offset) in &self.end_sites {
             let base = format!("{}_end", self.skeleton.joints[parent].name);
             let mut name = base.clone();
             let mut n = 1;
-            while out.joint(&name).is_some() {
+            while names.contains(&name) {
                 n += 1;
                 name = format!("{base}{n}");
             }
+            names.insert(name.clone());
             out.joints.push(Joint {
                 name,
                 parent: Some(parent),

@@ -1005,14 +1005,7 @@ impl Clip {
             })
             .sum();
         let loose = self.loose.heap_bytes() + self.loose_rot.heap_bytes();
-        let layout = self
-            .layout
-            .slots
-            .iter()
-            .map(|s| size_of::<TrackSlot>() + s.name.len())
-            .sum::<usize>()
-            + size_of_val(self.layout.quat_blocks.as_slice());
-        self.name.len() + groups + loose + layout
+        self.name.len() + groups + loose + self.layout.heap_bytes()
     }
 
     /// How the clip was laid out: its shared grids, loose tracks and

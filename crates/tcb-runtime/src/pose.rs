@@ -16,6 +16,8 @@ pub struct PoseLayout {
     /// A digest of the above, carried by every [`TrackId`] of this layout
     /// (equal layouts have equal keys).
     pub(crate) key: u64,
+    /// Track index by name (the first of a repeated name).
+    by_name: std::collections::HashMap<String, usize>,
 }
 
 impl PoseLayout {
@@ -23,20 +25,22 @@ impl PoseLayout {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         (&slots, blocks, &quat_blocks).hash(&mut h);
+        let mut by_name = std::collections::HashMap::with_capacity(slots.len());
+        for (i, s) in slots.iter().enumerate() {
+            by_name.entry(s.name.clone()).or_insert(i);
+        }
         PoseLayout {
             slots,
             blocks,
             quat_blocks,
             key: h.finish(),
+            by_name,
         }
     }
 
     /// The track called `name`.
     pub fn track(&self, name: &str) -> Option<TrackId> {
-        self.slots
-            .iter()
-            .position(|s| s.name == name)
-            .map(|i| self.id(i))
+        self.by_name.get(name).map(|&i| self.id(i))
     }
 
     /// Every track, in order (file order for a clip).
@@ -55,6 +59,17 @@ impl PoseLayout {
             return None;
         }
         self.slots.get(track.index)
+    }
+
+    /// Heap bytes: the slots with their names, the rotation blocks and the
+    /// name index (its table estimated from its capacity).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        use std::mem::{size_of, size_of_val};
+        let names: usize = self.slots.iter().map(|s| s.name.len()).sum();
+        size_of_val(self.slots.as_slice())
+            + 2 * names
+            + size_of_val(self.quat_blocks.as_slice())
+            + self.by_name.capacity() * (size_of::<(String, usize)>() + 1)
     }
 
     /// The id of track `i` (`i` below the track count).
