@@ -143,7 +143,7 @@ fn check(clip: &tcb_core::Clip, times: &[f64]) {
         pose.write_row(&mut got, Some(&mut got_v));
         clip.sample_into(t, &mut want, Some(&mut want_v));
         let mut at = 0;
-        for track in &clip.tracks {
+        for track in clip.tracks() {
             let dim = track.data.kind().dim();
             let r = at..at + dim;
             at += dim;

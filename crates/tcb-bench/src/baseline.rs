@@ -119,7 +119,7 @@ impl Baseline {
     /// tcb-core, computed once).
     pub fn new(clip: &tcb_core::Clip) -> Self {
         let tracks = clip
-            .tracks
+            .tracks()
             .iter()
             .map(|t| match &t.data {
                 TrackData::Scalar(t) => curve(t, false),

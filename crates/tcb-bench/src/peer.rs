@@ -29,7 +29,7 @@ impl SplinesPeer {
         let mut splines = Vec::new();
         let mut quats = Vec::new();
         let mut inner = (f64::NEG_INFINITY, f64::INFINITY);
-        for t in &clip.tracks {
+        for t in clip.tracks() {
             let (times, values): (Vec<f64>, Vec<[f32; 4]>) = match &t.data {
                 TrackData::Scalar(x) => (
                     x.times().to_vec(),

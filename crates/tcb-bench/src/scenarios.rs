@@ -220,7 +220,7 @@ fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::Clip, usize), tc
 fn animated_joints(loaded: &tcb_io::Loaded) -> usize {
     let mut names: Vec<&str> = loaded
         .clip
-        .tracks
+        .tracks()
         .iter()
         .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
         .collect();
@@ -394,10 +394,7 @@ pub fn wide() -> Scenario {
             ..scalar_track(times.clone(), &mut rng)
         })
         .collect();
-    let clip = tcb_core::Clip {
-        name: "wide".into(),
-        tracks,
-    };
+    let clip = tcb_core::Clip::new("wide", tracks).expect("unique track names");
     let mut s = Scenario::new("wide", clip, frames(2.0, 60.0));
     s.peer = Some(SplinesPeer::new(&s.source));
     s.read_limit = true;
@@ -416,10 +413,7 @@ pub fn sparse() -> Scenario {
             }
         })
         .collect();
-    let clip = tcb_core::Clip {
-        name: "sparse".into(),
-        tracks,
-    };
+    let clip = tcb_core::Clip::new("sparse", tracks).expect("unique track names");
     Scenario::new("sparse", clip, frames(2.0, 60.0))
 }
 
@@ -480,10 +474,7 @@ pub fn sparse_rotations() -> Scenario {
             }
         })
         .collect();
-    let clip = tcb_core::Clip {
-        name: "sparse-rotations".into(),
-        tracks,
-    };
+    let clip = tcb_core::Clip::new("sparse-rotations", tracks).expect("unique track names");
     Scenario::new("sparse-rotations", clip, frames(2.0, 60.0))
 }
 

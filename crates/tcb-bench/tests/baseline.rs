@@ -46,7 +46,7 @@ fn baseline_equals_the_reference() {
             clip.sample_into(t, &mut want, None);
             baseline.sample(t, &mut got);
             let mut at = 0;
-            for track in &clip.tracks {
+            for track in clip.tracks() {
                 let dim = track.data.kind().dim();
                 let (w, g) = (&want[at..at + dim], &got[at..at + dim]);
                 let d = w

@@ -544,7 +544,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     };
     let runtime = tcb_runtime::Clip::compile_with(clip, &options);
     let stats = runtime.stats();
-    let keys: usize = clip.tracks.iter().map(|t| t.data.times().len()).sum();
+    let keys: usize = clip.tracks().iter().map(|t| t.data.times().len()).sum();
     let mut out = String::new();
     use std::fmt::Write as _;
     writeln!(out, "file: {}", args.clip.display())?;
@@ -554,8 +554,8 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     writeln!(
         out,
         "clip: {:?}, {} tracks, {} channels, {keys} keys, {range}",
-        clip.name,
-        clip.tracks.len(),
+        clip.name(),
+        clip.tracks().len(),
         clip.channel_count()
     )?;
     match &loaded.skeleton {
@@ -571,7 +571,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
         "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
         "name", "kind", "keys", "first", "last"
     )?;
-    for (t, id) in clip.tracks.iter().zip(runtime.layout().ids()) {
+    for (t, id) in clip.tracks().iter().zip(runtime.layout().ids()) {
         let times = t.data.times();
         let (mode, settings) = match &t.data {
             tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
@@ -641,7 +641,7 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
         },
     };
     let scenario = tcb_bench::scenarios::file_with(&args.clip, &options)?;
-    if scenario.source.tracks.is_empty() {
+    if scenario.source.tracks().is_empty() {
         return Err(format!("{}: the clip has no tracks to time", args.clip.display()).into());
     }
     if cfg!(debug_assertions) {
@@ -736,8 +736,8 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
     if args.track.is_empty() && loaded.clip.channel_count() > 16 {
         eprintln!(
             "tcb: plotting '{}' ({} tracks; choose others with --track)",
-            loaded.clip.tracks[0].name,
-            loaded.clip.tracks.len()
+            loaded.clip.tracks()[0].name,
+            loaded.clip.tracks().len()
         );
     }
     let plot = tcb_plot::Plot {

@@ -143,10 +143,10 @@ pub struct NamedTrack {
 /// ```
 /// use tcb_core::{Clip, NamedTrack, Track, TrackData, TrackSettings};
 /// let squash = Track::new(vec![0.0, 1.25], vec![1.0f32, 0.6], vec![], &TrackSettings::default()).unwrap();
-/// let clip = Clip {
-///     name: "bounce".into(),
-///     tracks: vec![NamedTrack { name: "ball.squash".into(), data: TrackData::Scalar(squash) }],
-/// };
+/// let squash = NamedTrack { name: "ball.squash".into(), data: TrackData::Scalar(squash) };
+/// let clip = Clip::new("bounce", vec![squash.clone()]).unwrap();
+/// // Track names are unique in a clip.
+/// assert!(Clip::new("bounce", vec![squash.clone(), squash]).is_err());
 /// assert_eq!(clip.column_names(), ["ball.squash"]);
 /// let mut row = vec![0.0; clip.channel_count()];
 /// clip.sample_into(1.25, &mut row, None);
@@ -154,13 +154,50 @@ pub struct NamedTrack {
 /// ```
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Clip {
-    /// The clip's name.
-    pub name: String,
-    /// Its tracks, in file order.
-    pub tracks: Vec<NamedTrack>,
+    name: String,
+    tracks: Vec<NamedTrack>,
 }
 
+/// A clip [`Clip::new`] refuses: two tracks have this name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DuplicateTrack(pub String);
+
+impl std::fmt::Display for DuplicateTrack {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "two tracks are named '{}'", self.0)
+    }
+}
+
+impl std::error::Error for DuplicateTrack {}
+
 impl Clip {
+    /// A clip of `tracks` (file order), whose names must be unique.
+    pub fn new(name: impl Into<String>, tracks: Vec<NamedTrack>) -> Result<Self, DuplicateTrack> {
+        let mut seen = std::collections::HashSet::new();
+        if let Some(t) = tracks.iter().find(|t| !seen.insert(t.name.as_str())) {
+            return Err(DuplicateTrack(t.name.clone()));
+        }
+        Ok(Clip {
+            name: name.into(),
+            tracks,
+        })
+    }
+
+    /// The clip's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Its tracks, in file order.
+    pub fn tracks(&self) -> &[NamedTrack] {
+        &self.tracks
+    }
+
+    /// Its tracks, by value.
+    pub fn into_tracks(self) -> Vec<NamedTrack> {
+        self.tracks
+    }
+
     /// Total number of `f32` channels (columns after `time`).
     pub fn channel_count(&self) -> usize {
         self.tracks.iter().map(|t| t.data.kind().dim()).sum()

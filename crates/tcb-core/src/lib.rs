@@ -62,7 +62,7 @@ pub mod tangent;
 pub mod track;
 pub mod vector;
 
-pub use clip::{Clip, NamedTrack, TrackData, TrackKind};
+pub use clip::{Clip, DuplicateTrack, NamedTrack, TrackData, TrackKind};
 pub use error::TrackError;
 pub use params::{
     Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, RotationMode, TangentRule, Tcb,

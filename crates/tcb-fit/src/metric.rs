@@ -159,14 +159,14 @@ pub fn value_error(
     let channels = reference.channel_count();
     let (ra, rb) = (reference_rows, play(reduced, times));
     let mut worst = Worst::none();
-    let mut each = vec![0.0f64; reference.tracks.len()];
+    let mut each = vec![0.0f64; reference.tracks().len()];
     for (i, &t) in times.iter().enumerate() {
         let (ya, yb) = (
             &ra[i * channels..(i + 1) * channels],
             &rb[i * channels..(i + 1) * channels],
         );
         let mut at = 0;
-        for (k, track) in reference.tracks.iter().enumerate() {
+        for (k, track) in reference.tracks().iter().enumerate() {
             let kind = track.data.kind();
             let dim = kind.dim();
             let (a, b) = (&ya[at..at + dim], &yb[at..at + dim]);

@@ -439,7 +439,7 @@ pub fn reduce(
     let after = counts(&doc, &compiled);
     let kept = (0..kept.len())
         .filter(|&i| kept[i])
-        .map(|i| input.clip.tracks[i].name.clone())
+        .map(|i| input.clip.tracks()[i].name.clone())
         .collect();
     Ok(Reduced {
         doc,
@@ -492,7 +492,7 @@ impl<'a> Plan<'a> {
         let n = times.len();
         let mut tracks = Vec::new();
         let mut at = 0;
-        for (doc, track) in input.doc.tracks.iter().zip(&input.clip.tracks) {
+        for (doc, track) in input.doc.tracks.iter().zip(input.clip.tracks()) {
             let kind = track.data.kind();
             let dim = kind.dim();
             let (t0, t1) = (track.data.times()[0], *track.data.times().last().unwrap());
@@ -539,8 +539,8 @@ impl<'a> Plan<'a> {
         for (i, p) in tracks.iter().enumerate() {
             let Some(p) = p else { continue };
             let key = match settings.knots {
-                Knots::Track => input.clip.tracks[i].name.clone(),
-                Knots::Joint => joint_name(&input.clip.tracks[i].name).to_owned(),
+                Knots::Track => input.clip.tracks()[i].name.clone(),
+                Knots::Joint => joint_name(&input.clip.tracks()[i].name).to_owned(),
                 Knots::Clip => String::new(),
             };
             match groups
@@ -566,7 +566,7 @@ impl<'a> Plan<'a> {
     /// The tolerance and norm of track `i` at budget scale `scale`.
     fn budget(&self, i: usize, scale: f64) -> (Norm, f64) {
         let s = self.settings;
-        let kind = self.input.clip.tracks[i].data.kind();
+        let kind = self.input.clip.tracks()[i].data.kind();
         let p = self.tracks[i].as_ref().expect("a fitted track");
         match (s.metric, p.joint) {
             (Metric::Shell, Some((j, part))) => {
@@ -638,7 +638,7 @@ impl<'a> Plan<'a> {
             .map(|&i| {
                 let (norm, tol) = self.budget(i, scale);
                 Series {
-                    dim: self.input.clip.tracks[i].data.kind().dim(),
+                    dim: self.input.clip.tracks()[i].data.kind().dim(),
                     samples: &self.tracks[i].as_ref().expect("fitted").samples,
                     norm,
                     tol,
@@ -864,7 +864,7 @@ fn chains(
         .collect();
     let mut count = vec![0usize; n];
     let mut at = 0;
-    for (t, p) in clip.tracks.iter().zip(tracks) {
+    for (t, p) in clip.tracks().iter().zip(tracks) {
         let dim = t.data.kind().dim();
         if let Some(Prepared {
             joint: Some((j, part)),

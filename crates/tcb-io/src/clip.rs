@@ -262,9 +262,15 @@ impl ClipDoc {
                 data,
             });
         }
-        Ok(Clip {
-            name: self.name.clone(),
-            tracks,
+        // Names were checked above, with the track that repeats one.
+        Clip::new(self.name.clone(), tracks).map_err(|e| {
+            Error::invalid(
+                Location {
+                    track: Some(quote(&e.0)),
+                    ..Location::default()
+                },
+                "the name is already used".to_string(),
+            )
         })
     }
 

@@ -326,10 +326,10 @@ struct NodeOut {
 /// The track names after `renames`, checked: every `from` names a track,
 /// and no two tracks end up with one name.
 fn renamed(clip: &tcb_core::Clip, renames: &[(String, String)]) -> Result<Vec<String>, Error> {
-    let mut names: Vec<String> = clip.tracks.iter().map(|t| t.name.clone()).collect();
+    let mut names: Vec<String> = clip.tracks().iter().map(|t| t.name.clone()).collect();
     for (from, to) in renames {
         let i = clip
-            .tracks
+            .tracks()
             .iter()
             .position(|t| t.name == *from)
             .ok_or_else(|| Error::import(format!("--rename {from}={to}: no track '{from}'")))?;
@@ -374,7 +374,7 @@ pub fn export(
     let mut channels: Vec<(usize, &'static str, Sampler)> = Vec::new();
     // Weight tracks per node: (target index, track index).
     let mut weights: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
-    for (ti, t) in clip.tracks.iter().enumerate() {
+    for (ti, t) in clip.tracks().iter().enumerate() {
         let (node, path, morph) = target(&track_names[ti], &t.data).map_err(Error::import)?;
         let ni = match nodes.iter().position(|n| n.name == node) {
             Some(i) => i,
@@ -428,7 +428,7 @@ pub fn export(
         }
         let per: Vec<(Sampler, Option<f64>)> = list
             .iter()
-            .map(|(_, ti)| track_sampler(&clip.tracks[*ti].data, max_error))
+            .map(|(_, ti)| track_sampler(&clip.tracks()[*ti].data, max_error))
             .collect();
         if per
             .iter()
@@ -441,7 +441,7 @@ pub fn export(
         }
         for ((_, ti), (_, e)) in list.iter().zip(&per) {
             report.tracks.push(TrackExport {
-                name: clip.tracks[*ti].name.clone(),
+                name: clip.tracks()[*ti].name.clone(),
                 resampled_error: *e,
             });
         }
@@ -452,7 +452,7 @@ pub fn export(
             merge(&per.iter().map(|p| &p.0).collect::<Vec<_>>()),
         ));
     }
-    let bytes = write(&clip.name, &nodes, &channels, binary)?;
+    let bytes = write(clip.name(), &nodes, &channels, binary)?;
     Ok((bytes, report))
 }
 

@@ -129,7 +129,7 @@ pub struct Loaded {
 /// # */
 /// let loaded = tcb_io::load(path.as_ref())?;
 /// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31 + 7); // joints and End Sites
-/// assert_eq!(loaded.clip.tracks[0].name, "Hips.translation");
+/// assert_eq!(loaded.clip.tracks()[0].name, "Hips.translation");
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
 pub fn load(path: &Path) -> Result<Loaded, Error> {

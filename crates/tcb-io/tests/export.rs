@@ -31,7 +31,7 @@ fn round_trip(
 
 /// Largest difference per track (relative to max(1, |value|); rotations up to sign).
 fn compare(a: &tcb_core::Clip, b: &tcb_core::Clip, times: impl Iterator<Item = f64>) -> Vec<f64> {
-    let mut worst = vec![0.0f64; a.tracks.len()];
+    let mut worst = vec![0.0f64; a.tracks().len()];
     let (mut va, mut vb) = (
         vec![0.0f32; a.channel_count()],
         vec![0.0f32; b.channel_count()],
@@ -40,10 +40,10 @@ fn compare(a: &tcb_core::Clip, b: &tcb_core::Clip, times: impl Iterator<Item = f
         a.sample_into(t, &mut va, None);
         b.sample_into(t, &mut vb, None);
         let mut at = 0;
-        for (i, track) in a.tracks.iter().enumerate() {
+        for (i, track) in a.tracks().iter().enumerate() {
             // Same track in `b`, by name (glTF groups channels by node).
             let mut bt = 0;
-            for other in &b.tracks {
+            for other in b.tracks() {
                 if other.name == track.name {
                     break;
                 }
@@ -74,7 +74,7 @@ fn exact_tracks_round_trip_and_resampled_ones_hold_their_bound() {
     let clip = tcb_io::ClipDoc::parse(CLIP).unwrap().build().unwrap();
     for binary in [false, true] {
         let (back, report) = round_trip(&clip, binary, 1e-5);
-        assert_eq!(back.tracks.len(), clip.tracks.len());
+        assert_eq!(back.tracks().len(), clip.tracks().len());
         // Dense, and off the keys (f32 key times in glTF: stay inside).
         let worst = compare(&clip, &back, (0..=4001).map(|i| i as f64 * 2.0 / 4001.0));
         for (track, w) in report.tracks.iter().zip(&worst) {

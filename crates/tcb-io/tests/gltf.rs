@@ -36,8 +36,8 @@ fn simple_skin_samples_as_gltf_linear_slerp() {
     let path = data("simple_skin.gltf");
     let loaded = tcb_io::load(&path).unwrap();
     let clip = &loaded.clip;
-    assert_eq!(clip.tracks.len(), 1);
-    assert_eq!(clip.tracks[0].name, "node2.rotation");
+    assert_eq!(clip.tracks().len(), 1);
+    assert_eq!(clip.tracks()[0].name, "node2.rotation");
     let skeleton = loaded.skeleton.unwrap();
     assert_eq!(skeleton.joints.len(), 3);
     assert_eq!(skeleton.joints[2].parent, Some(1));

@@ -143,33 +143,40 @@ pub const MAX_MARKED_KEYS: usize = 300;
 
 /// The tracks a plot draws, checked.
 fn chosen<'a>(clip: &'a Clip, plot: &Plot) -> Result<Vec<&'a NamedTrack>, PlotError> {
-    if clip.tracks.is_empty() {
+    if clip.tracks().is_empty() {
         return err("the clip has no tracks");
     }
     if plot.tracks.is_empty() {
-        let channels: usize = clip.tracks.iter().map(|t| t.data.kind().dim()).sum();
+        let channels: usize = clip.tracks().iter().map(|t| t.data.kind().dim()).sum();
         return Ok(if channels <= 16 {
-            clip.tracks.iter().collect()
+            clip.tracks().iter().collect()
         } else {
-            vec![&clip.tracks[0]]
+            vec![&clip.tracks()[0]]
         });
     }
     plot.tracks
         .iter()
         .map(|name| {
-            clip.tracks.iter().find(|t| t.name == *name).ok_or_else(|| {
-                let all: Vec<&str> = clip
-                    .tracks
-                    .iter()
-                    .take(12)
-                    .map(|t| t.name.as_str())
-                    .collect();
-                let more = if clip.tracks.len() > 12 { ", ..." } else { "" };
-                PlotError(format!(
-                    "no track '{name}' (the clip has: {}{more})",
-                    all.join(", ")
-                ))
-            })
+            clip.tracks()
+                .iter()
+                .find(|t| t.name == *name)
+                .ok_or_else(|| {
+                    let all: Vec<&str> = clip
+                        .tracks()
+                        .iter()
+                        .take(12)
+                        .map(|t| t.name.as_str())
+                        .collect();
+                    let more = if clip.tracks().len() > 12 {
+                        ", ..."
+                    } else {
+                        ""
+                    };
+                    PlotError(format!(
+                        "no track '{name}' (the clip has: {}{more})",
+                        all.join(", ")
+                    ))
+                })
         })
         .collect()
 }

@@ -35,7 +35,7 @@ fn every_mode_draws_every_kind() {
             tcb_plot::Mode::Velocity,
             tcb_plot::Mode::Speed,
         ] {
-            for t in &loaded.clip.tracks {
+            for t in loaded.clip.tracks() {
                 let plot = tcb_plot::Plot {
                     tracks: vec![t.name.clone()],
                     mode,

@@ -36,10 +36,7 @@ fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::Clip {
             }
         })
         .collect();
-    tcb_core::Clip {
-        name: "synthetic".into(),
-        tracks,
-    }
+    tcb_core::Clip::new("synthetic", tracks).expect("unique track names")
 }
 
 /// `count` rotations, each on key times of its own.
@@ -67,10 +64,7 @@ fn sparse_rotations(count: usize, keys: usize, mode: RotationMode) -> tcb_core::
             }
         })
         .collect();
-    tcb_core::Clip {
-        name: "sparse-rotations".into(),
-        tracks,
-    }
+    tcb_core::Clip::new("sparse-rotations", tracks).expect("unique track names")
 }
 
 fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
@@ -115,10 +109,7 @@ fn skeleton_turning(joints: usize, keys: usize, mode: RotationMode, turn: f32) -
             data: TrackData::Quat(RotationTrack::new(t.clone(), q, vec![], &s).unwrap()),
         });
     }
-    tcb_core::Clip {
-        name: "skeleton".into(),
-        tracks,
-    }
+    tcb_core::Clip::new("skeleton", tracks).expect("unique track names")
 }
 
 fn play(c: &mut Criterion, group: &str, clip: &tcb_core::Clip, channels: u64) {

@@ -704,7 +704,7 @@ impl Clip {
         // Per group: vector channel rows (track, component) and rotation rows.
         let mut vec_rows: Vec<Vec<(usize, usize, Controls)>> = Vec::new();
         let mut hq_rows: Vec<Vec<(usize, RotationControls)>> = Vec::new();
-        for (i, t) in source.tracks.iter().enumerate() {
+        for (i, t) in source.tracks().iter().enumerate() {
             let grid = grid_of(&t.data);
             let g = *group_of.entry(grid_key(&grid)).or_insert_with(|| {
                 grids.push(grid);
@@ -728,7 +728,7 @@ impl Clip {
 
         // How much normalizing can grow a quantization error of each
         // rotation (before its rows are moved into loose lanes).
-        let mut rot_gain = vec![2.0f32; source.tracks.len()];
+        let mut rot_gain = vec![2.0f32; source.tracks().len()];
         if options.quantize {
             for (track, rot) in hq_rows.iter().flatten() {
                 rot_gain[*track] = normalize_gain(rot);
@@ -779,7 +779,7 @@ impl Clip {
         }
 
         let mut slots: Vec<TrackSlot> = source
-            .tracks
+            .tracks()
             .iter()
             .map(|t| TrackSlot {
                 name: t.name.clone(),
@@ -788,7 +788,7 @@ impl Clip {
             })
             .collect();
         let mut groups = Vec::with_capacity(grids.len());
-        let mut quant_error = vec![0.0f32; source.tracks.len()];
+        let mut quant_error = vec![0.0f32; source.tracks().len()];
         let mut quat_blocks = Vec::new();
         let mut at = 0usize; // pose block
         for (g, grid) in grids.into_iter().enumerate() {
@@ -919,7 +919,7 @@ impl Clip {
         }
         at += 4 * loose_rot.blocks;
         Clip {
-            name: source.name.clone(),
+            name: source.name().to_string(),
             groups,
             layout: Arc::new(PoseLayout::new(slots, at, quat_blocks)),
             loose,

@@ -333,7 +333,8 @@ mod tests {
     }
 
     /// A hand-built clip with two tracks of one name: `from_clip` used to
-    /// panic on it.
+    /// panic on it. Such a clip can no longer be made: `tcb_core::Clip::new`
+    /// refuses it (its fields are private).
     #[test]
     fn a_clip_with_a_repeated_name_is_refused() {
         let track = |v: f32| tcb_core::NamedTrack {
@@ -348,11 +349,10 @@ mod tests {
                 .unwrap(),
             ),
         };
-        let clip = Clip::compile(&tcb_core::Clip {
-            name: "twice".into(),
-            tracks: vec![track(1.0), track(2.0)],
-        });
-        assert!(matches!(Rig::from_clip(&clip), Err(RigError::Duplicate(_))));
+        let twice = tcb_core::Clip::new("twice", vec![track(1.0), track(2.0)]);
+        assert_eq!(twice, Err(tcb_core::DuplicateTrack("x".into())));
+        let once = Clip::compile(&tcb_core::Clip::new("once", vec![track(1.0)]).unwrap());
+        assert_eq!(Rig::from_clip(&once).unwrap().tracks().len(), 1);
     }
 
     #[test]

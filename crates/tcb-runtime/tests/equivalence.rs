@@ -222,9 +222,9 @@ fn random_clip(seed: u64, channels: usize) -> tcb_core::Clip {
         }
         tracks.push(TrackData::Quat(rotation_track(&mut rng, &own, &rs)));
     }
-    tcb_core::Clip {
-        name: format!("random-{seed}"),
-        tracks: tracks
+    tcb_core::Clip::new(
+        format!("random-{seed}"),
+        tracks
             .into_iter()
             .enumerate()
             .map(|(i, data)| NamedTrack {
@@ -232,7 +232,8 @@ fn random_clip(seed: u64, channels: usize) -> tcb_core::Clip {
                 data,
             })
             .collect(),
-    }
+    )
+    .expect("unique track names")
 }
 
 trait RotationSafe {
@@ -275,7 +276,7 @@ fn assert_rows_match(
     want: (&[f32], &[f32]),
 ) {
     let mut at = 0;
-    for t in &clip.tracks {
+    for t in clip.tracks() {
         let dim = t.data.kind().dim();
         let (g, w) = (&got.0[at..at + dim], &want.0[at..at + dim]);
         let (gv, wv) = (&got.1[at..at + dim], &want.1[at..at + dim]);
@@ -373,7 +374,7 @@ fn edge_channel_counts() {
     for channels in [0, 1, 7, 8, 9, 63, 64, 65] {
         for seed in 0..12 {
             let clip = random_clip(seed * 1000 + channels as u64, channels);
-            if clip.tracks.is_empty() {
+            if clip.tracks().is_empty() {
                 continue;
             }
             check_clip(&clip, seed);
@@ -406,13 +407,14 @@ fn wild_rotations_stay_within_1e_6() {
             ..s
         };
         let track = rotation_track_with(&mut rng, &t, &s, std::f64::consts::PI);
-        let clip = tcb_core::Clip {
-            name: "wild".into(),
-            tracks: vec![NamedTrack {
+        let clip = tcb_core::Clip::new(
+            "wild",
+            vec![NamedTrack {
                 name: "q".into(),
                 data: TrackData::Quat(track),
             }],
-        };
+        )
+        .expect("unique track names");
         let compiled = Arc::new(Clip::compile(&clip));
         let exact = compiled.stats().exact_segments;
         exact_segments += exact;
@@ -478,10 +480,7 @@ fn dense_squad_without_velocities() {
                 data: TrackData::Quat(rotation_track_with(&mut rng, &t, &s, 0.05)),
             })
             .collect();
-        let clip = tcb_core::Clip {
-            name: "capture".into(),
-            tracks,
-        };
+        let clip = tcb_core::Clip::new("capture", tracks).expect("unique track names");
         velocity_only += Clip::compile(&clip).stats().exact_for_velocity_only;
         check_clip(&clip, seed);
     }
@@ -519,10 +518,7 @@ fn rotations_on_their_own_grids() {
                 data: TrackData::Quat(rotation_track(&mut rng, &t, &s)),
             });
         }
-        let clip = tcb_core::Clip {
-            name: "own rotations".into(),
-            tracks,
-        };
+        let clip = tcb_core::Clip::new("own rotations", tracks).expect("unique track names");
         loose += Clip::compile(&clip).loose_track_count();
         check_clip(&clip, seed);
     }
@@ -554,12 +550,9 @@ fn tracks_on_their_own_grids() {
                 data,
             });
         }
-        let clip = tcb_core::Clip {
-            name: "own".into(),
-            tracks,
-        };
+        let clip = tcb_core::Clip::new("own", tracks).expect("unique track names");
         let compiled = Clip::compile(&clip);
-        assert_eq!(compiled.loose_track_count(), clip.tracks.len());
+        assert_eq!(compiled.loose_track_count(), clip.tracks().len());
         assert_eq!(compiled.group_count(), 0);
         check_clip(&clip, seed);
     }
@@ -603,7 +596,7 @@ proptest! {
     #[test]
     fn runtime_equals_reference(seed in any::<u64>(), channels in 0..80usize) {
         let clip = random_clip(seed, channels);
-        prop_assume!(!clip.tracks.is_empty());
+        prop_assume!(!clip.tracks().is_empty());
         check_clip(&clip, seed);
     }
 
@@ -647,13 +640,14 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
             ..TrackSettings::default()
         };
         let track = RotationTrack::new(t, q.to_vec(), vec![key; 4], &s).expect("finite parameters");
-        let clip = tcb_core::Clip {
-            name: "overflow".into(),
-            tracks: vec![NamedTrack {
+        let clip = tcb_core::Clip::new(
+            "overflow",
+            vec![NamedTrack {
                 name: "r".into(),
                 data: TrackData::Quat(track),
             }],
-        };
+        )
+        .expect("unique track names");
         let mut inst = Instance::new(Arc::new(Clip::compile(&clip)));
         let mut want = [0.0f32; 4];
         // A vector track with the same keys' parameters, reset before its
@@ -675,13 +669,14 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
             },
         )
         .expect("finite parameters");
-        let vclip = tcb_core::Clip {
-            name: "overflow".into(),
-            tracks: vec![NamedTrack {
+        let vclip = tcb_core::Clip::new(
+            "overflow",
+            vec![NamedTrack {
                 name: "v".into(),
                 data: TrackData::Vec3(v),
             }],
-        };
+        )
+        .expect("unique track names");
         let mut vinst = Instance::new(Arc::new(Clip::compile(&vclip))).with_velocities();
         for time in [-1.0, 3.5, 1e9] {
             let (mut got, mut want) = ([0.0f32; 3], [0.0f32; 3]);
@@ -736,13 +731,14 @@ fn rotations_with_huge_tangents_stay_unit() {
         ..TrackSettings::default()
     };
     let track = RotationTrack::new(t, q, keys, &s).expect("finite tangents");
-    let clip = tcb_core::Clip {
-        name: "huge".into(),
-        tracks: vec![NamedTrack {
+    let clip = tcb_core::Clip::new(
+        "huge",
+        vec![NamedTrack {
             name: "r".into(),
             data: TrackData::Quat(track),
         }],
-    };
+    )
+    .expect("unique track names");
     let mut inst = Instance::new(Arc::new(Clip::compile(&clip)));
     for time in [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0] {
         let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
@@ -791,13 +787,14 @@ fn mapped_times_rounded_below_the_first_key() {
         ..KeyParams::default()
     };
     let track = Track::new(times, values, vec![key; n], &settings).expect("valid");
-    let clip = tcb_core::Clip {
-        name: "oscillate".into(),
-        tracks: vec![NamedTrack {
+    let clip = tcb_core::Clip::new(
+        "oscillate",
+        vec![NamedTrack {
             name: "v".into(),
             data: TrackData::Vec2(track),
         }],
-    };
+    )
+    .expect("unique track names");
     assert_eq!(Clip::compile(&clip).loose_track_count(), 1);
     check_clip(&clip, 5);
     let mut inst = Instance::new(Arc::new(Clip::compile(&clip))).with_velocities();
@@ -873,10 +870,7 @@ fn dense_own_keys_played_at_a_lower_rate() {
                 }
             })
             .collect();
-        let clip = tcb_core::Clip {
-            name: "dense".into(),
-            tracks,
-        };
+        let clip = tcb_core::Clip::new("dense", tracks).expect("unique track names");
         let compiled = Arc::new(Clip::compile(&clip));
         assert!(compiled.loose_track_count() > 0, "seed {seed}");
         let (a, b) = clip.time_range().unwrap();
@@ -936,7 +930,9 @@ fn quantized_clips_stay_within_their_stated_bound() {
         let plain = Arc::new(Clip::compile(&clip));
         let small = Arc::new(Clip::compile_with(&clip, &options));
         assert!(
-            small.memory_bytes() <= plain.memory_bytes() || clip.tracks.is_empty() || channels < 8
+            small.memory_bytes() <= plain.memory_bytes()
+                || clip.tracks().is_empty()
+                || channels < 8
         );
         let (mut a, mut b) = (Instance::new(plain), Instance::new(small.clone()));
         let n = clip.channel_count();
@@ -950,7 +946,7 @@ fn quantized_clips_stay_within_their_stated_bound() {
             b.sample(time).write_row(&mut got, None);
             a.sample(time).write_row(&mut want, None);
             let mut at = 0;
-            for (t, id) in clip.tracks.iter().zip(small.layout().ids()) {
+            for (t, id) in clip.tracks().iter().zip(small.layout().ids()) {
                 let dim = t.data.kind().dim();
                 let (lo, hi) = (t.data.times()[0], *t.data.times().last().unwrap());
                 let bound = small.quantization_error(id).unwrap();

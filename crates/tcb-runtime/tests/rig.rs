@@ -57,7 +57,7 @@ fn setup() -> Setup {
 /// The reference value of rig track `name` in `clip` at `time`, or its rest.
 fn reference(rig: &Rig, clip: &tcb_core::Clip, name: &str, time: f64) -> [f64; 4] {
     let mut v = [0.0f32; 4];
-    match clip.tracks.iter().find(|t| t.name == name) {
+    match clip.tracks().iter().find(|t| t.name == name) {
         Some(t) => t.data.sample_into(time, &mut v, None),
         None => v = rig.tracks()[rig.track(name).unwrap().index()].rest,
     }
