@@ -37,7 +37,11 @@ use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 
 /// Padding lanes: a window from -PAD_SPAN to +PAD_SPAN (finite, so u stays
-/// finite), zero controls; padding rotations are lanes keyed there.
+/// finite), zero controls; padding rotations are lanes keyed there. Key
+/// times may lie beyond it (up to f64::MAX); there a padding lane's u leaves
+/// [0, 1] and its value is whatever the cubic gives, in lanes no accessor,
+/// row or blend result reads (a fuzz finding: the window check asserted
+/// padding lanes too).
 pub(crate) const PAD_SPAN: f64 = 1e300;
 
 /// One loose track.
@@ -623,10 +627,6 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
 #[inline(always)]
 fn inside(eased: bool, half: &[Half; 2], rate: f32x8, time: f64) -> (f32x8, f32x8) {
     let t = f64x4::splat(time);
-    debug_assert!(
-        half.iter()
-            .all(|h| (h.ws.simd_le(t) & t.simd_lt(h.we)).all())
-    );
     // `t - ws` is at least 0 and at most `we - ws = D`, so `u` is already
     // within the [0, 1] the reference clamps it to.
     let u = half.map(|h| (t - h.ws) / h.d);
@@ -740,6 +740,13 @@ pub(crate) fn sample(
         let out = 4 * b..4 * b + 4;
         if time >= info.inner[0] && time < info.inner[1] {
             let block = &st.block[b];
+            // Every real lane holds `time` (padding lanes span +-PAD_SPAN
+            // only: beyond it their u leaves [0, 1], which nobody reads).
+            debug_assert!((8 * b..loose.lanes.len().min(8 * b + 8)).all(|l| {
+                let h = &block.half[(l % 8) / 4];
+                let i = l % 4;
+                h.ws.to_array()[i] <= time && time < h.we.to_array()[i]
+            }));
             let (s, rate) = inside(info.eased, &block.half, block.rate, time);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
