@@ -363,7 +363,13 @@ impl<V: Value> Track<V> {
     fn evaluate(&self, time: f64) -> (V, V) {
         let (k, u) = locate(&self.times, time);
         let seg = &self.segments[k];
-        let (s, ds_du) = seg.ease.apply(u);
+        // A `step` segment stays P_k (math.md) exactly, at rate 0: as the
+        // runtime plays it, at s = 0, where the basis is [1, 0, 0, 0]. (The
+        // last key itself, below, still wins at the end.)
+        let (s, ds_du) = match seg.interp {
+            Interp::Step => (0.0, 0.0),
+            _ => seg.ease.apply(u),
+        };
         let s = s as f32;
         let h = hermite_basis(s);
         let dh = hermite_basis_derivative(s);
@@ -421,6 +427,26 @@ mod tests {
         assert_eq!(v, 0.0);
         let (_, v) = t.sample_with_velocity(2.0);
         assert_eq!(v, -1.0);
+    }
+
+    /// math.md: a `step` segment's value "stays P_k": exactly, not the
+    /// Hermite sum `h0 P + h1 P`, which rounds (0.1 came back as
+    /// 0.10000001 at 22 of 50 times, and a switch channel keyed 1.0 would
+    /// not hold 1.0).
+    #[test]
+    fn step_segments_hold_their_key_exactly() {
+        let mut keys = vec![KeyParams::default(); 3];
+        keys[0].interp = Interp::Step;
+        let t = scalar(
+            &[0.0, 1.0, 2.0],
+            &[0.1, 0.7, 0.3],
+            keys,
+            TrackSettings::default(),
+        );
+        for i in 0..1000 {
+            let (v, d) = t.sample_with_velocity(f64::from(i) / 1000.0);
+            assert_eq!((v, d), (0.1, 0.0), "at {}", f64::from(i) / 1000.0);
+        }
     }
 
     #[test]

@@ -362,15 +362,17 @@ pub(crate) fn per_key(rows: &Controls) -> Vec<[f32; KEY_STRIDE]> {
 }
 
 /// The two keys stored segment `seg` of `grid` reads: `(a, b)` with
-/// `P0 = a.P, M0 = a.TO, P1 = b.P, M1 = b.TI` (a `step` segment reads its
-/// first key twice; its tangents are zero).
+/// `P0 = a.P, M0 = a.TO, P1 = b.P, M1 = b.TI`. A `step` segment is played
+/// at `s = 0` (basis `[1, 0, 0, 0]`), and its `b` is key 0, whose `TI` is
+/// zero: its own key's `TI` belongs to the segment before and may be
+/// infinite, and `0 * inf` would be NaN.
 #[inline]
 pub(crate) fn key_pair(grid: &TimeGrid, seg: usize) -> (usize, usize) {
     let n = grid.times.len();
     match seg {
         0 => (n, n + 1),
         s if s == n => (n + 2, n + 3),
-        s if grid.is_step(s - 1) => (s - 1, s - 1),
+        s if grid.is_step(s - 1) => (s - 1, 0),
         s => (s - 1, s),
     }
 }

@@ -110,15 +110,22 @@ impl TimeGrid {
         cursor.0
     }
 
-    /// Stored segment, eased `s`, rate (times `dir`) and whether it is
-    /// `step`, for a `time` inside the keys (`t_0 <= time < t_{n-1}`).
+    /// Stored segment, eased `s` and rate (times `dir`) for a `time` inside
+    /// the keys (`t_0 <= time < t_{n-1}`). A `step` segment is played at
+    /// `s = 0` with rate 0: the basis there is exactly `[1, 0, 0, 0]`, so
+    /// the value is its first key exactly (math.md: it "stays P_k"), and
+    /// its velocity is zero (its `M0` is zero; [`crate::clip::key_pair`]
+    /// gives it a finite `M1`).
     #[inline(always)]
-    fn real(&self, time: f64, cursor: &mut Cursor, dir: f32) -> (usize, f64, f32, bool) {
+    fn real(&self, time: f64, cursor: &mut Cursor, dir: f32) -> (usize, f64, f32) {
         let k = self.locate(time, cursor);
+        if self.is_step(k) {
+            return (k + 1, 0.0, 0.0);
+        }
         let d = self.times[k + 1] - self.times[k];
         let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
         let (eased, ds_du) = self.ease(k).apply(u);
-        (k + 1, eased, (ds_du / d) as f32 * dir, self.is_step(k))
+        (k + 1, eased, (ds_du / d) as f32 * dir)
     }
 
     /// The basis for `time` (any f64), advancing `cursor`.
@@ -130,10 +137,9 @@ impl TimeGrid {
         // through (`map_time`'s own first answer): the rows of a real
         // segment, the table below with its other rows known to be off.
         if t0 <= time && time < tn {
-            let (segment, s, rate, step) = self.real(time, cursor, 1.0);
-            let (h, dh, rate) = sentinel_rows(
-                true, false, false, false, step, s as f32, rate, 1.0, 0.0, true,
-            );
+            let (segment, s, rate) = self.real(time, cursor, 1.0);
+            let (h, dh, rate) =
+                sentinel_rows(true, false, false, false, s as f32, rate, 1.0, 0.0, true);
             return FrameBasis {
                 segment,
                 s,
@@ -145,8 +151,7 @@ impl TimeGrid {
             };
         }
         // Which row of the table (module docs), and the stored segment.
-        let (mut real, mut line, mut reset, mut hold, mut step) =
-            (false, false, false, false, false);
+        let (mut real, mut line, mut reset, mut hold) = (false, false, false, false);
         let (mut s, mut rate, mut dir, mut dt, mut cyc) = (0.0f64, 0.0f32, 1.0f32, 0.0f32, 0.0f32);
         let segment = match map_time(time, t0, tn, self.pre, self.post) {
             Mapped::Inside {
@@ -160,7 +165,7 @@ impl TimeGrid {
                     n
                 } else {
                     let segment;
-                    (segment, s, rate, step) = self.real(time, cursor, dir);
+                    (segment, s, rate) = self.real(time, cursor, dir);
                     real = true;
                     segment
                 }
@@ -178,8 +183,7 @@ impl TimeGrid {
                 if last { n } else { 0 }
             }
         };
-        let (h, dh, rate) =
-            sentinel_rows(real, line, reset, hold, step, s as f32, rate, dir, dt, true);
+        let (h, dh, rate) = sentinel_rows(real, line, reset, hold, s as f32, rate, dir, dt, true);
         FrameBasis {
             segment,
             s,
@@ -193,8 +197,8 @@ impl TimeGrid {
 }
 
 /// The rows of the table in the module docs, for any lane type: lanes in
-/// a `real` segment take the basis at `s` (its `h4`/`h4'` zero on `step`
-/// segments, whose first key is read twice) and `rate` (with the
+/// a `real` segment take the basis at `s` (`step` segments come with
+/// `s = 0` and rate 0, so they hold their first key) and `rate` (with the
 /// direction in it); `line`, `reset` and `hold` lanes their fixed rows; the
 /// rest are exactly at the last key (`dir` carries `oscillate`'s sign).
 /// The one copy for the per-group frame (`f32`) and the loose lanes (`f32x8`).
@@ -205,7 +209,6 @@ pub(crate) fn sentinel_rows<L: Lane>(
     line: L::Mask,
     reset: L::Mask,
     hold: L::Mask,
-    step: L::Mask,
     s: L,
     rate: L,
     dir: L,
@@ -214,7 +217,6 @@ pub(crate) fn sentinel_rows<L: Lane>(
 ) -> ([L; 4], [L; 4], L) {
     let (z, o) = (L::of(0.0), L::of(1.0));
     let at_end = !(real | line | reset | hold);
-    let curve = real & !step;
     let hb = hermite_basis(s);
     let db = if velocity {
         hermite_basis_derivative(s)
@@ -226,13 +228,13 @@ pub(crate) fn sentinel_rows<L: Lane>(
             L::select(real, hb[0], L::select(reset, z, o)),
             L::select(real, hb[1], z),
             L::select(real, hb[2], L::select(line, dt, z)),
-            L::select(curve, hb[3], z),
+            L::select(real, hb[3], z),
         ],
         [
             L::select(real, db[0], z),
             L::select(real, db[1], z),
             L::select(real, db[2], L::select(line, o, z)),
-            L::select(curve, db[3], L::select(at_end, o, z)),
+            L::select(real, db[3], L::select(at_end, o, z)),
         ],
         L::select(real, rate, L::select(line, o, L::select(at_end, dir, z))),
     )

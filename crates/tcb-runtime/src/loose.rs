@@ -152,28 +152,20 @@ impl LooseLane {
 
     /// `[P0, P1, M0, M1]` of each component from keys `ka` and `kb` (see
     /// [`key_pair`]) into lane `i` of `out` (4 planes per component, `dim`
-    /// components); `step` zeroes `M1` (a step segment reads its first key
-    /// twice, and that key's TI belongs to the segment before).
+    /// components).
     #[inline(always)]
-    fn segment(&self, ka: usize, kb: usize, step: bool, out: &mut [f32x8], i: usize) {
+    fn segment(&self, ka: usize, kb: usize, out: &mut [f32x8], i: usize) {
         // One copy per dimension, so that each is straight-line code.
         match self.dim {
-            1 => self.segment_of::<1>(ka, kb, step, out, i),
-            2 => self.segment_of::<2>(ka, kb, step, out, i),
-            3 => self.segment_of::<3>(ka, kb, step, out, i),
-            _ => self.segment_of::<4>(ka, kb, step, out, i),
+            1 => self.segment_of::<1>(ka, kb, out, i),
+            2 => self.segment_of::<2>(ka, kb, out, i),
+            3 => self.segment_of::<3>(ka, kb, out, i),
+            _ => self.segment_of::<4>(ka, kb, out, i),
         }
     }
 
     #[inline(always)]
-    fn segment_of<const N: usize>(
-        &self,
-        ka: usize,
-        kb: usize,
-        step: bool,
-        out: &mut [f32x8],
-        i: usize,
-    ) {
+    fn segment_of<const N: usize>(&self, ka: usize, kb: usize, out: &mut [f32x8], i: usize) {
         let (a, b): ([[f32; KEY_STRIDE]; N], [[f32; KEY_STRIDE]; N]) = match &self.keys {
             Keys::F32(k) => (
                 k[ka * N..][..N].try_into().expect("N components"),
@@ -194,7 +186,7 @@ impl LooseLane {
             o[0].as_mut_array()[i] = a[0];
             o[1].as_mut_array()[i] = b[0];
             o[2].as_mut_array()[i] = a[1];
-            o[3].as_mut_array()[i] = if step { 0.0 } else { b[2] };
+            o[3].as_mut_array()[i] = b[2];
         }
     }
 }
@@ -437,32 +429,26 @@ impl LooseState {
         let lane = &loose.lanes[l];
         let t = lane.grid.times.as_slice();
         let n = t.len();
-        let (ws, we, d, ease, ka, kb, step) = if let Some(&[a, b]) = seg
+        let (ws, we, d, ease, ka, kb) = if let Some(&[a, b]) = seg
             .checked_sub(1)
             .and_then(|k| t.get(k..k + 2))
             .map(|w| <&[f64; 2]>::try_from(w).expect("two times"))
         {
             let k = seg - 1;
+            // A `step` segment is played at u = 0 (its width infinite),
+            // as the per-group frame plays it (`TimeGrid::real`): it holds
+            // its first key exactly, with rate 0.
             let step = lane.grid.is_step(k);
             (
                 a,
                 b,
-                b - a,
+                if step { f64::INFINITY } else { b - a },
                 lane.grid.ease(k),
                 k,
-                if step { k } else { seg },
-                step,
+                if step { 0 } else { seg },
             )
         } else if seg == 0 {
-            (
-                f64::NEG_INFINITY,
-                t[0],
-                1.0,
-                Default::default(),
-                n,
-                n + 1,
-                false,
-            )
+            (f64::NEG_INFINITY, t[0], 1.0, Default::default(), n, n + 1)
         } else {
             (
                 t[n - 1],
@@ -471,7 +457,6 @@ impl LooseState {
                 Default::default(),
                 n + 2,
                 n + 3,
-                false,
             )
         };
         debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
@@ -487,7 +472,7 @@ impl LooseState {
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
         block.rate.as_mut_array()[i] = (1.0 / d) as f32;
         block.seg[i] = seg;
-        lane.segment(ka, kb, step, &mut self.ctl[loose.block[b].ctl.clone()], i);
+        lane.segment(ka, kb, &mut self.ctl[loose.block[b].ctl.clone()], i);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -708,7 +693,6 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
         line,
         reset,
         hold,
-        f32x8::ZERO, // step segments: M1 is zero in the lane's cached controls
         s32,
         f32x8_of(rate[0], rate[1]),
         dirs,

@@ -704,6 +704,89 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
     }
 }
 
+/// A `step` segment holds its key exactly (math.md: the value "stays
+/// P_k"), with zero velocity, even where the key's incoming tangent
+/// overflows f32 (bias -1e300): the runtime read that infinite tangent as
+/// the step segment's `M1` and multiplied it by a zero row, which gave NaN
+/// where the reference holds the key (found by the `runtime` fuzz target:
+/// `fuzz/corpus/runtime/runtime-hermite-step-huge-tangent-nan`).
+#[test]
+fn step_segments_hold_their_keys_past_overflowing_tangents() {
+    let t = vec![0.0, 1.0, 2.5, 3.0];
+    fn keys<V: Copy>() -> Vec<KeyParams<V>> {
+        let mut keys = vec![KeyParams::default(); 4];
+        keys[1].tcb = tcb_core::Tcb::new(0.0, 0.0, -1e300);
+        keys[1].interp = Interp::Step;
+        keys
+    }
+    let q = [
+        Quat::from_rotation_x(0.3),
+        Quat::from_rotation_y(1.2),
+        Quat::from_rotation_z(-0.7),
+        Quat::from_rotation_x(2.0),
+    ];
+    let hermite = TrackSettings {
+        rotation: RotationMode::Hermite,
+        ..TrackSettings::default()
+    };
+    let tracks = vec![
+        NamedTrack {
+            name: "switch".into(),
+            data: TrackData::Scalar(
+                Track::new(
+                    t.clone(),
+                    vec![0.0, 1.0, 0.0, 1.0],
+                    keys(),
+                    &TrackSettings::default(),
+                )
+                .expect("finite parameters"),
+            ),
+        },
+        NamedTrack {
+            name: "v".into(),
+            data: TrackData::Vec3(
+                Track::new(
+                    t.clone(),
+                    vec![Vec3::X, Vec3::new(0.1, 0.7, -0.3), Vec3::Z, Vec3::ONE],
+                    keys(),
+                    &TrackSettings::default(),
+                )
+                .expect("finite parameters"),
+            ),
+        },
+        NamedTrack {
+            name: "r".into(),
+            data: TrackData::Quat(
+                RotationTrack::new(t.clone(), q.to_vec(), keys(), &hermite)
+                    .expect("finite parameters"),
+            ),
+        },
+    ];
+    let clip = tcb_core::Clip::new("step", tracks).expect("unique track names");
+    let compiled = Arc::new(Clip::compile(&clip));
+    let mut inst = Instance::new(compiled.clone()).with_velocities();
+    let n = clip.channel_count();
+    let (mut got, mut got_v) = (vec![0.0f32; n], vec![0.0f32; n]);
+    let (mut want, mut want_v) = (vec![0.0f32; n], vec![0.0f32; n]);
+    for i in 0..150 {
+        let time = 1.0 + f64::from(i) / 100.0;
+        inst.sample(time).write_row(&mut got, Some(&mut got_v));
+        clip.sample_into(time, &mut want, Some(&mut want_v));
+        assert_eq!(want[0], 1.0, "reference switch at {time}");
+        assert_eq!(&want[1..4], &[0.1, 0.7, -0.3], "reference vec3 at {time}");
+        assert_eq!(&got[..4], &want[..4], "runtime vectors at {time}");
+        assert!(
+            got_v.iter().chain(&want_v).all(|v| *v == 0.0),
+            "velocities at {time}: {got_v:?} {want_v:?}"
+        );
+        let r = Quat::from_slice(&got[4..8]);
+        assert!(
+            r.abs_diff_eq(q[1], 1e-6) || r.abs_diff_eq(-q[1], 1e-6),
+            "rotation at {time}: {r:?}"
+        );
+    }
+}
+
 /// A `hermite` rotation with explicit tangents of 1e36: the cubic's squared
 /// length overflows f32, and normalizing it gave a zero quaternion where
 /// the reference (normalizing in f64) gives a rotation (found by the
