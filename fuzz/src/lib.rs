@@ -111,6 +111,87 @@ pub fn blend(data: &[u8]) {
     assert!(tcb_runtime::blend::blend(&mut out, &layers, Some(&[&mask])).is_err());
 }
 
+/// `tcb reduce`'s input: a structured clip, sometimes with a skeleton whose
+/// joints its tracks animate (for the `shell` metric), and arbitrary
+/// options. Never a panic; a reduction that succeeds is within its
+/// tolerance by its own measurement, and what it writes reads back and
+/// builds.
+pub fn reduce(data: &[u8]) {
+    use tcb_core::skeleton::{Joint, Skeleton, Transform};
+    use tcb_fit::{Knots, Metric, ReduceOptions, Tangents};
+    let mut u = Unstructured::new(data);
+    let Ok(mut doc) = arbitrary_doc(&mut u) else {
+        return;
+    };
+    let skeleton = if bool::arbitrary(&mut u).unwrap_or(false) {
+        let mut joints = Vec::new();
+        for (i, track) in doc.tracks.iter_mut().enumerate() {
+            let channel = match track.kind {
+                TrackKind::Quat => "rotation",
+                TrackKind::Vec3 if i % 2 == 0 => "translation",
+                TrackKind::Vec3 => "scale",
+                _ => "weight",
+            };
+            track.name = format!("j{i}.{channel}");
+            let parent = match i {
+                0 => None,
+                _ => u.int_in_range(0..=i).ok().filter(|p| *p < i),
+            };
+            let [x, y, z, _] = value(&mut u).unwrap_or_default();
+            joints.push(Joint {
+                name: format!("j{i}"),
+                parent,
+                rest: Transform {
+                    translation: glam::Vec3::new(x, y, z),
+                    ..Transform::IDENTITY
+                },
+            });
+        }
+        Some(Skeleton { joints })
+    } else {
+        None
+    };
+    let Ok(clip) = doc.build() else {
+        return;
+    };
+    let number = |u: &mut Unstructured| -> Option<f64> {
+        match u.int_in_range(0..=3u8).unwrap_or(0) {
+            0 => None,
+            1 => f64::arbitrary(u).ok(),
+            _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
+        }
+    };
+    let options = ReduceOptions {
+        tolerance: number(&mut u),
+        shell: number(&mut u),
+        metric: *u
+            .choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
+            .unwrap_or(&None),
+        rotation_tolerance: number(&mut u),
+        knots: *u
+            .choose(&[Knots::Track, Knots::Joint, Knots::Clip])
+            .unwrap_or(&Knots::Track),
+        tangents: *u
+            .choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
+            .unwrap_or(&Tangents::Best),
+    };
+    let input = tcb_fit::reduce::Input {
+        doc: &doc,
+        clip: &clip,
+        skeleton: skeleton.as_ref(),
+    };
+    if let Ok(r) = tcb_fit::reduce(input, &options, &|_, _| {}) {
+        assert!(
+            r.worst.error <= r.settings.tolerance,
+            "reduced beyond its tolerance: {} > {}",
+            r.worst.error,
+            r.settings.tolerance
+        );
+        let back = ClipDoc::parse(&r.doc.to_json()).expect("the reduced clip reads back");
+        back.build().expect("the reduced clip builds");
+    }
+}
+
 /// Play a clip that built at its key times, between them, beyond them and
 /// at the awkward times, against the reference.
 fn play(clip: &tcb_core::Clip) {

@@ -49,3 +49,8 @@ fn runtime_corpus() {
 fn blend_corpus() {
     replay("blend", bodies::blend);
 }
+
+#[test]
+fn reduce_corpus() {
+    replay("reduce", bodies::reduce);
+}
