@@ -4,17 +4,20 @@
 //! so a clip read and written again says no more than it said. [`ClipDoc::build`]
 //! resolves defaults and builds the validated [`tcb_core::Clip`].
 //!
-//! Parsing is strict: unknown fields are errors (a misspelt `tangent_rule`
-//! would otherwise silently give another curve), except `extras`, which any
-//! object may carry for the user's own data, as in glTF.
+//! Reading and writing go through serde. Parsing is strict: unknown fields
+//! are errors (a misspelt `tangent_rule` would otherwise silently give
+//! another curve; `deny_unknown_fields`), except `extras`, which any object
+//! may carry for the user's own data, as in glTF. Errors name the track
+//! and the key: serde_path_to_error says where in the document an error
+//! is, and [`ClipDoc::parse`] turns that path into a [`Location`].
 
 use crate::error::{Error, ErrorKind, Location};
+use serde::de::{self, IgnoredAny};
+
 use glam::{Quat, Vec2, Vec3, Vec4};
-use serde_json::{Map, Value as Json};
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::Path;
-use std::str::FromStr;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{
     Clip, Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
@@ -24,41 +27,75 @@ use tcb_core::{
 /// The format string a clip file carries.
 pub const FORMAT: &str = "tcb-clip/1";
 
-/// Track settings as a file states them: `defaults`, or a track's overrides.
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct SettingsDoc {
-    /// `tangent_rule`.
-    pub tangent_rule: Option<TangentRule>,
-    /// `ends`.
-    pub ends: Option<Ends>,
-    /// `match_speed`.
-    pub match_speed: Option<bool>,
-    /// `continuity_fade`.
-    pub continuity_fade: Option<bool>,
-    /// `tcb`: the default `[t, c, b]` of keys that do not state one.
-    pub tcb: Option<[f64; 3]>,
-    /// `pre`.
-    pub pre: Option<Extrapolation>,
-    /// `post`.
-    pub post: Option<Extrapolation>,
-    /// `rotation` (quat tracks).
-    pub rotation: Option<RotationMode>,
-    /// `hemisphere` (quat tracks): `nearest` or `keep`.
-    pub hemisphere: Option<Hemisphere>,
+/// Declares a struct with the nine track settings after its own fields, so
+/// that `defaults`, a track (whose overrides sit beside its own fields:
+/// serde's `flatten` cannot be combined with `deny_unknown_fields`) and
+/// [`SettingsDoc`] list them once.
+macro_rules! with_settings {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($body:tt)* }) => {
+        $(#[$meta])*
+        $vis struct $name {
+            $($body)*
+            /// `tangent_rule`.
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub tangent_rule: Option<TangentRule>,
+            /// `ends`.
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub ends: Option<Ends>,
+            /// `match_speed`.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub match_speed: Option<bool>,
+            /// `continuity_fade`.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub continuity_fade: Option<bool>,
+            /// `tcb`: the default `[t, c, b]` of keys that do not state one.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub tcb: Option<[f64; 3]>,
+            /// `pre`.
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub pre: Option<Extrapolation>,
+            /// `post`.
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub post: Option<Extrapolation>,
+            /// `rotation` (quat tracks).
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub rotation: Option<RotationMode>,
+            /// `hemisphere` (quat tracks): `nearest` or `keep`.
+            #[serde(default, skip_serializing_if = "Option::is_none", with = "named")]
+            pub hemisphere: Option<Hemisphere>,
+        }
+
+        impl $name {
+            /// The nine settings alone.
+            #[allow(dead_code)]
+            fn settings_doc(&self) -> SettingsDoc {
+                SettingsDoc {
+                    tangent_rule: self.tangent_rule,
+                    ends: self.ends,
+                    match_speed: self.match_speed,
+                    continuity_fade: self.continuity_fade,
+                    tcb: self.tcb,
+                    pre: self.pre,
+                    post: self.post,
+                    rotation: self.rotation,
+                    hemisphere: self.hemisphere,
+                }
+            }
+        }
+    };
+}
+
+with_settings! {
+    /// Track settings as a file states them: `defaults`, or a track's overrides.
+    #[derive(Clone, Debug, PartialEq, Default, Serialize)]
+    pub struct SettingsDoc {}
 }
 
 impl SettingsDoc {
-    const FIELDS: [&'static str; 9] = [
-        "tangent_rule",
-        "ends",
-        "match_speed",
-        "continuity_fade",
-        "tcb",
-        "pre",
-        "post",
-        "rotation",
-        "hemisphere",
-    ];
+    /// Whether it states nothing.
+    pub fn is_empty(&self) -> bool {
+        *self == SettingsDoc::default()
+    }
 
     /// These settings, with any field they leave out taken from `base`.
     pub fn or(&self, base: &SettingsDoc) -> SettingsDoc {
@@ -177,61 +214,39 @@ pub fn write_clip_doc(doc: &ClipDoc, path: &Path) -> Result<(), Error> {
 impl ClipDoc {
     /// Parse clip JSON. Errors carry the track and key, not the file.
     pub fn parse(text: &str) -> Result<Self, Error> {
-        let json = parse_json(text)?;
-        let top = Location::default();
-        let obj = as_object(&json, &top, "the clip")?;
-        check_fields(
-            obj,
-            &["format", "name", "defaults", "tracks", "skeleton"],
-            &top,
-            "the clip",
-        )?;
-        match obj.get("format") {
-            Some(Json::String(f)) if f == FORMAT => {}
-            Some(other) => {
-                return Err(Error::invalid(
-                    top,
-                    format!("format is {other}, expected \"{FORMAT}\""),
-                ));
-            }
-            None => {
-                return Err(Error::invalid(
-                    top,
-                    format!("missing \"format\": \"{FORMAT}\""),
-                ));
-            }
+        let mut de = serde_json::Deserializer::from_str(text);
+        let file: FileIn = match serde_path_to_error::deserialize(&mut de) {
+            Ok(file) => file,
+            Err(e) => return Err(parse_error(text, e)),
+        };
+        if let Err(e) = de.end() {
+            return Err(Error {
+                location: Location::default(),
+                kind: ErrorKind::Json {
+                    line: e.line(),
+                    column: e.column(),
+                    message: strip_position(&e.to_string()),
+                },
+            });
         }
-        let name = match obj.get("name") {
-            None => String::new(),
-            Some(v) => as_str(v, &top, "name")?.to_owned(),
-        };
-        let defaults = match obj.get("defaults") {
-            None => SettingsDoc::default(),
-            Some(v) => {
-                let d = as_object(v, &top, "defaults")?;
-                check_fields(d, &SettingsDoc::FIELDS, &top, "defaults")?;
-                parse_settings(d, &top)?
-            }
-        };
-        let tracks = match obj.get("tracks") {
-            Some(Json::Array(a)) => a,
-            Some(_) => return Err(Error::invalid(top, "tracks must be an array")),
-            None => return Err(Error::invalid(top, "missing \"tracks\"")),
-        };
-        let tracks = tracks
-            .iter()
-            .enumerate()
-            .map(|(i, t)| parse_track(i, t))
-            .collect::<Result<Vec<_>, _>>()?;
-        let skeleton = match obj.get("skeleton") {
-            None => None,
-            Some(v) => Some(crate::skeleton_json::parse(v)?),
+        let top = Location::default();
+        if let Some(message) = format_error(file.format.map(serde_json::Value::String).as_ref()) {
+            return Err(Error::invalid(top, message));
+        }
+        let Some(tracks) = file.tracks else {
+            return Err(Error::invalid(top, "missing \"tracks\""));
         };
         Ok(ClipDoc {
-            name,
-            defaults,
-            tracks,
-            skeleton,
+            name: file.name,
+            defaults: file.defaults.map(|d| d.settings_doc()).unwrap_or_default(),
+            tracks: tracks
+                .into_iter()
+                .map(TrackIn::into_doc)
+                .collect::<Result<_, _>>()?,
+            skeleton: file
+                .skeleton
+                .map(crate::skeleton_json::SkeletonIn::into_skeleton)
+                .transpose()?,
         })
     }
 
@@ -276,30 +291,18 @@ impl ClipDoc {
 
     /// The clip as JSON text: one line per field of a track, so that large
     /// clips stay readable and diffable. Numbers are written in their
-    /// shortest round-trip form.
+    /// shortest round-trip form (f32 values and tangents as f32).
     pub fn to_json(&self) -> String {
-        let mut out = String::new();
-        out.push_str("{\n");
-        let _ = writeln!(out, "  \"format\": \"{FORMAT}\",");
-        let _ = writeln!(out, "  \"name\": {},", json_str(&self.name));
-        let defaults = settings_json(&self.defaults);
-        if !defaults.is_empty() {
-            let _ = writeln!(out, "  \"defaults\": {{{}}},", defaults.join(", "));
-        }
-        if let Some(skeleton) = &self.skeleton {
-            crate::skeleton_json::write(skeleton, &mut out);
-        }
-        out.push_str("  \"tracks\": [");
-        for (i, t) in self.tracks.iter().enumerate() {
-            out.push_str(if i == 0 { "\n" } else { ",\n" });
-            t.write_json(&mut out);
-        }
-        out.push_str(if self.tracks.is_empty() {
-            "]\n}\n"
-        } else {
-            "\n  ]\n}\n"
-        });
-        out
+        to_json_text(&FileOut {
+            format: FORMAT,
+            name: &self.name,
+            defaults: &self.defaults,
+            skeleton: self
+                .skeleton
+                .as_ref()
+                .map(crate::skeleton_json::SkeletonOut::of),
+            tracks: self.tracks.iter().map(TrackDoc::out).collect(),
+        })
     }
 }
 
@@ -357,168 +360,351 @@ impl TrackDoc {
             }
         })
     }
+}
 
-    fn write_json(&self, out: &mut String) {
-        let dim = self.kind.dim();
-        let value = |v: &[f32; 4]| {
-            if self.kind == TrackKind::Scalar {
-                num32(v[0])
-            } else {
-                format!(
-                    "[{}]",
-                    v[..dim]
-                        .iter()
-                        .map(|&x| num32(x))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
+/// `Option<T>` as the name of a [`tcb_core`] enum (its `Display` and
+/// `FromStr`). An unknown name's message has a `{field}` placeholder that
+/// [`ClipDoc::parse`] fills with the field it was found in.
+mod named {
+    use serde::{Deserialize, Deserializer, Serializer, de};
+    use std::fmt::Display;
+    use std::str::FromStr;
+
+    pub fn serialize<T: Display, S: Serializer>(v: &Option<T>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => s.collect_str(v),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, T, D>(d: D) -> Result<Option<T>, D::Error>
+    where
+        T: FromStr,
+        T::Err: Display,
+        D: Deserializer<'de>,
+    {
+        let name = std::borrow::Cow::<str>::deserialize(d)?;
+        name.parse()
+            .map(Some)
+            .map_err(|e| de::Error::custom(format!("unknown {{field}} \"{name}\" ({e})")))
+    }
+}
+
+/// `extras`: whatever the user keeps there, not kept by the reader but
+/// walked, so that it is nested no deeper than the JSON reader's limit
+/// (128 levels) like the rest of the file.
+pub(crate) struct Extras;
+
+impl<'de> Deserialize<'de> for Extras {
+    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> de::Visitor<'de> for V {
+            type Value = Extras;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("any JSON value")
             }
+            fn visit_bool<E>(self, _: bool) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_i64<E>(self, _: i64) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_u64<E>(self, _: u64) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_f64<E>(self, _: f64) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_str<E>(self, _: &str) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_unit<E>(self) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_none<E>(self) -> Result<Extras, E> {
+                Ok(Extras)
+            }
+            fn visit_some<D: de::Deserializer<'de>>(self, d: D) -> Result<Extras, D::Error> {
+                Extras::deserialize(d)
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
+                while a.next_element::<Extras>()?.is_some() {}
+                Ok(Extras)
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
+                while a.next_entry::<IgnoredAny, Extras>()?.is_some() {}
+                Ok(Extras)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A value as written: a number, or an array of numbers (its shape is
+/// checked against the track's kind once the kind is known).
+#[derive(Clone, Debug, PartialEq)]
+enum ValueIn {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for ValueIn {
+    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> de::Visitor<'de> for V {
+            type Value = ValueIn;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or an array of numbers")
+            }
+            fn visit_f64<E>(self, x: f64) -> Result<ValueIn, E> {
+                Ok(ValueIn::One(x))
+            }
+            fn visit_i64<E>(self, x: i64) -> Result<ValueIn, E> {
+                Ok(ValueIn::One(x as f64))
+            }
+            fn visit_u64<E>(self, x: u64) -> Result<ValueIn, E> {
+                Ok(ValueIn::One(x as f64))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut a: A) -> Result<ValueIn, A::Error> {
+                // At most 4 are ever used; a longer array is reported by
+                // length, without keeping what it holds.
+                let mut out = Vec::with_capacity(4);
+                while let Some(x) = a.next_element::<f64>()? {
+                    if out.len() < 16 {
+                        out.push(x);
+                    } else {
+                        out.push(0.0);
+                        out.truncate(16);
+                    }
+                }
+                Ok(ValueIn::Many(out))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl ValueIn {
+    /// The value for `kind`, as f32 components padded to 4.
+    fn to_value(&self, kind: TrackKind, what: &str) -> Result<[f32; 4], String> {
+        let mut out = [0.0f32; 4];
+        let xs: &[f64] = match (self, kind) {
+            (ValueIn::One(x), TrackKind::Scalar) => std::slice::from_ref(x),
+            (ValueIn::Many(_), TrackKind::Scalar) => {
+                return Err(format!(
+                    "{what} of a scalar track must be a number, found {}",
+                    self.brief()
+                ));
+            }
+            (ValueIn::One(_), _) => {
+                return Err(format!(
+                    "{what} of a {kind} track must be an array of {} numbers, found {}",
+                    kind.dim(),
+                    self.brief()
+                ));
+            }
+            (ValueIn::Many(xs), _) if xs.len() != kind.dim() => {
+                return Err(format!(
+                    "{what} of a {kind} track must have {} numbers, found {}",
+                    kind.dim(),
+                    xs.len()
+                ));
+            }
+            (ValueIn::Many(xs), _) => xs,
         };
-        let _ = write!(
-            out,
-            "    {{\n      \"name\": {},\n      \"kind\": \"{}\",\n      \"times\": [{}],\n      \"values\": [{}]",
-            json_str(&self.name),
-            self.kind,
-            self.times
-                .iter()
-                .map(|&t| num64(t))
-                .collect::<Vec<_>>()
-                .join(", "),
-            self.values.iter().map(value).collect::<Vec<_>>().join(", "),
-        );
-        if self.keys.iter().any(|k| !k.is_empty()) {
-            let keys: Vec<String> = self
-                .keys
-                .iter()
-                .map(|k| {
-                    let mut f = Vec::new();
-                    if let Some(t) = k.tcb {
-                        f.push(format!(
-                            "\"tcb\": [{}, {}, {}]",
-                            num64(t[0]),
-                            num64(t[1]),
-                            num64(t[2])
-                        ));
-                    }
-                    if let Some(e) = k.ease {
-                        f.push(format!("\"ease\": [{}, {}]", num64(e[0]), num64(e[1])));
-                    }
-                    if let Some(i) = k.interp {
-                        f.push(format!("\"interp\": \"{i}\""));
-                    }
-                    if let Some(v) = &k.tangent_in {
-                        f.push(format!("\"in\": {}", value(v)));
-                    }
-                    if let Some(v) = &k.tangent_out {
-                        f.push(format!("\"out\": {}", value(v)));
-                    }
-                    format!("{{{}}}", f.join(", "))
-                })
-                .collect();
-            let _ = write!(out, ",\n      \"keys\": [{}]", keys.join(", "));
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o = finite_f32(x, what)?;
         }
-        for field in settings_json(&self.settings) {
-            let _ = write!(out, ",\n      {field}");
+        Ok(out)
+    }
+
+    fn brief(&self) -> String {
+        match self {
+            ValueIn::One(x) => format!("{x}"),
+            ValueIn::Many(xs) if xs.len() > 4 => format!("an array of {}", xs.len()),
+            ValueIn::Many(xs) => format!(
+                "[{}]",
+                xs.iter()
+                    .map(|x| format!("{x}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         }
-        out.push_str("\n    }");
     }
 }
 
-fn settings_json(s: &SettingsDoc) -> Vec<String> {
-    let mut f = Vec::new();
-    let mut text = |k: &str, v: Option<&str>| {
-        if let Some(v) = v {
-            f.push(format!("\"{k}\": \"{v}\""));
-        }
-    };
-    text("tangent_rule", s.tangent_rule.map(|x| x.name()));
-    text("ends", s.ends.map(|x| x.name()));
-    text("pre", s.pre.map(|x| x.name()));
-    text("post", s.post.map(|x| x.name()));
-    text("rotation", s.rotation.map(|x| x.name()));
-    text("hemisphere", s.hemisphere.map(|x| x.name()));
-    if let Some(b) = s.match_speed {
-        f.push(format!("\"match_speed\": {b}"));
+/// An f64 as read that must fit an f32 (finite after rounding).
+pub(crate) fn finite_f32(x: f64, what: &str) -> Result<f32, String> {
+    let y = x as f32;
+    if y.is_finite() {
+        Ok(y)
+    } else {
+        // serde_json's shortest form (`1e300`, not 301 digits).
+        let text = serde_json::Number::from_f64(x).map_or(x.to_string(), |n| n.to_string());
+        Err(format!("{what} {text} is not a finite f32"))
     }
-    if let Some(b) = s.continuity_fade {
-        f.push(format!("\"continuity_fade\": {b}"));
-    }
-    if let Some(t) = s.tcb {
-        f.push(format!(
-            "\"tcb\": [{}, {}, {}]",
-            num64(t[0]),
-            num64(t[1]),
-            num64(t[2])
-        ));
-    }
-    f
 }
 
-/// Shortest round-trip form of an f32 (as JSON: `1` not `1.0` is fine).
-pub(crate) fn num32(x: f32) -> String {
-    format!("{x}")
+/// A track's `kind`, with the contract's message for an unknown one.
+fn kind<'de, D: de::Deserializer<'de>>(d: D) -> Result<TrackKind, D::Error> {
+    let name = std::borrow::Cow::<str>::deserialize(d)?;
+    TrackKind::from_name(&name).ok_or_else(|| {
+        de::Error::custom(format!(
+            "unknown {{field}} \"{name}\" (expected one of: scalar, vec2, vec3, vec4, quat)"
+        ))
+    })
 }
 
-fn num64(x: f64) -> String {
-    format!("{x}")
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileIn {
+    format: Option<String>,
+    #[serde(default)]
+    name: String,
+    #[serde(default)]
+    defaults: Option<DefaultsIn>,
+    tracks: Option<Vec<TrackIn>>,
+    #[serde(default)]
+    skeleton: Option<crate::skeleton_json::SkeletonIn>,
+    #[serde(default, rename = "extras")]
+    _extras: Option<Extras>,
 }
 
-pub(crate) fn json_str(s: &str) -> String {
-    Json::String(s.to_owned()).to_string()
+with_settings! {
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct DefaultsIn {
+        #[serde(default, rename = "extras")]
+        _extras: Option<Extras>,
+    }
+}
+
+with_settings! {
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct TrackIn {
+        name: String,
+        #[serde(deserialize_with = "kind")]
+        kind: TrackKind,
+        times: Vec<f64>,
+        values: Vec<ValueIn>,
+        #[serde(default)]
+        keys: Option<Vec<KeyIn>>,
+        #[serde(default, rename = "extras")]
+        _extras: Option<Extras>,
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyIn {
+    #[serde(default)]
+    tcb: Option<[f64; 3]>,
+    #[serde(default)]
+    ease: Option<[f64; 2]>,
+    #[serde(default, with = "named")]
+    interp: Option<Interp>,
+    #[serde(default, rename = "in")]
+    tangent_in: Option<ValueIn>,
+    #[serde(default, rename = "out")]
+    tangent_out: Option<ValueIn>,
+    #[serde(default, rename = "extras")]
+    _extras: Option<Extras>,
+}
+
+/// What an error's location needs when the strict parse fails: the
+/// format, and the tracks' names (everything else skipped unread, so
+/// that this pass succeeds where the strict one stopped).
+#[derive(Deserialize)]
+struct Outline {
+    #[serde(default)]
+    format: Option<serde_json::Value>,
+    #[serde(default)]
+    tracks: Vec<NameOnly>,
+}
+
+#[derive(Deserialize)]
+struct NameOnly {
+    #[serde(default)]
+    name: Option<serde_json::Value>,
 }
 
 fn quote(name: &str) -> String {
     format!("'{name}'")
 }
 
-/// Marks a number token that overflows f64 (`1e999`), quoted so that the
-/// document parses and the error can name its track and key.
-const OVERFLOW: &str = "\u{0}overflow:";
-
-/// JSON text to a value. serde_json refuses numbers beyond f64 as a syntax
-/// error; those tokens are quoted with [`OVERFLOW`] and reported later, where
-/// the track and key are known.
-fn parse_json(text: &str) -> Result<Json, Error> {
-    let mut text = std::borrow::Cow::Borrowed(text);
-    // Each round quotes one token; the bound only guards against a loop.
-    for _ in 0..64 {
-        let e = match serde_json::from_str::<Json>(&text) {
-            Ok(json) => return Ok(json),
-            Err(e) => e,
-        };
-        if e.to_string().starts_with("number out of range")
-            && let Some(quoted) = quote_number_at(&text, e.line(), e.column())
-        {
-            text = quoted.into();
-            continue;
-        }
-        return Err(Error {
-            location: Location::default(),
-            kind: ErrorKind::Json {
-                line: e.line(),
-                column: e.column(),
-                message: strip_position(&e.to_string()),
-            },
-        });
+/// The format check: `None` when it is this format.
+fn format_error(format: Option<&serde_json::Value>) -> Option<String> {
+    match format {
+        Some(serde_json::Value::String(f)) if f == FORMAT => None,
+        Some(other) => Some(format!("format is {other}, expected \"{FORMAT}\"")),
+        None => Some(format!("missing \"format\": \"{FORMAT}\"")),
     }
-    Err(Error::invalid(
-        Location::default(),
-        "too many numbers out of range",
-    ))
 }
 
-/// `text` with the number token ending near `line`:`column` quoted.
-fn quote_number_at(text: &str, line: usize, column: usize) -> Option<String> {
+/// Where a serde error is, as a [`Location`] and the field it was in,
+/// from its path (`tracks[3].keys[5].tcb`) and the tracks' names.
+fn locate(
+    path: &serde_path_to_error::Path,
+    names: &[Option<String>],
+) -> (Location, String, String) {
+    use serde_path_to_error::Segment;
+    let mut loc = Location::default();
+    // The object the error is in (for messages), and the field.
+    let (mut within, mut field) = ("the clip".to_owned(), String::new());
+    let mut last_map: Option<&str> = None;
+    for seg in path.iter() {
+        match seg {
+            // Inside `extras` the user's own keys say nothing to us.
+            Segment::Map { key } if key == "extras" => {
+                field = key.clone();
+                break;
+            }
+            Segment::Map { key } => {
+                match (last_map, key.as_str()) {
+                    (None, "defaults") => within = "defaults".into(),
+                    (None, "skeleton") => within = "skeleton".into(),
+                    _ => {}
+                }
+                last_map = Some(key);
+                field = key.clone();
+            }
+            Segment::Seq { index } => match last_map {
+                Some("tracks") if loc.track.is_none() => {
+                    loc.track = Some(match names.get(*index) {
+                        Some(Some(n)) => quote(n),
+                        _ => format!("#{index}"),
+                    });
+                    within = "a track".into();
+                }
+                Some("times" | "values" | "keys") if loc.track.is_some() => {
+                    loc.key = Some(*index);
+                    if last_map == Some("keys") {
+                        within = "a key".into();
+                    }
+                }
+                Some("joints") => within = format!("skeleton joint {index}"),
+                _ => {}
+            },
+            _ => {}
+        }
+    }
+    (loc, within, field)
+}
+
+/// The number token that ends at or near byte column `column` of `line`
+/// (serde_json's position of a number it refused), if it is one.
+fn number_at(text: &str, line: usize, column: usize) -> Option<&str> {
     let start_of_line: usize = text
         .split_inclusive('\n')
-        .take(line - 1)
+        .take(line.saturating_sub(1))
         .map(str::len)
         .sum();
     let at = (start_of_line + column).min(text.len());
     let is_num = |c: u8| c.is_ascii_digit() || matches!(c, b'e' | b'E' | b'+' | b'-' | b'.');
     let bytes = text.as_bytes();
     let mut end = at;
-    while end > 0 && !is_num(bytes[end - 1]) {
+    while end > start_of_line && !is_num(bytes[end - 1]) {
         end -= 1;
     }
     while end < bytes.len() && is_num(bytes[end]) {
@@ -528,14 +714,78 @@ fn quote_number_at(text: &str, line: usize, column: usize) -> Option<String> {
     while start > 0 && is_num(bytes[start - 1]) {
         start -= 1;
     }
-    (start < end).then(|| {
-        format!(
-            "{}\"\\u0000overflow:{}\"{}",
-            &text[..start],
-            &text[start..end],
-            &text[end..]
-        )
-    })
+    let token = &text[start..end];
+    token.parse::<f64>().ok().map(|_| token)
+}
+
+/// The error for a failed strict parse.
+fn parse_error(text: &str, e: serde_path_to_error::Error<serde_json::Error>) -> Error {
+    let outline: Option<Outline> = serde_json::from_str(text).ok();
+    if let Some(o) = &outline
+        && let Some(message) = format_error(o.format.as_ref())
+    {
+        return Error::invalid(Location::default(), message);
+    }
+    let names: Vec<Option<String>> = outline.map_or_else(Vec::new, |o| {
+        o.tracks
+            .into_iter()
+            .map(|t| t.name.and_then(|n| n.as_str().map(str::to_owned)))
+            .collect()
+    });
+    let (mut location, within, field) = locate(e.path(), &names);
+    // One entry of `times` or `values` is one key's time or value.
+    let field = match field.as_str() {
+        "times" => "time".to_owned(),
+        "values" => "value".to_owned(),
+        _ => field,
+    };
+    // Inside a track the location says where; elsewhere the message does.
+    let prefix = match (&location.track, within.as_str()) {
+        (None, w) if w != "the clip" => format!("{w}: "),
+        _ => String::new(),
+    };
+    let inner = e.into_inner();
+    let (line, column) = (inner.line(), inner.column());
+    let message = strip_position(&inner.to_string())
+        .replace('`', "\"")
+        .replace("expected f64", "expected a number")
+        .replace(
+            "recursion limit exceeded",
+            "nested deeper than 128 levels (the JSON reader's limit)",
+        );
+    if inner.is_syntax() || inner.is_eof() {
+        // JSON has no infinity: a number beyond f64 (1e999) is refused by
+        // the tokenizer; say which, where the track and key are known.
+        if let Some(token) = number_at(text, line, column)
+            && token.parse::<f64>().is_ok_and(f64::is_infinite)
+        {
+            return Error::invalid(
+                location,
+                format!("{prefix}{field} {token} is not a finite number"),
+            );
+        }
+        // Broken JSON: its line and column say where.
+        location = Location::default();
+        return Error {
+            location,
+            kind: ErrorKind::Json {
+                line,
+                column,
+                message,
+            },
+        };
+    }
+    let message = if message.contains("{field}") {
+        message.replacen("{field}", &field, 1)
+    } else if message.starts_with("unknown field")
+        || message.starts_with("missing field")
+        || field.is_empty()
+    {
+        message
+    } else {
+        format!("{field}: {message}")
+    };
+    Error::invalid(location, format!("{prefix}{message}"))
 }
 
 /// serde_json appends " at line L column C"; we report those separately.
@@ -546,298 +796,279 @@ fn strip_position(message: &str) -> String {
     }
 }
 
-pub(crate) fn as_object<'a>(
-    v: &'a Json,
-    loc: &Location,
-    what: &str,
-) -> Result<&'a Map<String, Json>, Error> {
-    v.as_object()
-        .ok_or_else(|| Error::invalid(loc.clone(), format!("{what} must be a JSON object")))
-}
-
-pub(crate) fn as_str<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a str, Error> {
-    v.as_str()
-        .ok_or_else(|| Error::invalid(loc.clone(), format!("{what} must be a string, found {v}")))
-}
-
-fn as_bool(v: &Json, loc: &Location, what: &str) -> Result<bool, Error> {
-    v.as_bool().ok_or_else(|| {
-        Error::invalid(
-            loc.clone(),
-            format!("{what} must be true or false, found {v}"),
-        )
-    })
-}
-
-fn as_f64(v: &Json, loc: &Location, what: &str) -> Result<f64, Error> {
-    if let Some(token) = v.as_str().and_then(|s| s.strip_prefix(OVERFLOW)) {
-        return Err(Error::invalid(
-            loc.clone(),
-            format!("{what} {token} is not a finite number"),
-        ));
-    }
-    v.as_f64()
-        .ok_or_else(|| Error::invalid(loc.clone(), format!("{what} must be a number, found {v}")))
-}
-
-/// A JSON number that fits an f32 (finite after rounding).
-pub(crate) fn as_f32(v: &Json, loc: &Location, what: &str) -> Result<f32, Error> {
-    let x = as_f64(v, loc, what)? as f32;
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(Error::invalid(
-            loc.clone(),
-            format!("{what} {v} is not a finite f32"),
-        ))
-    }
-}
-
-pub(crate) fn as_array<'a>(v: &'a Json, loc: &Location, what: &str) -> Result<&'a [Json], Error> {
-    v.as_array().map(Vec::as_slice).ok_or_else(|| {
-        Error::invalid(
-            loc.clone(),
-            format!("{what} must be an array, found {}", brief(v)),
-        )
-    })
-}
-
-pub(crate) fn as_numbers<const N: usize>(
-    v: &Json,
-    loc: &Location,
-    what: &str,
-) -> Result<[f64; N], Error> {
-    let a = as_array(v, loc, what)?;
-    if a.len() != N {
-        return Err(Error::invalid(
-            loc.clone(),
-            format!("{what} must have {N} numbers, found {}", a.len()),
-        ));
-    }
-    let mut out = [0.0; N];
-    for (o, x) in out.iter_mut().zip(a) {
-        *o = as_f64(x, loc, what)?;
-    }
-    Ok(out)
-}
-
-fn as_enum<T: FromStr<Err = tcb_core::params::UnknownName>>(
-    v: &Json,
-    loc: &Location,
-    what: &str,
-) -> Result<T, Error> {
-    let s = as_str(v, loc, what)?;
-    s.parse()
-        .map_err(|e| Error::invalid(loc.clone(), format!("unknown {what} \"{s}\" ({e})")))
-}
-
-/// A short rendering of a JSON value for messages.
-fn brief(v: &Json) -> String {
-    let s = v.to_string();
-    if s.chars().count() > 40 {
-        format!("{}...", s.chars().take(40).collect::<String>())
-    } else {
-        s
-    }
-}
-
-pub(crate) fn check_fields(
-    obj: &Map<String, Json>,
-    allowed: &[&str],
-    loc: &Location,
-    what: &str,
-) -> Result<(), Error> {
-    for k in obj.keys() {
-        if k != "extras" && !allowed.contains(&k.as_str()) {
+impl TrackIn {
+    fn into_doc(self) -> Result<TrackDoc, Error> {
+        let loc = Location {
+            track: Some(quote(&self.name)),
+            ..Location::default()
+        };
+        let at = |key: usize| Location {
+            key: Some(key),
+            ..loc.clone()
+        };
+        if self.values.len() != self.times.len() {
             return Err(Error::invalid(
-                loc.clone(),
+                loc,
                 format!(
-                    "unknown field \"{k}\" in {what} (expected one of: {})",
-                    allowed.join(", ")
+                    "{} values for {} times",
+                    self.values.len(),
+                    self.times.len()
                 ),
             ));
         }
-    }
-    Ok(())
-}
-
-fn parse_settings(obj: &Map<String, Json>, loc: &Location) -> Result<SettingsDoc, Error> {
-    let get = |k: &str| obj.get(k);
-    Ok(SettingsDoc {
-        tangent_rule: get("tangent_rule")
-            .map(|v| as_enum(v, loc, "tangent_rule"))
-            .transpose()?,
-        ends: get("ends").map(|v| as_enum(v, loc, "ends")).transpose()?,
-        match_speed: get("match_speed")
-            .map(|v| as_bool(v, loc, "match_speed"))
-            .transpose()?,
-        continuity_fade: get("continuity_fade")
-            .map(|v| as_bool(v, loc, "continuity_fade"))
-            .transpose()?,
-        tcb: get("tcb").map(|v| parse_tcb(v, loc)).transpose()?,
-        pre: get("pre").map(|v| as_enum(v, loc, "pre")).transpose()?,
-        post: get("post").map(|v| as_enum(v, loc, "post")).transpose()?,
-        rotation: get("rotation")
-            .map(|v| as_enum(v, loc, "rotation"))
-            .transpose()?,
-        hemisphere: get("hemisphere")
-            .map(|v| as_enum(v, loc, "hemisphere"))
-            .transpose()?,
-    })
-}
-
-fn parse_tcb(v: &Json, loc: &Location) -> Result<[f64; 3], Error> {
-    // JSON has no NaN or infinity, but 1e999 parses as infinity.
-    let t = as_numbers::<3>(v, loc, "tcb")?;
-    if t.iter().all(|x| x.is_finite()) {
-        Ok(t)
-    } else {
-        Err(Error::invalid(
-            loc.clone(),
-            "tcb has a value that is not finite",
-        ))
-    }
-}
-
-/// A value of `kind`: a number for scalars, an array of `dim` numbers otherwise.
-fn parse_value(v: &Json, kind: TrackKind, loc: &Location, what: &str) -> Result<[f32; 4], Error> {
-    let mut out = [0.0f32; 4];
-    if kind == TrackKind::Scalar {
-        if v.is_array() {
-            return Err(Error::invalid(
-                loc.clone(),
-                format!(
-                    "{what} of a scalar track must be a number, found {}",
-                    brief(v)
-                ),
-            ));
-        }
-        out[0] = as_f32(v, loc, what)?;
-        return Ok(out);
-    }
-    let a = v.as_array().ok_or_else(|| {
-        Error::invalid(
-            loc.clone(),
-            format!(
-                "{what} of a {kind} track must be an array of {} numbers, found {}",
-                kind.dim(),
-                brief(v)
-            ),
-        )
-    })?;
-    if a.len() != kind.dim() {
-        return Err(Error::invalid(
-            loc.clone(),
-            format!(
-                "{what} of a {kind} track must have {} numbers, found {}",
-                kind.dim(),
-                a.len()
-            ),
-        ));
-    }
-    for (o, x) in out.iter_mut().zip(a) {
-        *o = as_f32(x, loc, what)?;
-    }
-    Ok(out)
-}
-
-fn parse_track(index: usize, v: &Json) -> Result<TrackDoc, Error> {
-    let mut loc = Location {
-        track: Some(format!("#{index}")),
-        ..Location::default()
-    };
-    let obj = as_object(v, &loc, "a track")?;
-    let name = match obj.get("name") {
-        Some(n) => as_str(n, &loc, "name")?.to_owned(),
-        None => return Err(Error::invalid(loc, "missing \"name\"")),
-    };
-    loc.track = Some(quote(&name));
-    let mut allowed = vec!["name", "kind", "times", "values", "keys"];
-    allowed.extend(SettingsDoc::FIELDS);
-    check_fields(obj, &allowed, &loc, "a track")?;
-    let kind = match obj.get("kind") {
-        Some(k) => {
-            let s = as_str(k, &loc, "kind")?;
-            TrackKind::from_name(s).ok_or_else(|| {
-                Error::invalid(
-                    loc.clone(),
-                    format!(
-                        "unknown kind \"{s}\" (expected one of: scalar, vec2, vec3, vec4, quat)"
-                    ),
-                )
-            })?
-        }
-        None => return Err(Error::invalid(loc, "missing \"kind\"")),
-    };
-    let times_json = as_array(obj.get("times").unwrap_or(&Json::Null), &loc, "times")?;
-    let values_json = as_array(obj.get("values").unwrap_or(&Json::Null), &loc, "values")?;
-    let at = |key: usize| Location {
-        key: Some(key),
-        ..loc.clone()
-    };
-    let times = times_json
-        .iter()
-        .enumerate()
-        .map(|(k, t)| as_f64(t, &at(k), "time"))
-        .collect::<Result<Vec<_>, _>>()?;
-    if values_json.len() != times.len() {
-        return Err(Error::invalid(
-            loc,
-            format!("{} values for {} times", values_json.len(), times.len()),
-        ));
-    }
-    let values = values_json
-        .iter()
-        .enumerate()
-        .map(|(k, v)| parse_value(v, kind, &at(k), "value"))
-        .collect::<Result<Vec<_>, _>>()?;
-    let keys = match obj.get("keys") {
-        None => Vec::new(),
-        Some(k) => {
-            let keys = as_array(k, &loc, "keys")?;
-            if keys.len() != times.len() {
+        let values = self
+            .values
+            .iter()
+            .enumerate()
+            .map(|(k, v)| {
+                v.to_value(self.kind, "value")
+                    .map_err(|m| Error::invalid(at(k), m))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let keys = match &self.keys {
+            None => Vec::new(),
+            Some(keys) if keys.len() != self.times.len() => {
                 return Err(Error::invalid(
                     loc,
-                    format!("{} keys for {} times", keys.len(), times.len()),
+                    format!("{} keys for {} times", keys.len(), self.times.len()),
                 ));
             }
-            keys.iter()
+            Some(keys) => keys
+                .iter()
                 .enumerate()
-                .map(|(k, key)| parse_key(key, kind, &at(k)))
-                .collect::<Result<Vec<_>, _>>()?
-        }
-    };
-    let settings = parse_settings(obj, &loc)?;
-    Ok(TrackDoc {
-        name,
-        kind,
-        times,
-        values,
-        keys,
-        settings,
-    })
+                .map(|(k, key)| {
+                    let value = |v: &Option<ValueIn>, what| {
+                        v.as_ref()
+                            .map(|v| v.to_value(self.kind, what))
+                            .transpose()
+                            .map_err(|m| Error::invalid(at(k), m))
+                    };
+                    Ok(KeyDoc {
+                        tcb: key.tcb,
+                        ease: key.ease,
+                        interp: key.interp,
+                        tangent_in: value(&key.tangent_in, "in")?,
+                        tangent_out: value(&key.tangent_out, "out")?,
+                    })
+                })
+                .collect::<Result<Vec<_>, Error>>()?,
+        };
+        Ok(TrackDoc {
+            settings: self.settings_doc(),
+            name: self.name,
+            kind: self.kind,
+            times: self.times,
+            values,
+            keys,
+        })
+    }
 }
 
-fn parse_key(v: &Json, kind: TrackKind, loc: &Location) -> Result<KeyDoc, Error> {
-    let obj = as_object(v, loc, "a key")?;
-    check_fields(obj, &["tcb", "ease", "interp", "in", "out"], loc, "a key")?;
-    Ok(KeyDoc {
-        tcb: obj.get("tcb").map(|v| parse_tcb(v, loc)).transpose()?,
-        ease: obj
-            .get("ease")
-            .map(|v| as_numbers::<2>(v, loc, "ease"))
-            .transpose()?,
-        interp: obj
-            .get("interp")
-            .map(|v| as_enum(v, loc, "interp"))
-            .transpose()?,
-        tangent_in: obj
-            .get("in")
-            .map(|v| parse_value(v, kind, loc, "in"))
-            .transpose()?,
-        tangent_out: obj
-            .get("out")
-            .map(|v| parse_value(v, kind, loc, "out"))
-            .transpose()?,
-    })
+/// Lays a clip out one line per field of a track, so that large clips stay
+/// readable and diffable: containers down to the tracks' fields are
+/// indented, anything inside a field (times, values, keys) is on one line.
+#[derive(Default)]
+struct ClipFormatter {
+    depth: usize,
+    has_value: bool,
+    /// A number's text, before it is written.
+    number: Vec<u8>,
+}
+
+impl ClipFormatter {
+    /// Containers this deep or less put each entry on its own line.
+    const PRETTY: usize = 3;
+
+    fn entry<W: ?Sized + std::io::Write>(&self, w: &mut W, first: bool) -> std::io::Result<()> {
+        if self.depth <= Self::PRETTY {
+            w.write_all(if first { b"\n" } else { b",\n" })?;
+            w.write_all(&b" ".repeat(2 * self.depth))
+        } else if first {
+            Ok(())
+        } else {
+            w.write_all(b", ")
+        }
+    }
+
+    fn open<W: ?Sized + std::io::Write>(&mut self, w: &mut W, c: &[u8]) -> std::io::Result<()> {
+        self.depth += 1;
+        self.has_value = false;
+        w.write_all(c)
+    }
+
+    fn close<W: ?Sized + std::io::Write>(&mut self, w: &mut W, c: &[u8]) -> std::io::Result<()> {
+        if self.depth <= Self::PRETTY && self.has_value {
+            w.write_all(b"\n")?;
+            w.write_all(&b" ".repeat(2 * (self.depth - 1)))?;
+        }
+        self.depth -= 1;
+        w.write_all(c)
+    }
+}
+
+impl serde_json::ser::Formatter for ClipFormatter {
+    fn begin_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.open(w, b"[")
+    }
+    fn end_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.close(w, b"]")
+    }
+    fn begin_array_value<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        self.entry(w, first)
+    }
+    fn end_array_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
+        self.has_value = true;
+        Ok(())
+    }
+    fn begin_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.open(w, b"{")
+    }
+    fn end_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.close(w, b"}")
+    }
+    fn begin_object_key<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        self.entry(w, first)
+    }
+    fn begin_object_value<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        w.write_all(b": ")
+    }
+    fn end_object_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
+        self.has_value = true;
+        Ok(())
+    }
+    fn write_f32<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f32) -> std::io::Result<()> {
+        self.number.clear();
+        serde_json::ser::CompactFormatter.write_f32(&mut self.number, x)?;
+        self.write_number(w)
+    }
+    fn write_f64<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f64) -> std::io::Result<()> {
+        self.number.clear();
+        serde_json::ser::CompactFormatter.write_f64(&mut self.number, x)?;
+        self.write_number(w)
+    }
+}
+
+impl ClipFormatter {
+    /// serde_json's shortest round-trip form, without the `.0` of whole
+    /// numbers (motion capture is full of them) or the `+` of exponents.
+    fn write_number<W: ?Sized + std::io::Write>(&self, w: &mut W) -> std::io::Result<()> {
+        let n = self.number.as_slice();
+        let n = n.strip_suffix(b".0").unwrap_or(n);
+        match n.windows(2).position(|p| p == b"e+") {
+            Some(i) => {
+                w.write_all(&n[..=i])?;
+                w.write_all(&n[i + 2..])
+            }
+            None => w.write_all(n),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct FileOut<'a> {
+    format: &'static str,
+    name: &'a str,
+    #[serde(skip_serializing_if = "SettingsDoc::is_empty")]
+    defaults: &'a SettingsDoc,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    skeleton: Option<crate::skeleton_json::SkeletonOut<'a>>,
+    tracks: Vec<TrackOut<'a>>,
+}
+
+#[derive(Serialize)]
+struct TrackOut<'a> {
+    name: &'a str,
+    #[serde(serialize_with = "display")]
+    kind: TrackKind,
+    times: &'a [f64],
+    values: Vec<ValueOut<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    keys: Option<Vec<KeyOut<'a>>>,
+    #[serde(flatten)]
+    settings: &'a SettingsDoc,
+}
+
+#[derive(Serialize)]
+struct KeyOut<'a> {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tcb: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ease: Option<[f64; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none", with = "named")]
+    interp: Option<Interp>,
+    #[serde(rename = "in", skip_serializing_if = "Option::is_none")]
+    tangent_in: Option<ValueOut<'a>>,
+    #[serde(rename = "out", skip_serializing_if = "Option::is_none")]
+    tangent_out: Option<ValueOut<'a>>,
+}
+
+/// A value of a track's kind: a number for scalars, else its components.
+struct ValueOut<'a>(&'a [f32]);
+
+impl<'a> ValueOut<'a> {
+    fn of(kind: TrackKind, v: &'a [f32; 4]) -> Self {
+        ValueOut(&v[..kind.dim()])
+    }
+}
+
+impl Serialize for ValueOut<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self.0 {
+            [x] => s.serialize_f32(*x),
+            xs => xs.serialize(s),
+        }
+    }
+}
+
+fn display<T: std::fmt::Display, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(v)
+}
+
+impl TrackDoc {
+    fn out(&self) -> TrackOut<'_> {
+        let kind = self.kind;
+        fn value(kind: TrackKind, v: &Option<[f32; 4]>) -> Option<ValueOut<'_>> {
+            v.as_ref().map(|v| ValueOut::of(kind, v))
+        }
+        TrackOut {
+            name: &self.name,
+            kind,
+            times: &self.times,
+            values: self.values.iter().map(|v| ValueOut::of(kind, v)).collect(),
+            keys: self.keys.iter().any(|k| !k.is_empty()).then(|| {
+                self.keys
+                    .iter()
+                    .map(|k| KeyOut {
+                        tcb: k.tcb,
+                        ease: k.ease,
+                        interp: k.interp,
+                        tangent_in: value(kind, &k.tangent_in),
+                        tangent_out: value(kind, &k.tangent_out),
+                    })
+                    .collect()
+            }),
+            settings: &self.settings,
+        }
+    }
+}
+
+/// `value` as JSON in the clip file's layout ([`ClipFormatter`]).
+pub(crate) fn to_json_text<T: Serialize>(value: &T) -> String {
+    let mut buf = Vec::new();
+    let mut ser = serde_json::Serializer::with_formatter(&mut buf, ClipFormatter::default());
+    // Writing to memory fails only if a Serialize impl refuses, and ours
+    // do not (non-finite numbers are written as null, as serde_json does).
+    if value.serialize(&mut ser).is_err() {
+        buf.clear();
+    }
+    buf.push(b'\n');
+    String::from_utf8(buf).unwrap_or_default()
 }

@@ -9,131 +9,144 @@
 //! ]}
 //! ```
 
-use crate::clip::{as_array, as_f32, as_object, as_str, check_fields, json_str, num32};
+use crate::clip::finite_f32;
 use crate::error::{Error, Location};
 use glam::{Quat, Vec3};
-use serde_json::Value as Json;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 
-const FIELDS: [&str; 5] = ["name", "parent", "translation", "rotation", "scale"];
+/// `skeleton` as read (validated by [`SkeletonIn::into_skeleton`]).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkeletonIn {
+    joints: Vec<JointIn>,
+    #[serde(default, rename = "extras")]
+    _extras: Option<crate::clip::Extras>,
+}
 
-/// Parse and validate a `skeleton` object.
-pub(crate) fn parse(v: &Json) -> Result<Skeleton, Error> {
-    let top = Location::default();
-    let obj = as_object(v, &top, "skeleton")?;
-    check_fields(obj, &["joints"], &top, "skeleton")?;
-    let joints = match obj.get("joints") {
-        Some(j) => as_array(j, &top, "skeleton joints")?,
-        None => return Err(Error::invalid(top, "skeleton: missing \"joints\"")),
-    };
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut out = Vec::with_capacity(joints.len());
-    for (i, j) in joints.iter().enumerate() {
-        let what = format!("skeleton joint {i}");
-        let o = as_object(j, &top, &what)?;
-        check_fields(o, &FIELDS, &top, &what)?;
-        let name = match o.get("name") {
-            Some(n) => as_str(n, &top, &format!("{what} name"))?.to_owned(),
-            None => return Err(Error::invalid(top, format!("{what}: missing \"name\""))),
-        };
-        let what = format!("skeleton joint {i} '{name}'");
-        if let Some(first) = seen.insert(name.clone(), i) {
-            return Err(Error::invalid(
-                top,
-                format!("{what}: the name is already used by joint {first}"),
-            ));
-        }
-        let parent = match o.get("parent") {
-            None | Some(Json::Null) => None,
-            Some(p) => match p.as_u64() {
-                Some(p) if (p as usize) < i => Some(p as usize),
-                Some(p) => {
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointIn {
+    name: String,
+    #[serde(default)]
+    parent: Option<f64>,
+    #[serde(default)]
+    translation: Option<Vec<f64>>,
+    #[serde(default)]
+    rotation: Option<Vec<f64>>,
+    #[serde(default)]
+    scale: Option<Vec<f64>>,
+    #[serde(default, rename = "extras")]
+    _extras: Option<crate::clip::Extras>,
+}
+
+impl SkeletonIn {
+    /// The skeleton, or the first joint that breaks the contract.
+    pub(crate) fn into_skeleton(self) -> Result<Skeleton, Error> {
+        let top = Location::default();
+        let mut seen: HashMap<String, usize> = HashMap::new();
+        let mut out = Vec::with_capacity(self.joints.len());
+        for (i, j) in self.joints.into_iter().enumerate() {
+            let what = format!("skeleton joint {i} '{}'", j.name);
+            if let Some(first) = seen.insert(j.name.clone(), i) {
+                return Err(Error::invalid(
+                    top,
+                    format!("{what}: the name is already used by joint {first}"),
+                ));
+            }
+            let parent = match j.parent {
+                None => None,
+                Some(p) if p >= 0.0 && p.fract() == 0.0 && p < i as f64 => Some(p as usize),
+                Some(p) if p >= 0.0 && p.fract() == 0.0 => {
                     return Err(Error::invalid(
                         top,
                         format!("{what}: parent {p} is not smaller than the joint's own index {i}"),
                     ));
                 }
-                None => {
+                Some(p) => {
                     return Err(Error::invalid(
                         top,
                         format!("{what}: parent must be a joint index or null, found {p}"),
                     ));
                 }
-            },
-        };
-        let numbers = |key: &str, n: usize, default: [f32; 4]| -> Result<[f32; 4], Error> {
-            let Some(v) = o.get(key) else {
-                return Ok(default);
             };
-            let field = format!("{what} {key}");
-            let a = as_array(v, &top, &field)?;
-            if a.len() != n {
+            let numbers = |key: &str, v: Option<Vec<f64>>, n: usize, default: [f32; 4]| {
+                let Some(v) = v else {
+                    return Ok(default);
+                };
+                let field = format!("{what} {key}");
+                if v.len() != n {
+                    return Err(Error::invalid(
+                        top.clone(),
+                        format!("{field} must have {n} numbers, found {}", v.len()),
+                    ));
+                }
+                let mut out = [0.0; 4];
+                for (o, x) in out.iter_mut().zip(v) {
+                    *o = finite_f32(x, &field).map_err(|m| Error::invalid(top.clone(), m))?;
+                }
+                Ok(out)
+            };
+            let t = numbers("translation", j.translation, 3, [0.0; 4])?;
+            let r = numbers("rotation", j.rotation, 4, [0.0, 0.0, 0.0, 1.0])?;
+            let s = numbers("scale", j.scale, 3, [1.0, 1.0, 1.0, 0.0])?;
+            let rotation = Quat::from_array(r);
+            if rotation.length_squared() == 0.0 {
                 return Err(Error::invalid(
-                    top.clone(),
-                    format!("{field} must have {n} numbers, found {}", a.len()),
+                    top,
+                    format!("{what}: rotation is zero (not a rotation)"),
                 ));
             }
-            let mut out = [0.0; 4];
-            for (o, x) in out.iter_mut().zip(a) {
-                *o = as_f32(x, &top, &field)?;
-            }
-            Ok(out)
-        };
-        let t = numbers("translation", 3, [0.0; 4])?;
-        let r = numbers("rotation", 4, [0.0, 0.0, 0.0, 1.0])?;
-        let s = numbers("scale", 3, [1.0, 1.0, 1.0, 0.0])?;
-        let rotation = Quat::from_array(r);
-        if rotation.length_squared() == 0.0 {
-            return Err(Error::invalid(
-                top,
-                format!("{what}: rotation is zero (not a rotation)"),
-            ));
+            out.push(Joint {
+                name: j.name,
+                parent,
+                rest: Transform {
+                    translation: Vec3::new(t[0], t[1], t[2]),
+                    rotation: rotation.normalize(),
+                    scale: Vec3::new(s[0], s[1], s[2]),
+                },
+            });
         }
-        out.push(Joint {
-            name,
-            parent,
-            rest: Transform {
-                translation: Vec3::new(t[0], t[1], t[2]),
-                rotation: rotation.normalize(),
-                scale: Vec3::new(s[0], s[1], s[2]),
-            },
-        });
+        Ok(Skeleton { joints: out })
     }
-    Ok(Skeleton { joints: out })
 }
 
-/// Write `"skeleton": {...},` (one joint per line) into a clip's JSON.
-pub(crate) fn write(skeleton: &Skeleton, out: &mut String) {
-    let list = |v: &[f32]| v.iter().map(|&x| num32(x)).collect::<Vec<_>>().join(", ");
-    out.push_str("  \"skeleton\": {\"joints\": [");
-    for (i, j) in skeleton.joints.iter().enumerate() {
-        out.push_str(if i == 0 { "\n" } else { ",\n" });
-        let parent = j.parent.map_or("null".to_owned(), |p| p.to_string());
-        let _ = write!(
-            out,
-            "    {{\"name\": {}, \"parent\": {parent}, \"translation\": [{}]",
-            json_str(&j.name),
-            list(&j.rest.translation.to_array())
-        );
-        if j.rest.rotation != Quat::IDENTITY {
-            let _ = write!(
-                out,
-                ", \"rotation\": [{}]",
-                list(&j.rest.rotation.to_array())
-            );
+/// `skeleton` as written: one joint per line; `rotation` and `scale` only
+/// where they are not the identity.
+#[derive(Serialize)]
+pub(crate) struct SkeletonOut<'a> {
+    joints: Vec<JointOut<'a>>,
+}
+
+#[derive(Serialize)]
+struct JointOut<'a> {
+    name: &'a str,
+    parent: Option<usize>,
+    translation: [f32; 3],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rotation: Option<[f32; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    scale: Option<[f32; 3]>,
+}
+
+impl<'a> SkeletonOut<'a> {
+    pub(crate) fn of(skeleton: &'a Skeleton) -> Self {
+        SkeletonOut {
+            joints: skeleton
+                .joints
+                .iter()
+                .map(|j| JointOut {
+                    name: &j.name,
+                    parent: j.parent,
+                    translation: j.rest.translation.to_array(),
+                    rotation: (j.rest.rotation != Quat::IDENTITY)
+                        .then(|| j.rest.rotation.to_array()),
+                    scale: (j.rest.scale != Vec3::ONE).then(|| j.rest.scale.to_array()),
+                })
+                .collect(),
         }
-        if j.rest.scale != Vec3::ONE {
-            let _ = write!(out, ", \"scale\": [{}]", list(&j.rest.scale.to_array()));
-        }
-        out.push('}');
     }
-    out.push_str(if skeleton.joints.is_empty() {
-        "]},\n"
-    } else {
-        "\n  ]},\n"
-    });
 }
 
 #[cfg(test)]
@@ -179,7 +192,7 @@ mod tests {
             ),
             (
                 r#"{"joints": [{"name": "a", "translation": [1, 1e999, 0]}]}"#,
-                "skeleton joint 0 'a' translation 1e999 is not a finite number",
+                "skeleton joint 0: translation 1e999 is not a finite number",
             ),
             (
                 r#"{"joints": [{"name": "a", "rotation": [0, 0, 0, 0]}]}"#,
@@ -195,9 +208,9 @@ mod tests {
             ),
             (
                 r#"{"joints": [{"name": "a", "length": 2}]}"#,
-                "unknown field \"length\" in skeleton joint 0",
+                "skeleton joint 0: unknown field \"length\"",
             ),
-            (r#"{"bones": []}"#, "unknown field \"bones\" in skeleton"),
+            (r#"{"bones": []}"#, "skeleton: unknown field \"bones\""),
         ];
         for (skeleton, message) in cases {
             let err = ClipDoc::parse(&clip(skeleton)).unwrap_err().to_string();
