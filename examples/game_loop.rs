@@ -33,9 +33,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let run = Arc::new(Clip::compile(
         &bvh.to_clip_doc("run", RotationMode::Hermite)?.build()?,
     ));
-    let rig = Arc::new(Rig::from_skeleton(&bvh.skeleton)?);
-    let binding = SkeletonBinding::for_layout(bvh.skeleton.clone(), rig.layout());
-    let joints = bvh.skeleton.joints.len();
+    let rig = Arc::new(Rig::from_skeleton(bvh.skeleton())?);
+    let binding = SkeletonBinding::for_layout(bvh.skeleton().clone(), rig.layout());
+    let joints = bvh.skeleton().joints.len();
 
     // Four characters, each with its two layers and its blended pose.
     struct Character {
@@ -62,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut spent = std::time::Duration::ZERO;
     let mut head_height = 0.0f32;
     // Look joints up once, not per frame.
-    let head = bvh.skeleton.joint("Head").unwrap_or(0);
+    let head = bvh.skeleton().joint("Head").unwrap_or(0);
     for _ in 0..frames {
         clock += dt;
         let started = Instant::now();

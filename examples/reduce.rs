@@ -14,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let input = tcb_fit::reduce::Input {
         doc: &doc,
         clip: &clip,
-        skeleton: Some(&bvh.skeleton),
+        skeleton: Some(bvh.skeleton()),
     };
     let reduced = tcb_fit::reduce(input, &Default::default(), &|_, _| {})?;
     println!("{}", reduced.summary_line());

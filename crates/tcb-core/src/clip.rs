@@ -220,13 +220,29 @@ impl Clip {
     }
 
     /// Sample every track at `time` into `values` (and `velocities`), each
-    /// [`Clip::channel_count`] long.
+    /// [`Clip::channel_count`] long (shorter slices get the channels that
+    /// fit; longer ones keep the rest).
     pub fn sample_into(&self, time: f64, values: &mut [f32], mut velocities: Option<&mut [f32]>) {
         let mut at = 0;
         for t in &self.tracks {
             let dim = t.data.kind().dim();
-            let vel = velocities.as_deref_mut().map(|v| &mut v[at..at + dim]);
-            t.data.sample_into(time, &mut values[at..at + dim], vel);
+            let (mut v, mut d) = ([0.0f32; 4], [0.0f32; 4]);
+            let want_d = velocities.as_ref().is_some_and(|d| d.len() > at);
+            if values.len() <= at && !want_d {
+                break;
+            }
+            t.data
+                .sample_into(time, &mut v[..dim], want_d.then_some(&mut d[..dim]));
+            let put = |out: Option<&mut [f32]>, from: &[f32]| {
+                for (o, x) in out.unwrap_or_default().iter_mut().zip(from) {
+                    *o = *x;
+                }
+            };
+            put(values.get_mut(at..), &v[..dim]);
+            put(
+                velocities.as_deref_mut().and_then(|o| o.get_mut(at..)),
+                &d[..dim],
+            );
             at += dim;
         }
     }

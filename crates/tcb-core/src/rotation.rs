@@ -411,7 +411,8 @@ fn squad_segments(
             tangent_out: None,
         })
         .collect();
-    let tangents = key_tangents(times, &chords, &tkeys, settings);
+    let tangents = key_tangents(times, &chords, &tkeys, settings)
+        .expect("one chord per segment and one key per time, as built above");
     // Source chord A of key k (the wrap chord at key 0 of a cyclic track) and
     // destination chord B.
     let cyclic = settings.ends == Ends::Cyclic;

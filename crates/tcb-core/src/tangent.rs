@@ -120,14 +120,32 @@ impl ChordWeights {
     /// ```
     /// use tcb_core::{Tcb, TangentRule, tangent::ChordWeights};
     /// // Even spacing: every rule agrees.
-    /// let a = ChordWeights::new(TangentRule::Adjusted, false, Tcb::DEFAULT, 1.0, 1.0);
-    /// let s = ChordWeights::new(TangentRule::Secant, false, Tcb::DEFAULT, 1.0, 1.0);
+    /// let a = ChordWeights::new(TangentRule::Adjusted, Tcb::DEFAULT, 1.0, 1.0);
+    /// let s = ChordWeights::new(TangentRule::Secant, Tcb::DEFAULT, 1.0, 1.0);
     /// assert_eq!(a, s);
     /// // adjusted, D- = 1, D+ = 3: DS is scaled by 2/4, DD by 6/4.
-    /// let a = ChordWeights::new(TangentRule::Adjusted, false, Tcb::DEFAULT, 1.0, 3.0);
+    /// let a = ChordWeights::new(TangentRule::Adjusted, Tcb::DEFAULT, 1.0, 3.0);
     /// assert_eq!((a.in_a, a.out_b), (0.25, 0.75));
     /// ```
-    pub fn new(rule: TangentRule, continuity_fade: bool, tcb: Tcb, d_in: f64, d_out: f64) -> Self {
+    pub fn new(rule: TangentRule, tcb: Tcb, d_in: f64, d_out: f64) -> Self {
+        Self::weights(rule, false, tcb, d_in, d_out)
+    }
+
+    /// [`ChordWeights::new`] with the track setting `continuity_fade`
+    /// (math.md): the `adjusted` rule's step-size factors fade towards 1 as
+    /// |c| grows; the other rules are as in `new`.
+    ///
+    /// ```
+    /// use tcb_core::{Tcb, TangentRule, tangent::ChordWeights};
+    /// let c = Tcb::new(0.0, -1.0, 0.0);
+    /// let faded = ChordWeights::with_continuity_fade(TangentRule::Adjusted, c, 1.0, 3.0);
+    /// assert_eq!(faded, ChordWeights::new(TangentRule::Uniform, c, 1.0, 3.0));
+    /// ```
+    pub fn with_continuity_fade(rule: TangentRule, tcb: Tcb, d_in: f64, d_out: f64) -> Self {
+        Self::weights(rule, true, tcb, d_in, d_out)
+    }
+
+    fn weights(rule: TangentRule, continuity_fade: bool, tcb: Tcb, d_in: f64, d_out: f64) -> Self {
         let w = Weights::new(tcb);
         let sum = d_in + d_out;
         match rule {
@@ -216,14 +234,14 @@ pub struct TangentKey<V> {
 ///
 /// `times` has n >= 2 strictly increasing entries, `chords[k]` is the chord
 /// of segment k (`P_{k+1} - P_k`, or a log-difference for rotations; n - 1 of
-/// them), `keys` has n entries. `Ends::Cyclic` needs n >= 3 and a closed
-/// track; the caller checks that.
+/// them), `keys` has n entries; `None` when the lengths say otherwise.
+/// `Ends::Cyclic` needs a closed track; the caller checks that.
 pub fn key_tangents<V: Vector>(
     times: &[f64],
     chords: &[V],
     keys: &[TangentKey<V>],
     settings: &TrackSettings,
-) -> Vec<KeyTangents<V>> {
+) -> Option<Vec<KeyTangents<V>>> {
     key_tangents_wrapped(times, chords, keys, settings, 1.0)
 }
 
@@ -238,12 +256,14 @@ pub fn key_tangents_wrapped<V: Vector>(
     keys: &[TangentKey<V>],
     settings: &TrackSettings,
     wrap_sign: f64,
-) -> Vec<KeyTangents<V>> {
+) -> Option<Vec<KeyTangents<V>>> {
     let n = times.len();
-    debug_assert!(n >= 2 && chords.len() == n - 1 && keys.len() == n);
+    if n < 2 || chords.len() != n - 1 || keys.len() != n {
+        return None;
+    }
     let interval = |k: usize| times[k + 1] - times[k];
     let rule = |tcb: Tcb, a: V, b: V, d_in: f64, d_out: f64, speed: bool| {
-        let (ds, dd) = ChordWeights::new(
+        let (ds, dd) = ChordWeights::weights(
             settings.tangent_rule,
             settings.continuity_fade,
             tcb,
@@ -306,7 +326,7 @@ pub fn key_tangents_wrapped<V: Vector>(
     if settings.ends == Ends::Natural {
         natural_ends(chords, keys, &mut out);
     }
-    out
+    Some(out)
 }
 
 /// `natural` ends in per-segment units: with `TO_0 = DD_0 / D_0` and
@@ -336,6 +356,31 @@ fn natural_ends<V: Vector>(chords: &[V], keys: &[TangentKey<V>], out: &mut [KeyT
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The tangents of well-formed inputs (every test's are).
+    fn key_tangents<V: Vector>(
+        times: &[f64],
+        chords: &[V],
+        keys: &[TangentKey<V>],
+        settings: &TrackSettings,
+    ) -> Vec<KeyTangents<V>> {
+        super::key_tangents(times, chords, keys, settings).expect("well-formed inputs")
+    }
+
+    #[test]
+    fn key_tangents_refuse_lengths_that_disagree() {
+        let k = [TangentKey {
+            tcb: Tcb::DEFAULT,
+            tangent_in: None,
+            tangent_out: None,
+        }; 3];
+        let s = TrackSettings::default();
+        assert!(super::key_tangents(&[0.0, 1.0, 2.0], &[1.0f32, 2.0], &k, &s).is_some());
+        assert!(super::key_tangents(&[0.0, 1.0, 2.0], &[1.0f32], &k, &s).is_none());
+        assert!(super::key_tangents(&[0.0, 1.0], &[1.0f32], &k, &s).is_none());
+        assert!(super::key_tangents::<f32>(&[0.0], &[], &k[..1], &s).is_none());
+        assert!(super::key_tangents::<f32>(&[], &[], &[], &s).is_none());
+    }
     use crate::params::TrackSettings;
 
     fn keys(tcbs: &[Tcb]) -> Vec<TangentKey<f32>> {
@@ -378,7 +423,7 @@ mod tests {
     fn rules_by_hand_on_uneven_keys() {
         // D- = 1, D+ = 3, t = c = b = 0, A = 2, B = 6 (v- = 2, v+ = 2).
         let (a, b) = (2.0f32, 6.0f32);
-        let ds_dd = |rule| ChordWeights::new(rule, false, Tcb::DEFAULT, 1.0, 3.0).apply(a, b);
+        let ds_dd = |rule| ChordWeights::new(rule, Tcb::DEFAULT, 1.0, 3.0).apply(a, b);
         // uniform: (A + B)/2 both sides.
         assert_eq!(ds_dd(TangentRule::Uniform), (4.0, 4.0));
         // adjusted: 2*1/4 * 4 = 2, 2*3/4 * 4 = 6 -> TI = 2, TO = 2.
@@ -392,8 +437,7 @@ mod tests {
     #[test]
     fn rules_differ_on_a_bend() {
         // D- = 1, D+ = 3, A = 1 (v- = 1), B = 9 (v+ = 3).
-        let ds_dd =
-            |rule| ChordWeights::new(rule, false, Tcb::DEFAULT, 1.0, 3.0).apply(1.0f64, 9.0);
+        let ds_dd = |rule| ChordWeights::new(rule, Tcb::DEFAULT, 1.0, 3.0).apply(1.0f64, 9.0);
         assert_eq!(ds_dd(TangentRule::Uniform), (5.0, 5.0));
         assert_eq!(ds_dd(TangentRule::Adjusted), (2.5, 7.5));
         // secant: TI = TO = 2 -> DS = 2, DD = 6
@@ -405,13 +449,13 @@ mod tests {
     #[test]
     fn continuity_fade_removes_the_adjustment_at_c_minus_one() {
         let tcb = Tcb::new(0.0, -1.0, 0.0);
-        let faded = ChordWeights::new(TangentRule::Adjusted, true, tcb, 1.0, 3.0);
-        let plain = ChordWeights::new(TangentRule::Uniform, false, tcb, 1.0, 3.0);
+        let faded = ChordWeights::with_continuity_fade(TangentRule::Adjusted, tcb, 1.0, 3.0);
+        let plain = ChordWeights::new(TangentRule::Uniform, tcb, 1.0, 3.0);
         assert_eq!(faded, plain);
         // c = -0.5: f_in = 0.5 -> 0.75, f_out = 1.5 -> 1.25.
         let tcb = Tcb::new(0.0, -0.5, 0.0);
         let w = Weights::new(tcb);
-        let faded = ChordWeights::new(TangentRule::Adjusted, true, tcb, 1.0, 3.0);
+        let faded = ChordWeights::with_continuity_fade(TangentRule::Adjusted, tcb, 1.0, 3.0);
         assert_eq!(faded.in_a, 0.75 * w.in_a);
         assert_eq!(faded.out_b, 1.25 * w.out_b);
     }

@@ -239,7 +239,8 @@ impl<V: Value> Track<V> {
                 tangent_out: k.tangent_out,
             })
             .collect();
-        let tangents = key_tangents_wrapped(&times, &chords, &tangent_keys, settings, wrap_sign);
+        let tangents = key_tangents_wrapped(&times, &chords, &tangent_keys, settings, wrap_sign)
+            .expect("one chord per segment and one key per time, as checked above");
         let segments = segment_eases(&keys)
             .enumerate()
             .map(|(k, ease)| {

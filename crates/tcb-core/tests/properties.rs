@@ -314,10 +314,10 @@ fn printed_eq_10_would_make_speed_jump() {
     let (a, b) = (Vec3::new(1.0, 2.0, 0.0), Vec3::new(3.0, -1.0, 1.0));
     let tcb = Tcb::new(0.2, 0.0, 0.3);
     // Ours.
-    let (ds, dd) = ChordWeights::new(TangentRule::Adjusted, false, tcb, d_in, d_out).apply(a, b);
+    let (ds, dd) = ChordWeights::new(TangentRule::Adjusted, tcb, d_in, d_out).apply(a, b);
     assert!((ds.norm() / d_in - dd.norm() / d_out).abs() < 1e-6);
     // As printed: the factors swapped.
-    let (ds_u, dd_u) = ChordWeights::new(TangentRule::Uniform, false, tcb, d_in, d_out).apply(a, b);
+    let (ds_u, dd_u) = ChordWeights::new(TangentRule::Uniform, tcb, d_in, d_out).apply(a, b);
     let printed_ds = ds_u.scale(2.0 * d_out / (d_in + d_out));
     let printed_dd = dd_u.scale(2.0 * d_in / (d_in + d_out));
     let (ti, to) = (printed_ds.norm() / d_in, printed_dd.norm() / d_out);

@@ -273,7 +273,7 @@ impl Solved {
 
 /// The `adjusted` rule's chord weights with t = c = b = 0.
 fn weights(d_in: f64, d_out: f64) -> ChordWeights {
-    ChordWeights::new(TangentRule::Adjusted, false, Tcb::DEFAULT, d_in, d_out)
+    ChordWeights::new(TangentRule::Adjusted, Tcb::DEFAULT, d_in, d_out)
 }
 
 impl Problem<'_> {

@@ -44,22 +44,17 @@ impl Channel {
     }
 }
 
-/// A parsed BVH file.
+/// A parsed BVH file ([`Bvh::parse`]; its parts are read through
+/// accessors, so that every `Bvh` is one the parser checked: a channel
+/// list per joint, whole rows of values).
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation = `OFFSET`.
-    pub skeleton: Skeleton,
-    /// Channels of each joint, in the order listed.
-    pub channels: Vec<Vec<Channel>>,
-    /// `End Site`s: the parent joint and the offset.
-    pub end_sites: Vec<(usize, Vec3)>,
-    /// `Frame Time`, seconds.
-    pub frame_time: f64,
-    /// Channel values, one row per frame, channels in hierarchy order.
-    pub values: Vec<f32>,
-    /// Things that were read but look wrong (a `Frames:` count that
-    /// disagrees with the rows).
-    pub warnings: Vec<String>,
+    skeleton: Skeleton,
+    channels: Vec<Vec<Channel>>,
+    end_sites: Vec<(usize, Vec3)>,
+    frame_time: f64,
+    values: Vec<f32>,
+    warnings: Vec<String>,
 }
 
 /// Tokens of the hierarchy with their 1-based lines.
@@ -364,6 +359,37 @@ impl Bvh {
         Ok(())
     }
 
+    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation = `OFFSET`.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// Channels of each joint, in the order listed.
+    pub fn channels(&self) -> &[Vec<Channel>] {
+        &self.channels
+    }
+
+    /// `End Site`s: the parent joint and the offset.
+    pub fn end_sites(&self) -> &[(usize, Vec3)] {
+        &self.end_sites
+    }
+
+    /// `Frame Time`, seconds.
+    pub fn frame_time(&self) -> f64 {
+        self.frame_time
+    }
+
+    /// Channel values, one row per frame, channels in hierarchy order.
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// Things that were read but look wrong (a `Frames:` count that
+    /// disagrees with the rows).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
     /// Number of channels (values per frame).
     pub fn channel_count(&self) -> usize {
         self.channels.iter().map(Vec::len).sum()
@@ -395,10 +421,14 @@ impl Bvh {
     /// The local translation and rotation of `joint` in `frame`: position
     /// channels as written (the `OFFSET` on axes without one), rotation
     /// channels composed in the order listed (`Zrotation Xrotation
-    /// Yrotation` is `qz * qx * qy`), in f64.
-    pub fn local(&self, frame: usize, joint: usize) -> (DVec3, DQuat) {
+    /// Yrotation` is `qz * qx * qy`), in f64; `None` beyond the frames or
+    /// the joints.
+    pub fn local(&self, frame: usize, joint: usize) -> Option<(DVec3, DQuat)> {
+        if frame >= self.frame_count() || joint >= self.skeleton.joints.len() {
+            return None;
+        }
         let first: usize = self.channels[..joint].iter().map(Vec::len).sum();
-        self.local_at(frame * self.channel_count(), first, joint)
+        Some(self.local_at(frame * self.channel_count(), first, joint))
     }
 
     /// [`Self::local`] of the frame whose row starts at value `row` and of

@@ -345,15 +345,39 @@ fn renamed(clip: &tcb_core::Clip, renames: &[(String, String)]) -> Result<Vec<St
     Ok(names)
 }
 
-/// Export `clip` to glTF; `.glb` when `binary`. With `skeleton`, its
+/// The container [`export`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Container {
+    /// `.gltf`: JSON, the buffer as a `data:` URI inside it.
+    Gltf,
+    /// `.glb`: binary, the JSON and the buffer in one file.
+    Glb,
+}
+
+impl Container {
+    /// `.glb` for a path ending in `glb` (any case), else `.gltf`.
+    pub fn for_path(path: &Path) -> Container {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        {
+            Container::Glb
+        } else {
+            Container::Gltf
+        }
+    }
+}
+
+/// Export `clip` to glTF in `container`. With `skeleton`, its
 /// joints are the node hierarchy (children and rest transforms); tracks
 /// animate the node of their name. Returns the file bytes and the report.
 pub fn export(
     clip: &tcb_core::Clip,
     skeleton: Option<&Skeleton>,
-    binary: bool,
+    container: Container,
     options: &ExportOptions,
 ) -> Result<(Vec<u8>, ExportReport), Error> {
+    let binary = container == Container::Glb;
     let max_error = options.max_error;
     let track_names = renamed(clip, &options.rename)?;
     let mut report = ExportReport::default();
@@ -771,10 +795,8 @@ pub fn export_file(
     path: &Path,
     options: &ExportOptions,
 ) -> Result<ExportReport, Error> {
-    let binary = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let (bytes, report) = export(clip, skeleton, binary, options).map_err(|e| e.in_file(path))?;
+    let (bytes, report) =
+        export(clip, skeleton, Container::for_path(path), options).map_err(|e| e.in_file(path))?;
     crate::write_atomically(path, &bytes)?;
     Ok(report)
 }

@@ -157,7 +157,7 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
             let doc = bvh
                 .to_clip_doc(&stem, options.rotation)
                 .map_err(|e| e.in_file(path))?;
-            (doc, bvh.warnings)
+            (doc, bvh.warnings().to_vec())
         }
         "gltf" | "glb" => {
             let bytes = read_limited(path, options.max_file_bytes)?;

@@ -1,7 +1,7 @@
 //! Export to glTF, import again, sample: exact tracks match the original to
 //! 1e-5, resampled ones within the error the export reported.
 
-use tcb_io::gltf_export::export;
+use tcb_io::gltf_export::{Container, export};
 use tcb_io::gltf_import::import;
 
 const CLIP: &str = r#"{"format": "tcb-clip/1", "name": "rt",
@@ -17,14 +17,14 @@ const CLIP: &str = r#"{"format": "tcb-clip/1", "name": "rt",
 
 fn round_trip(
     clip: &tcb_core::Clip,
-    binary: bool,
+    container: Container,
     max_error: f64,
 ) -> (tcb_core::Clip, tcb_io::gltf_export::ExportReport) {
     let options = tcb_io::gltf_export::ExportOptions {
         max_error,
         ..Default::default()
     };
-    let (bytes, report) = export(clip, None, binary, &options).unwrap();
+    let (bytes, report) = export(clip, None, container, &options).unwrap();
     let back = import(&bytes, None, None, "rt").unwrap();
     (back.doc.build().unwrap(), report)
 }
@@ -72,8 +72,8 @@ fn compare(a: &tcb_core::Clip, b: &tcb_core::Clip, times: impl Iterator<Item = f
 #[test]
 fn exact_tracks_round_trip_and_resampled_ones_hold_their_bound() {
     let clip = tcb_io::ClipDoc::parse(CLIP).unwrap().build().unwrap();
-    for binary in [false, true] {
-        let (back, report) = round_trip(&clip, binary, 1e-5);
+    for container in [Container::Gltf, Container::Glb] {
+        let (back, report) = round_trip(&clip, container, 1e-5);
         assert_eq!(back.tracks().len(), clip.tracks().len());
         // Dense, and off the keys (f32 key times in glTF: stay inside).
         let worst = compare(&clip, &back, (0..=4001).map(|i| i as f64 * 2.0 / 4001.0));
@@ -113,7 +113,7 @@ fn cmu_hermite_round_trips_exactly() {
         ..Default::default()
     };
     let clip = tcb_io::load_with(path.as_ref(), &options).unwrap().clip;
-    let (back, report) = round_trip(&clip, true, 1e-5);
+    let (back, report) = round_trip(&clip, Container::Glb, 1e-5);
     assert_eq!(report.max_error(), 0.0);
     // glTF key times are f32 (at 22.9 s, up to 1e-6 s from the f64 times,
     // which moves a fast joint by about 1e-5): compare the curves at the
@@ -151,7 +151,7 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
     let (_, report) = export(
         &with(r#""post": "repeat","#),
         None,
-        true,
+        Container::Glb,
         &Default::default(),
     )
     .unwrap();
@@ -163,7 +163,7 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
         .unwrap()
         .build()
         .unwrap();
-    let err = export(&bad, None, true, &Default::default())
+    let err = export(&bad, None, Container::Glb, &Default::default())
         .unwrap_err()
         .to_string();
     assert!(
@@ -175,7 +175,7 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
         .build()
         .unwrap();
     assert!(
-        export(&gap, None, true, &Default::default())
+        export(&gap, None, Container::Glb, &Default::default())
             .unwrap_err()
             .to_string()
             .contains("without gaps")
@@ -187,7 +187,13 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
 fn hierarchy_round_trips(path: &str) {
     let first = tcb_io::load(path.as_ref()).unwrap();
     let skeleton = first.skeleton.clone().expect("importers fill the skeleton");
-    let (bytes, _) = export(&first.clip, Some(&skeleton), true, &Default::default()).unwrap();
+    let (bytes, _) = export(
+        &first.clip,
+        Some(&skeleton),
+        Container::Glb,
+        &Default::default(),
+    )
+    .unwrap();
     let again = import(&bytes, None, None, "rt").unwrap();
     let back = &again.skeleton;
     assert_eq!(back.joints.len(), skeleton.joints.len(), "{path}");
@@ -250,7 +256,7 @@ fn unused_tangents_are_zero() {
     // The first key's in-tangent and the last key's out-tangent, exact and
     // resampled.
     let clip = tcb_io::ClipDoc::parse(CLIP).unwrap().build().unwrap();
-    let (bytes, _) = export(&clip, None, true, &Default::default()).unwrap();
+    let (bytes, _) = export(&clip, None, Container::Glb, &Default::default()).unwrap();
     let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
     let blob = gltf.blob.clone().unwrap();
     let mut cubic = 0;

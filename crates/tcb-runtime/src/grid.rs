@@ -38,8 +38,8 @@ pub struct TimeGrid {
     /// Ease of each of the n-1 segments, or empty when no segment eases.
     pub eases: Vec<SegmentEase>,
     /// Whether each of the n-1 segments is `step` in every channel of the
-    /// group (they hold the segment's first key: the kernels read it
-    /// twice), or empty when none is.
+    /// group (played at `s = 0`, so they hold the segment's first key), or
+    /// empty when none is.
     pub steps: Vec<bool>,
     /// Before the first key.
     pub pre: Extrapolation,

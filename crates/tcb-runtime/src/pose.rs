@@ -108,12 +108,9 @@ macro_rules! accessors {
             self.components(&self.values, track, TrackKind::$kind).map($make)
         }
 
-        #[doc = concat!("The d/dt of a `", stringify!($value), "` track (zero without velocities); `None` when `track` is of another kind or of another layout.")]
+        #[doc = concat!("The d/dt of a `", stringify!($value), "` track; `None` when the pose carries no velocities ([`Pose::has_velocities`]: an instance made `with_velocities` samples them), or `track` is of another kind or of another layout.")]
         pub fn $velocity(&self, track: TrackId) -> Option<$t> {
-            match &self.velocities {
-                Some(v) => self.components(v, track, TrackKind::$kind).map($make),
-                None => self.components(&self.values, track, TrackKind::$kind).map(|_| ($make)([0.0; 4])),
-            }
+            self.components(self.velocities.as_ref()?, track, TrackKind::$kind).map($make)
         }
     )+};
 }

@@ -212,8 +212,13 @@ fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
         max_error,
         ..Default::default()
     };
-    let (glb, _) =
-        tcb_io::gltf_export::export(&loaded.clip, Some(&skeleton), true, &export).unwrap();
+    let (glb, _) = tcb_io::gltf_export::export(
+        &loaded.clip,
+        Some(&skeleton),
+        tcb_io::gltf_export::Container::Glb,
+        &export,
+    )
+    .unwrap();
     let scene = read(&glb);
     // The hierarchy is the skeleton's: same names, same parents.
     assert_eq!(scene.names.len(), skeleton.joints.len());

@@ -1,0 +1,164 @@
+//! Issue 11's API point, tried on every public constructor and field of
+//! tcb-io that existed before it. The documents (`ClipDoc`, `TrackDoc`,
+//! `KeyDoc`, `SettingsDoc`) keep public fields on purpose: they are the
+//! file as written, and `build` is where they are checked, so a document
+//! that disagrees with itself is an error there, never a panic. `Bvh`'s
+//! fields became accessors (a hand-made one could index past its rows).
+
+use std::path::Path;
+use tcb_core::{Interp, TrackKind};
+use tcb_io::gltf_export::{Container, ExportOptions, export};
+use tcb_io::{ClipDoc, ImportOptions, KeyDoc, SettingsDoc, TrackDoc};
+
+fn track(kind: TrackKind, times: Vec<f64>, values: Vec<[f32; 4]>, keys: Vec<KeyDoc>) -> TrackDoc {
+    TrackDoc {
+        name: "t".into(),
+        kind,
+        times,
+        values,
+        keys,
+        settings: SettingsDoc::default(),
+    }
+}
+
+/// Documents that disagree with themselves: errors from `build`, and
+/// `to_json` writes whatever they hold.
+#[test]
+fn documents_that_disagree_are_build_errors() {
+    let v = |x: f32| [x, 0.0, 0.0, 1.0];
+    let key = KeyDoc {
+        tcb: Some([f64::NAN, 0.0, 0.0]),
+        ease: Some([2.0, -1.0]),
+        interp: Some(Interp::Step),
+        tangent_in: Some([f32::INFINITY; 4]),
+        tangent_out: None,
+    };
+    let cases = [
+        track(TrackKind::Scalar, vec![0.0, 1.0], vec![v(0.0)], vec![]),
+        track(
+            TrackKind::Vec3,
+            vec![0.0, 1.0],
+            vec![v(0.0), v(1.0)],
+            vec![KeyDoc::default()],
+        ),
+        track(
+            TrackKind::Vec3,
+            vec![0.0, 1.0],
+            vec![v(0.0), v(1.0)],
+            vec![key.clone(), key],
+        ),
+        track(
+            TrackKind::Quat,
+            vec![0.0, 1.0],
+            vec![[0.0; 4], v(1.0)],
+            vec![],
+        ),
+        track(
+            TrackKind::Vec2,
+            vec![1.0, 0.0],
+            vec![v(0.0), v(1.0)],
+            vec![],
+        ),
+        track(
+            TrackKind::Vec4,
+            vec![0.0, f64::NAN],
+            vec![v(0.0), v(1.0)],
+            vec![],
+        ),
+        track(
+            TrackKind::Scalar,
+            vec![0.0, 1.0],
+            vec![v(f32::NAN), v(1.0)],
+            vec![],
+        ),
+        track(TrackKind::Scalar, vec![], vec![], vec![]),
+    ];
+    for t in cases {
+        let doc = ClipDoc {
+            name: "d".into(),
+            tracks: vec![t.clone()],
+            ..ClipDoc::default()
+        };
+        assert!(doc.build().is_err(), "{t:?}");
+        let _ = doc.to_json();
+    }
+    let twice = ClipDoc {
+        tracks: vec![
+            track(
+                TrackKind::Scalar,
+                vec![0.0, 1.0],
+                vec![v(0.0), v(1.0)],
+                vec![],
+            ),
+            track(
+                TrackKind::Scalar,
+                vec![0.0, 1.0],
+                vec![v(0.0), v(1.0)],
+                vec![],
+            ),
+        ],
+        ..ClipDoc::default()
+    };
+    let err = twice.build().unwrap_err().to_string();
+    assert!(err.contains("already used"), "{err}");
+}
+
+/// A `Bvh` comes only from `parse`; `local` beyond its frames or joints is
+/// `None`.
+#[test]
+fn bvh_parts_are_read_through_accessors() {
+    let text = "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 Xrotation Yrotation Zrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n1 2 3\n4 5 6\n";
+    let bvh = tcb_io::bvh::Bvh::parse(text).unwrap();
+    assert_eq!((bvh.frame_count(), bvh.channels().len()), (2, 1));
+    assert!(bvh.local(1, 0).is_some());
+    assert!(bvh.local(2, 0).is_none());
+    assert!(bvh.local(0, 1).is_none());
+    assert!(bvh.local(usize::MAX, usize::MAX).is_none());
+}
+
+/// Export options out of range, and import limits of zero: errors or a
+/// valid file, never a panic.
+#[test]
+fn options_out_of_range() {
+    let doc = ClipDoc {
+        tracks: vec![track(
+            TrackKind::Vec3,
+            vec![0.0, 1.0, 2.0],
+            vec![[0.0; 4], [1.0; 4], [0.0; 4]],
+            vec![],
+        )],
+        ..ClipDoc::default()
+    };
+    let clip = doc.build().unwrap();
+    for max_error in [f64::NAN, -1.0, 0.0, f64::INFINITY] {
+        let options = ExportOptions {
+            max_error,
+            rename: vec![("t".into(), "t".into()), ("u".into(), "t".into())],
+        };
+        for container in [Container::Gltf, Container::Glb] {
+            let _ = export(&clip, None, container, &options);
+        }
+    }
+    let options = ImportOptions {
+        max_file_bytes: 0,
+        animation: Some("no such animation".into()),
+        ..ImportOptions::default()
+    };
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+    for file in ["simple_skin.gltf", "cmu-01_01.bvh"] {
+        let err = tcb_io::load_with(&data.join(file), &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("max_file_bytes"), "{err}");
+    }
+    let err = tcb_io::load_with(
+        &data.join("simple_skin.gltf"),
+        &ImportOptions {
+            animation: Some("no such animation".into()),
+            ..ImportOptions::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("no such animation"), "{err}");
+}

@@ -1,0 +1,219 @@
+//! Issue 11's API point, tried on every public constructor and field the
+//! runtime had before it: none makes a value whose later use panics or
+//! lies. Handles of another clip, accessors of the wrong kind, masks and
+//! layers of another layout, rigs with bad rest values, playback speeds
+//! that are not numbers, and slices of the wrong length are refused
+//! (`None`, `Err`) or do what the docs say.
+
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::{NamedTrack, RotationTrack, Track, TrackData, TrackKind, TrackSettings};
+use tcb_runtime::blend::{BlendError, add};
+use tcb_runtime::{
+    BlendMask, Clip, CompileOptions, Instance, Playback, Pose, Rig, RigError, RigTrack,
+    SkeletonBinding, blend,
+};
+
+fn clip(names: &[&str]) -> Arc<Clip> {
+    let t = vec![0.0, 1.0, 2.0];
+    let tracks = names
+        .iter()
+        .map(|n| NamedTrack {
+            name: (*n).into(),
+            data: if n.ends_with(".rotation") {
+                TrackData::Quat(
+                    RotationTrack::new(
+                        t.clone(),
+                        vec![Quat::IDENTITY, Quat::from_rotation_z(1.0), Quat::IDENTITY],
+                        Vec::new(),
+                        &TrackSettings::default(),
+                    )
+                    .expect("valid"),
+                )
+            } else {
+                TrackData::Vec3(
+                    Track::new(
+                        t.clone(),
+                        vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+                        Vec::new(),
+                        &TrackSettings::default(),
+                    )
+                    .expect("valid"),
+                )
+            },
+        })
+        .collect();
+    Arc::new(Clip::compile(
+        &tcb_core::Clip::new("c", tracks).expect("unique names"),
+    ))
+}
+
+/// A `TrackId` (once `TrackId(pub usize)`) of one clip says nothing about
+/// another clip's pose, and an accessor of the wrong kind (once
+/// `Pose::vec3` on a rotation returned x, y, z) is `None`.
+#[test]
+fn handles_of_another_clip_and_accessors_of_the_wrong_kind_are_none() {
+    let a = clip(&["a.translation", "a.rotation"]);
+    let b = clip(&["b.rotation", "b.translation", "c.translation"]);
+    let mut ia = Instance::new(a.clone()).with_velocities();
+    let mut ib = Instance::new(b.clone());
+    let (pa, pb) = (ia.sample(0.5).clone(), ib.sample(0.5).clone());
+    let (ta, ra) = (
+        a.track("a.translation").unwrap(),
+        a.track("a.rotation").unwrap(),
+    );
+    assert!(pa.vec3(ta).is_some() && pa.quat(ra).is_some());
+    assert_eq!(pa.quat(ta), None);
+    assert_eq!(pa.vec3(ra), None);
+    assert_eq!(pa.scalar(ta), None);
+    assert_eq!(pa.vec4(ra), None);
+    for id in a.layout().ids() {
+        assert_eq!(pb.vec3(id), None);
+        assert_eq!(pb.quat(id), None);
+        assert_eq!(pb.quat_velocity(id), None);
+        assert_eq!(pb.angular_velocity(id), None);
+        assert!(b.layout().slot(id).is_none());
+    }
+    // No velocities sampled: none to read.
+    let c = b.track("c.translation").unwrap();
+    assert_eq!(pb.vec3_velocity(c), None);
+    assert!(pa.vec3_velocity(ta).is_some());
+    assert_eq!(a.quantization_error(ta), Some(0.0));
+    assert_eq!(b.quantization_error(ta), None);
+}
+
+/// `write_row` writes what fits (once it indexed past the end).
+#[test]
+fn rows_of_any_length() {
+    let a = clip(&["a.translation", "a.rotation"]);
+    let mut i = Instance::new(a).with_velocities();
+    let pose = i.sample(0.5);
+    let mut short = [f32::NAN; 2];
+    pose.write_row(&mut short, Some(&mut []));
+    assert!(short.iter().all(|x| x.is_finite()));
+    let mut long = [f32::NAN; 20];
+    pose.write_row(&mut long, None);
+    assert!(long[..7].iter().all(|x| x.is_finite()) && long[7..].iter().all(|x| x.is_nan()));
+}
+
+/// Layers and masks of another layout are errors, never silently skipped.
+#[test]
+fn layers_and_masks_of_another_layout_are_errors() {
+    let a = clip(&["a.translation", "a.rotation"]);
+    let b = clip(&["b.rotation"]);
+    let (mut ia, mut ib) = (Instance::new(a.clone()), Instance::new(b.clone()));
+    let mut out = Pose::new(&a);
+    let (pa, pb) = (ia.sample(0.2).clone(), ib.sample(0.2).clone());
+    assert_eq!(
+        blend(&mut out, &[(&pa, 0.5), (&pb, 0.5)], None),
+        Err(BlendError::Layout { layer: 1 })
+    );
+    let mask_b = BlendMask::new(&b, |_| 1.0);
+    let mask_a = BlendMask::new(&a, |_| f32::NAN);
+    assert!(blend(&mut out, &[(&pa, 1.0)], Some(&[&mask_b])).is_err());
+    assert!(blend(&mut out, &[(&pa, 1.0)], Some(&[&mask_a, &mask_a])).is_err());
+    assert!(mask_a.times(&mask_b).is_err());
+    assert!(add(&mut out, &pa, &pb, 1.0, None).is_err());
+    assert!(add(&mut out, &pa, &pa, 1.0, Some(&mask_b)).is_err());
+    // NaN weights are the caller's numbers, not a panic.
+    blend(&mut out, &[(&pa, f32::NAN)], Some(&[&mask_a])).unwrap();
+}
+
+/// A rig refuses repeated names and rest values that are not finite or
+/// not a rotation, and a clip whose track has the rig's name but another
+/// kind; playback refuses speeds that are not numbers.
+#[test]
+fn rigs_and_playback_refuse_bad_values() {
+    let track = |name: &str, kind, rest| RigTrack {
+        name: name.into(),
+        kind,
+        rest,
+    };
+    assert!(matches!(
+        Rig::new(vec![
+            track("a", TrackKind::Vec3, [0.0; 4]),
+            track("a", TrackKind::Vec3, [0.0; 4])
+        ]),
+        Err(RigError::Duplicate(_))
+    ));
+    assert!(matches!(
+        Rig::new(vec![track("a", TrackKind::Vec3, [f32::NAN, 0.0, 0.0, 0.0])]),
+        Err(RigError::BadRest(_))
+    ));
+    assert!(matches!(
+        Rig::new(vec![track("a", TrackKind::Quat, [0.0; 4])]),
+        Err(RigError::BadRest(_))
+    ));
+    let rig = Arc::new(
+        Rig::new(vec![track("a.rotation", TrackKind::Vec3, [0.0; 4])]).expect("a valid rig"),
+    );
+    assert!(Instance::with_rig(clip(&["a.rotation"]), &rig).is_err());
+    let mut i = Instance::new(clip(&["a.rotation"]));
+    for speed in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert!(i.set_playback(Playback::Loop, speed).is_err());
+    }
+    assert_eq!(i.playback(), (Playback::Clip, 1.0));
+    i.set_playback(Playback::PingPong, -2.5).unwrap();
+    for t in [f64::NAN, f64::INFINITY, -1e300, 1e300] {
+        i.sample(t);
+    }
+}
+
+/// A skeleton is plain data (public fields): one whose parents are not
+/// below their joints, or that names tracks of other kinds, still binds
+/// and composes without a panic, into slices of any length.
+#[test]
+fn skeletons_of_any_shape_bind_and_compose() {
+    let a = clip(&["a.translation", "b.rotation", "c.rotation"]);
+    let joint = |name: &str, parent| Joint {
+        name: name.into(),
+        parent,
+        rest: Transform::IDENTITY,
+    };
+    let skeleton = Skeleton {
+        joints: vec![
+            joint("a", Some(5)),
+            joint("b", Some(1)),
+            joint("c", Some(0)),
+            joint("a", None),
+        ],
+    };
+    let binding = SkeletonBinding::new(skeleton, &a);
+    let mut i = Instance::new(a);
+    let pose = i.sample(0.7);
+    for n in [0, 2, 4, 9] {
+        let mut local = vec![Transform::IDENTITY; n];
+        let mut model = vec![glam::Affine3A::IDENTITY; n.saturating_sub(1)];
+        binding.model_transforms(pose, &mut local, &mut model);
+    }
+}
+
+/// Quantized compilation of values spanning all of f32 (the range
+/// overflows f64 nowhere, and f32 per channel) stays finite.
+#[test]
+fn quantizing_extreme_ranges() {
+    let t = vec![0.0, 1.0];
+    let v = Track::new(
+        t,
+        vec![Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX)],
+        Vec::new(),
+        &TrackSettings::default(),
+    )
+    .expect("finite values");
+    let src = tcb_core::Clip::new(
+        "q",
+        vec![NamedTrack {
+            name: "v".into(),
+            data: TrackData::Vec3(v),
+        }],
+    )
+    .expect("one track");
+    let c = Arc::new(Clip::compile_with(&src, &CompileOptions { quantize: true }));
+    let id = c.track("v").unwrap();
+    let mut i = Instance::new(c);
+    for t in [0.0, 0.5, 1.0] {
+        let p = i.sample(t);
+        assert!(p.vec3(id).is_some());
+    }
+}
