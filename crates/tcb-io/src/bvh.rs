@@ -44,6 +44,12 @@ impl Channel {
     }
 }
 
+/// The deepest joint hierarchy [`Bvh::parse`] reads: joints nested
+/// deeper are refused (nothing here recurses on the depth, but no rig is
+/// more than tens of joints deep, and a file that claims otherwise is not
+/// one).
+pub const MAX_DEPTH: usize = 1024;
+
 /// A parsed BVH file ([`Bvh::parse`]; its parts are read through
 /// accessors, so that every `Bvh` is one the parser checked: a channel
 /// list per joint, whole rows of values).
@@ -180,6 +186,14 @@ impl Bvh {
                         (l, w) => {
                             return Err(Error::syntax(l, format!("expected '{{', found '{w}'")));
                         }
+                    }
+                    if stack.len() == MAX_DEPTH {
+                        return Err(Error::syntax(
+                            line,
+                            format!(
+                                "joints nested deeper than {MAX_DEPTH} (the limit; rigs are tens deep)"
+                            ),
+                        ));
                     }
                     self.skeleton.joints.push(Joint {
                         name,

@@ -317,3 +317,38 @@ fn a_file_without_an_extension_says_so() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A hierarchy nested 100,000 deep is refused at the limit, naming it; one
+/// at the limit reads.
+#[test]
+fn deep_hierarchies_are_refused() {
+    let nested = |depth: usize| {
+        let mut text = String::from("HIERARCHY\n");
+        for i in 0..depth {
+            let word = if i == 0 { "ROOT" } else { "JOINT" };
+            text.push_str(&format!(
+                "{word} j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 1 Zrotation\n"
+            ));
+        }
+        text.push_str(&"}\n".repeat(depth));
+        text.push_str("MOTION\nFrames: 2\nFrame Time: 0.1\n");
+        for _ in 0..2 {
+            text.push_str(&"1 ".repeat(depth));
+            text.push('\n');
+        }
+        text
+    };
+    let max = tcb_io::bvh::MAX_DEPTH;
+    let err = tcb_io::bvh::Bvh::parse(&nested(100_000))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "line {}: joints nested deeper than {max} (the limit; rigs are tens deep)",
+            2 + 4 * max
+        )
+    );
+    let ok = tcb_io::bvh::Bvh::parse(&nested(max)).unwrap();
+    assert_eq!(ok.skeleton().joints.len(), max);
+}
