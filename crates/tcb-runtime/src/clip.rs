@@ -427,13 +427,25 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         let (_, d1) = tcb_core::squad::squad_with_derivative(&c, 1.0);
         let next = if interps[k] == Interp::Step { k } else { k + 1 };
         let (q0, q1) = (keys[k].to_array(), keys[next].to_array());
-        let ctl: [[f32; 4]; 4] =
+        let mut ctl: [[f32; 4]; 4] =
             std::array::from_fn(|i| [q0[i], q1[i], d0[i], d1[i]].map(finite_f32));
+        let max_rate = 2.0 / (t.times()[k + 1] - t.times()[k]);
+        let mut holds = cubic_holds(&c, &ctl, max_rate, (0.0, 1.0));
+        // Where the cubic through squad's end derivatives misses the values,
+        // tangents fitted to the values may hold them (an instance without
+        // velocities then plays the cubic; one with velocities plays squad
+        // exactly). Not the last segment: the post sentinel's arriving
+        // velocity is its M1.
+        if !holds.values && k + 2 < n {
+            let fitted = fitted_tangents(&c, &ctl);
+            let h = cubic_holds(&c, &fitted, max_rate, (0.0, 1.0));
+            if h.values {
+                (ctl, holds) = (fitted, h);
+            }
+        }
         for (i, comp) in comps.iter_mut().enumerate() {
             comp[k + 1] = ctl[i];
         }
-        let max_rate = 2.0 / (t.times()[k + 1] - t.times()[k]);
-        let holds = cubic_holds(&c, &ctl, max_rate, (0.0, 1.0));
         if !holds.both() {
             exact[k + 1] = Some(c);
             velocity_only[k + 1] = holds.values;
@@ -454,6 +466,38 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         exact,
         velocity_only,
     }
+}
+
+/// `ctl` with its tangents (`M0`, `M1` of each component) fitted to squad's
+/// values over the segment in least squares, its ends kept: the cubic then
+/// follows the curve more closely than the one through its end
+/// derivatives, and its velocity less.
+fn fitted_tangents(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4]) -> [[f32; 4]; 4] {
+    use tcb_core::basis::hermite_basis;
+    const POINTS: usize = 64;
+    let (mut a11, mut a12, mut a22) = (0.0f64, 0.0f64, 0.0f64);
+    let mut rhs = [[0.0f64; 2]; 4];
+    for j in 1..POINTS {
+        let s = j as f64 / POINTS as f64;
+        let (q, _) =
+            tcb_core::quat::normalize(tcb_core::squad::squad_with_derivative(c, s).0, None);
+        let h = hermite_basis(s);
+        a11 += h[2] * h[2];
+        a12 += h[2] * h[3];
+        a22 += h[3] * h[3];
+        for (i, r) in rhs.iter_mut().enumerate() {
+            let rest = q[i] - h[0] * f64::from(ctl[i][0]) - h[1] * f64::from(ctl[i][1]);
+            r[0] += h[2] * rest;
+            r[1] += h[3] * rest;
+        }
+    }
+    let det = a11 * a22 - a12 * a12;
+    std::array::from_fn(|i| {
+        let [b1, b2] = rhs[i];
+        let m0 = (a22 * b1 - a12 * b2) / det;
+        let m1 = (a11 * b2 - a12 * b1) / det;
+        [ctl[i][0], ctl[i][1], finite_f32(m0), finite_f32(m1)]
+    })
 }
 
 /// How much normalizing can grow an error of a rotation's cubic:

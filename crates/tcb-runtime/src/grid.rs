@@ -119,12 +119,12 @@ impl TimeGrid {
     #[inline(always)]
     fn real(&self, time: f64, cursor: &mut Cursor, dir: f32) -> (usize, f64, f32) {
         let k = self.locate(time, cursor);
-        if self.is_step(k) {
-            return (k + 1, 0.0, 0.0);
-        }
         let d = self.times[k + 1] - self.times[k];
         let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
         let (eased, ds_du) = self.ease(k).apply(u);
+        // Selects, not a branch: almost no grid has step segments.
+        let hold = !self.steps.is_empty() && self.is_step(k);
+        let (eased, ds_du) = if hold { (0.0, 0.0) } else { (eased, ds_du) };
         (k + 1, eased, (ds_du / d) as f32 * dir)
     }
 

@@ -484,8 +484,11 @@ fn dense_squad_without_velocities() {
         velocity_only += Clip::compile(&clip).stats().exact_for_velocity_only;
         check_clip(&clip, seed);
     }
+    // 2023 with the cubic through squad's end derivatives alone; the
+    // tangents fitted to the values (where that cubic misses them) bring
+    // about 400 more segments onto the cubic without velocities.
     assert!(
-        velocity_only > 20,
+        velocity_only > 2300,
         "{velocity_only} segments for velocities only"
     );
 }
