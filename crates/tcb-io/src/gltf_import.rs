@@ -114,6 +114,19 @@ pub fn import_with(
     let animation = options.animation.as_deref();
     let invalid =
         |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
+    // The `gltf` crate (1.4.1) subtracts the header's 12 bytes from the
+    // GLB length field before it checks it (an overflow, a panic in debug
+    // builds): check it here first.
+    if let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+        && length < 12
+    {
+        return Err(invalid(&format!(
+            "the GLB header says the file is {length} bytes, less than its own 12-byte header"
+        )));
+    }
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(&e))?;
     let json = unchecked.document.into_json();
     check_indices(&json)?;

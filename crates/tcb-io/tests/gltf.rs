@@ -448,3 +448,25 @@ fn buffer_uris_stay_inside_the_assets_folder() {
     );
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// A GLB header whose length field is below the header's own 12 bytes:
+/// the `gltf` crate (1.4.1) subtracts 12 from it and overflows (a panic in
+/// debug builds), so the importer checks it first (found by the `gltf`
+/// fuzz target: `fuzz/corpus/gltf/crash-glb-length-below-header`).
+#[test]
+fn a_glb_length_below_its_header_is_an_error_not_a_panic() {
+    let bytes = b"glTF{\n{\x0e\0\0\0\0\0\0\0\x0d\x01\0\0U";
+    let err = tcb_io::gltf_import::import(bytes, None, None, "x")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "not a valid glTF 2.0 file: the GLB header says the file is 0 bytes, less than its own 12-byte header"
+    );
+    let mut glb = b"glTF\x02\0\0\0".to_vec();
+    glb.extend(11u32.to_le_bytes());
+    let err = tcb_io::gltf_import::import(&glb, None, None, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("says the file is 11 bytes"), "{err}");
+}
