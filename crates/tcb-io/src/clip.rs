@@ -252,6 +252,20 @@ impl ClipDoc {
 
     /// Resolve defaults and build every track. Errors name the track and key.
     pub fn build(&self) -> Result<Clip, Error> {
+        // A default tcb is checked even where every key states its own: a
+        // clip that builds must write as it is, and JSON has no NaN.
+        let tcb_error = |s: &SettingsDoc| {
+            s.tcb.filter(|t| !t.iter().all(|x| x.is_finite())).map(|t| {
+                let t = t.map(|x| format!("{x}"));
+                format!("tcb [{}] is not finite", t.join(", "))
+            })
+        };
+        if let Some(m) = tcb_error(&self.defaults) {
+            return Err(Error::invalid(
+                Location::default(),
+                format!("defaults: {m}"),
+            ));
+        }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         let mut tracks = Vec::with_capacity(self.tracks.len());
         for (i, t) in self.tracks.iter().enumerate() {
@@ -259,6 +273,9 @@ impl ClipDoc {
                 track: Some(quote(&t.name)),
                 ..Location::default()
             };
+            if let Some(m) = tcb_error(&t.settings) {
+                return Err(Error::invalid(loc, m));
+            }
             if let Some(first) = seen.insert(&t.name, i) {
                 return Err(Error::invalid(
                     loc,

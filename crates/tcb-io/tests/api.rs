@@ -162,3 +162,43 @@ fn options_out_of_range() {
     .to_string();
     assert!(err.contains("no such animation"), "{err}");
 }
+
+/// A default `tcb` that is not finite is refused even where every key
+/// states its own (found by the `reduce` fuzz target: the reducer wrote such
+/// a track's keys without their own tcb, and JSON cannot hold NaN, so the
+/// clip written did not read back). A document that builds writes and
+/// reads back as it is.
+#[test]
+fn a_default_tcb_that_is_not_finite_is_refused_where_it_is_unused() {
+    let keys = vec![
+        KeyDoc {
+            tcb: Some([0.0; 3]),
+            ..KeyDoc::default()
+        };
+        2
+    ];
+    let mut t = track(
+        TrackKind::Scalar,
+        vec![0.0, 1.0],
+        vec![[0.0; 4], [1.0; 4]],
+        keys,
+    );
+    t.settings.tcb = Some([0.0, f64::NAN, 0.0]);
+    let doc = ClipDoc {
+        tracks: vec![t.clone()],
+        ..ClipDoc::default()
+    };
+    let err = doc.build().unwrap_err().to_string();
+    assert_eq!(err, "track 't': tcb [0, NaN, 0] is not finite");
+    t.settings.tcb = None;
+    let doc = ClipDoc {
+        defaults: SettingsDoc {
+            tcb: Some([f64::INFINITY, 0.0, 0.0]),
+            ..SettingsDoc::default()
+        },
+        tracks: vec![t],
+        ..ClipDoc::default()
+    };
+    let err = doc.build().unwrap_err().to_string();
+    assert_eq!(err, "defaults: tcb [inf, 0, 0] is not finite");
+}
