@@ -462,7 +462,8 @@ impl<'de> Deserialize<'de> for Extras {
 #[derive(Clone, Debug, PartialEq)]
 enum ValueIn {
     One(f64),
-    Many(Vec<f64>),
+    /// The first 4 numbers (all a value uses) and how many there were.
+    Many(Vec<f64>, usize),
 }
 
 impl<'de> Deserialize<'de> for ValueIn {
@@ -484,17 +485,15 @@ impl<'de> Deserialize<'de> for ValueIn {
             }
             fn visit_seq<A: de::SeqAccess<'de>>(self, mut a: A) -> Result<ValueIn, A::Error> {
                 // At most 4 are ever used; a longer array is reported by
-                // length, without keeping what it holds.
-                let mut out = Vec::with_capacity(4);
+                // its length, without keeping what it holds.
+                let (mut out, mut len) = (Vec::with_capacity(4), 0);
                 while let Some(x) = a.next_element::<f64>()? {
-                    if out.len() < 16 {
+                    if len < 4 {
                         out.push(x);
-                    } else {
-                        out.push(0.0);
-                        out.truncate(16);
                     }
+                    len += 1;
                 }
-                Ok(ValueIn::Many(out))
+                Ok(ValueIn::Many(out, len))
             }
         }
         d.deserialize_any(V)
@@ -507,7 +506,7 @@ impl ValueIn {
         let mut out = [0.0f32; 4];
         let xs: &[f64] = match (self, kind) {
             (ValueIn::One(x), TrackKind::Scalar) => std::slice::from_ref(x),
-            (ValueIn::Many(_), TrackKind::Scalar) => {
+            (ValueIn::Many(..), TrackKind::Scalar) => {
                 return Err(format!(
                     "{what} of a scalar track must be a number, found {}",
                     self.brief()
@@ -520,14 +519,14 @@ impl ValueIn {
                     self.brief()
                 ));
             }
-            (ValueIn::Many(xs), _) if xs.len() != kind.dim() => {
+            (ValueIn::Many(_, len), _) if *len != kind.dim() => {
                 return Err(format!(
                     "{what} of a {kind} track must have {} numbers, found {}",
                     kind.dim(),
-                    xs.len()
+                    len
                 ));
             }
-            (ValueIn::Many(xs), _) => xs,
+            (ValueIn::Many(xs, _), _) => xs,
         };
         for (o, &x) in out.iter_mut().zip(xs) {
             *o = finite_f32(x, what)?;
@@ -538,8 +537,8 @@ impl ValueIn {
     fn brief(&self) -> String {
         match self {
             ValueIn::One(x) => format!("{x}"),
-            ValueIn::Many(xs) if xs.len() > 4 => format!("an array of {}", xs.len()),
-            ValueIn::Many(xs) => format!(
+            ValueIn::Many(_, len) if *len > 4 => format!("an array of {len}"),
+            ValueIn::Many(xs, _) => format!(
                 "[{}]",
                 xs.iter()
                     .map(|x| format!("{x}"))

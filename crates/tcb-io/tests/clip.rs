@@ -132,6 +132,13 @@ fn serde_errors_name_the_track_and_key() {
             "track 'bad': extras 1e999 is not a finite number",
         ),
         (
+            track(&format!(
+                r#""kind": "vec3", "times": [0, 1], "values": [[1, 2, 3], [{}0]]"#,
+                "0, ".repeat(99)
+            )),
+            "track 'bad': key 1: value of a vec3 track must have 3 numbers, found 100",
+        ),
+        (
             r#"{"format": "tcb-clip/1", "defaults": {"ends": 3}, "tracks": []}"#.to_owned(),
             "defaults: ends: invalid type: integer",
         ),
