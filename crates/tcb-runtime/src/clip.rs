@@ -2,15 +2,21 @@
 //!
 //! Tracks are grouped by identical key times, segment eases and `pre`/`post`
 //! modes; a group's channels share one `grid::FrameBasis`
-//! per frame. Per group, per stored segment (see `grid.rs`), per block
-//! of 8 channels, the Hermite controls are stored lane-contiguous as
-//! `wide::f32x8` (32-byte aligned, zero-padded):
+//! per frame. Per group, per key (and sentinel pseudo-key, see
+//! `per_key`), the Hermite controls are stored lane-contiguous as
+//! `wide::f32x8` planes (32-byte aligned, unused lanes zero or, for
+//! rotations, the identity), vector blocks first, then rotation blocks
+//! (see `crate::store`):
 //!
 //! ```text
-//! vectors     [segment][block][P0 P1 M0 M1]                 4 x f32x8
-//! rotations   [segment][block][P0 P1 M0 M1][x y z w]       16 x f32x8, normalized after
+//! vectors     [key][P TO (TI)][block]                    1 plane each
+//! rotations   [key][P TO (TI)][block][x y z w]           4 planes each, normalized after
 //! exact       per (segment, block) where needed: squad in power form, 2 x 16 x f64x4
 //! ```
+//!
+//! `TI` is stored only where it differs from `TO` (it seldom does on evenly
+//! spaced keys), and a segment reads `P0 TO0` of its first key and `P1 TI1`
+//! of its second.
 //!
 //! `linear` and `step` segments and explicit tangents are folded into the
 //! same controls, so the kernels have no per-channel branches. Every
@@ -26,7 +32,7 @@ use crate::grid::TimeGrid;
 use crate::kernel::{HQ_STRIDE, KEY_STRIDE, SQ_STRIDE};
 use crate::loose::{Loose, LooseLane};
 use crate::pose::PoseLayout;
-use crate::quant::Quantized;
+use crate::store::KeyStore;
 use std::collections::HashMap;
 use std::sync::Arc;
 use tcb_core::ease::SegmentEase;
@@ -111,17 +117,15 @@ pub(crate) struct Group {
     pub grid: TimeGrid,
     /// Vector channels and rotations (lanes in use), exact entries.
     pub lanes: [usize; 3],
+    /// Vector blocks (one plane each), then rotation blocks (four planes
+    /// each) from pose block `vec_out` on.
     pub vec_blocks: usize,
-    pub vec: Vec<f32x8>,
+    pub hq_blocks: usize,
+    pub vec_out: usize,
+    /// Their controls per key, f32 or quantized.
+    pub keys: KeyStore,
     /// `P_{n-1} - P_0` per vector block, when a side is `offset-repeat`.
     pub delta: Vec<f32x8>,
-    pub vec_out: usize,
-    pub hq_blocks: usize,
-    pub hq: Vec<f32x8>,
-    pub hq_out: usize,
-    /// With quantization: `vec` and `hq` in 16 bits (then those are empty).
-    pub qvec: Option<Quantized>,
-    pub qhq: Option<Quantized>,
     /// Per stored segment `k`, its entries of `exact`: `exact_at[k]..exact_at[k + 1]`
     /// (empty when `exact` is).
     pub exact_at: Vec<u32>,
@@ -875,6 +879,7 @@ impl Clip {
             };
             let ids: Vec<usize> = hq_rows[g].iter().map(|r| r.0).collect();
             let (hq_blocks, hq_out) = quats(&ids, &mut at, &mut slots, &mut quat_blocks);
+            debug_assert_eq!(hq_out, vec_out + vec_blocks, "rotations follow the vectors");
             // [P TO TI] x [x y z w] per key (and sentinel pseudo-key).
             let hrows: Vec<Vec<[f32; HQ_STRIDE]>> = hq_rows[g]
                 .iter()
@@ -888,42 +893,49 @@ impl Clip {
             let vkeys: Vec<Vec<[f32; KEY_STRIDE]>> = vrows.iter().map(per_key).collect();
             let keys = grid.times.len() + 4;
             let (exact_at, exact) = exact_table(&hq_rows[g], segments);
-            let mut vec = pack(&vkeys, keys, [0.0; KEY_STRIDE]);
-            let mut hq = pack(&hrows, keys, IDENTITY_PAD);
-            let (mut qvec, mut qhq) = (None, None);
-            if options.quantize {
-                let (q, err) = Quantized::new(&vec, keys, vec_blocks, KEY_STRIDE);
+            // Plane p, control j (P TO TI) of key k: vector blocks, then
+            // rotation blocks of 4 planes (x y z w); unused lanes 0, or the
+            // identity for rotations.
+            let control = |k: usize, j: usize, p: usize| {
+                f32x8::new(std::array::from_fn(|l| {
+                    if p < vec_blocks {
+                        vkeys.get(8 * p + l).map_or(0.0, |r| r[k][j])
+                    } else {
+                        let (b, c) = ((p - vec_blocks) / 4, (p - vec_blocks) % 4);
+                        let pad = IDENTITY_PAD[4 * j + c];
+                        hrows.get(8 * b + l).map_or(pad, |r| r[k][4 * j + c])
+                    }
+                }))
+            };
+            let planes = vec_blocks + 4 * hq_blocks;
+            let (store, err) = KeyStore::new(keys, planes, options.quantize, control);
+            if let Some(err) = err {
+                let e = |j: usize, lane: usize, plane: usize| err[j][plane][lane % 8];
                 for (lane, (track, _, _)) in vec_rows[g].iter().enumerate() {
-                    let e = |j: usize| err[(lane / 8) * KEY_STRIDE + j][lane % 8];
-                    let bound = e(0) + 4.0 / 27.0 * (e(1) + e(2));
+                    let p = lane / 8;
+                    let bound = e(0, lane, p) + 4.0 / 27.0 * (e(1, lane, p) + e(2, lane, p));
                     quant_error[*track] = quant_error[*track].max(bound);
                 }
-                let (qr, err) = Quantized::new(&hq, keys, hq_blocks, HQ_STRIDE);
                 for (lane, (track, rot)) in hq_rows[g].iter().enumerate() {
-                    let e = |j: usize| err[(lane / 8) * HQ_STRIDE + j][lane % 8];
                     let bound = (0..4)
-                        .map(|c| e(c) + 4.0 / 27.0 * (e(4 + c) + e(8 + c)))
+                        .map(|c| {
+                            let p = vec_blocks + 4 * (lane / 8) + c;
+                            e(0, lane, p) + 4.0 / 27.0 * (e(1, lane, p) + e(2, lane, p))
+                        })
                         .fold(0.0f32, f32::max);
                     let bound = bound * normalize_gain(rot);
                     quant_error[*track] = quant_error[*track].max(bound);
                 }
-                (qvec, qhq) = (Some(q), Some(qr));
-                vec = Vec::new();
-                hq = Vec::new();
             }
             groups.push(Group {
                 lanes: [vrows.len(), hq_rows[g].len(), exact.len()],
                 exact_at,
                 exact,
-                vec,
+                keys: store,
                 delta,
                 vec_blocks,
                 vec_out,
-                hq,
                 hq_blocks,
-                hq_out,
-                qvec,
-                qhq,
                 grid,
             });
         }
@@ -1041,11 +1053,8 @@ impl Clip {
             .map(|g| {
                 size_of::<Group>()
                     + grid(&g.grid)
-                    + size_of_val(g.vec.as_slice())
+                    + g.keys.heap_bytes()
                     + size_of_val(g.delta.as_slice())
-                    + size_of_val(g.hq.as_slice())
-                    + g.qvec.as_ref().map_or(0, Quantized::heap_bytes)
-                    + g.qhq.as_ref().map_or(0, Quantized::heap_bytes)
                     + size_of_val(g.exact_at.as_slice())
                     + size_of_val(g.exact.as_slice())
             })
@@ -1091,7 +1100,10 @@ impl Clip {
     pub fn bytes_per_frame(&self) -> usize {
         self.groups
             .iter()
-            .map(|g| 2 * (g.vec_blocks * KEY_STRIDE + g.hq_blocks * HQ_STRIDE) * 32)
+            .map(|g| {
+                let bytes = if g.keys.quantized() { 16 } else { 32 };
+                4 * g.keys.planes() * bytes
+            })
             .sum()
     }
 }

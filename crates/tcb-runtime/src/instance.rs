@@ -6,8 +6,8 @@ use crate::grid::Cursor;
 use crate::kernel;
 use crate::loose::LooseState;
 use crate::pose::Pose;
-use crate::quant::Quantized;
 use crate::rig::{Rig, RigError, RigMap};
+use crate::store::KeyCache;
 use std::sync::Arc;
 use wide::f32x8;
 
@@ -52,8 +52,8 @@ pub struct Instance {
     loose: LooseState,
     loose_rot: LooseState,
     pose: Pose,
-    /// Per group: expanded quantized keys, vectors then rotations (see `crate::quant`).
-    caches: Vec<[KeyCache; 2]>,
+    /// Per group: expanded quantized keys (see `crate::store`).
+    caches: Vec<KeyCache>,
     /// With a rig: the map into its layout and the pose in it.
     rig: Option<Box<(RigMap, Pose)>>,
     /// Playback mode and speed.
@@ -69,17 +69,7 @@ impl Instance {
             loose: LooseState::new(&clip.loose),
             loose_rot: LooseState::new(&clip.loose_rot),
             pose: Pose::new(&clip),
-            caches: clip
-                .groups
-                .iter()
-                .map(|g| {
-                    let n = |q: bool, x: usize| if q { x } else { 0 };
-                    [
-                        KeyCache::new(n(g.qvec.is_some(), g.vec_blocks * kernel::KEY_STRIDE)),
-                        KeyCache::new(n(g.qhq.is_some(), g.hq_blocks * kernel::HQ_STRIDE)),
-                    ]
-                })
-                .collect(),
+            caches: clip.groups.iter().map(|g| g.keys.cache()).collect(),
             clip,
             rig: None,
             playback: (Playback::Clip, 1.0),
@@ -231,7 +221,7 @@ pub(crate) fn sample_into(
     loose: &mut LooseState,
     loose_rot: &mut LooseState,
     pose: &mut Pose,
-    caches: &mut [[KeyCache; 2]],
+    caches: &mut [KeyCache],
 ) {
     let Pose {
         values, velocities, ..
@@ -243,18 +233,16 @@ pub(crate) fn sample_into(
         let rate = f32x8::splat(f.rate);
         let seg = f.segment;
         let (ka, kb) = crate::clip::key_pair(&g.grid, seg);
+        let (cv, cq) = g.keys.segment(ka, kb, cache).split_at(g.vec_blocks);
         if g.vec_blocks > 0 {
-            let n = g.vec_blocks * kernel::KEY_STRIDE;
-            let (a, b) = keys(&g.vec, g.qvec.as_ref(), n, ka, kb, &mut cache[0]);
             let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
-            kernel::vectors(a, b, &h, out);
+            kernel::vectors(cv, &h, out);
             if f.cycles != 0.0 && !g.delta.is_empty() {
                 kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
             }
             if let Some(v) = velocities.as_deref_mut() {
                 kernel::vector_velocities(
-                    a,
-                    b,
+                    cv,
                     &dh,
                     rate,
                     &mut v[g.vec_out..g.vec_out + g.vec_blocks],
@@ -262,18 +250,16 @@ pub(crate) fn sample_into(
             }
         }
         if g.hq_blocks > 0 {
-            let n = g.hq_blocks * kernel::HQ_STRIDE;
-            let range = g.hq_out..g.hq_out + 4 * g.hq_blocks;
+            let hq_out = g.vec_out + g.vec_blocks;
+            let range = hq_out..hq_out + 4 * g.hq_blocks;
             if f.reset {
                 kernel::identity(&mut values[range.clone()]);
                 if let Some(v) = velocities.as_deref_mut() {
                     v[range].fill(f32x8::ZERO);
                 }
             } else {
-                let (a, b) = keys(&g.hq, g.qhq.as_ref(), n, ka, kb, &mut cache[1]);
                 kernel::hermite_quats(
-                    a,
-                    b,
+                    cq,
                     &h,
                     &dh,
                     rate,
@@ -292,7 +278,8 @@ pub(crate) fn sample_into(
                         None if e.values => e.value_mask,
                         None => continue,
                     };
-                    let planes = g.hq_out + 4 * e.block..g.hq_out + 4 * e.block + 4;
+                    let at = hq_out + 4 * e.block;
+                    let planes = at..at + 4;
                     kernel::exact_quats(
                         e,
                         mask,
@@ -317,51 +304,4 @@ pub(crate) fn sample_into(
             velocities.as_deref_mut().map(|v| &mut v[planes]),
         );
     }
-}
-
-/// Expanded quantized keys of one group, two slots (forward playback
-/// reuses the previous frame's second key as this one's first).
-#[derive(Clone, Debug)]
-pub(crate) struct KeyCache {
-    keys: [usize; 2],
-    data: Vec<f32x8>,
-}
-
-impl KeyCache {
-    pub fn new(n: usize) -> Self {
-        KeyCache {
-            keys: [usize::MAX; 2],
-            data: vec![f32x8::ZERO; 2 * n],
-        }
-    }
-}
-
-/// Keys `ka` and `kb` (`n` vectors each) of a group's controls: slices of
-/// the f32 storage, or, when quantized, expanded into the cache (only the
-/// keys it does not hold yet).
-#[inline(always)]
-fn keys<'a>(
-    plain: &'a [f32x8],
-    quantized: Option<&Quantized>,
-    n: usize,
-    ka: usize,
-    kb: usize,
-    cache: &'a mut KeyCache,
-) -> (&'a [f32x8], &'a [f32x8]) {
-    let Some(q) = quantized else {
-        return (&plain[ka * n..(ka + 1) * n], &plain[kb * n..(kb + 1) * n]);
-    };
-    let mut slot_of = |k: usize, keep: usize| -> usize {
-        if let Some(s) = cache.keys.iter().position(|&c| c == k) {
-            return s;
-        }
-        let s = if cache.keys[0] == keep { 1 } else { 0 };
-        q.expand(k, &mut cache.data[s * n..(s + 1) * n]);
-        cache.keys[s] = k;
-        s
-    };
-    let sa = slot_of(ka, kb);
-    let sb = slot_of(kb, ka);
-    let d = &cache.data;
-    (&d[sa * n..(sa + 1) * n], &d[sb * n..(sb + 1) * n])
 }

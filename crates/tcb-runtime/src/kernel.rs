@@ -1,13 +1,13 @@
 //! The SIMD kernels: one stored segment, eight channels per `f32x8`, the
 //! frame's rows broadcast. No branch depends on a channel.
 
+use crate::store::Segment;
 use tcb_core::basis::hermite;
 use wide::{f32x8, f64x4};
 
-/// `[P, TO, TI]` of 8 channels at one key (`P0 = a.P, M0 = a.TO` and
-/// `P1 = b.P, M1 = b.TI` for a segment from key a to key b).
+/// `[P, TO, TI]` of one channel at one key (`clip::per_key`).
 pub(crate) const KEY_STRIDE: usize = 3;
-/// `[P, TO, TI]` x `[x, y, z, w]` of 8 rotations at one key.
+/// `[P, TO, TI]` x `[x, y, z, w]` of one rotation at one key.
 pub(crate) const HQ_STRIDE: usize = 12;
 /// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
 /// of 4 quaternions in f64 ([`tcb_core::squad::CONTROLS`]): the two outer
@@ -19,37 +19,23 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
     r.map(f32x8::splat)
 }
 
-/// Values of vector channels between keys `a` and `b`:
+/// Values of vector channels on segment `c` (one plane per block):
 /// `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula of
 /// [`tcb_core::basis::hermite`] itself.
 #[inline]
-pub(crate) fn vectors(a: &[f32x8], b: &[f32x8], h: &[f32x8; 4], out: &mut [f32x8]) {
-    let keys = a
-        .as_chunks::<KEY_STRIDE>()
-        .0
-        .iter()
-        .zip(b.as_chunks::<KEY_STRIDE>().0);
-    for ((a, b), o) in keys.zip(out) {
-        *o = hermite(h, a[0], b[0], a[1], b[2]);
+pub(crate) fn vectors(c: Segment, h: &[f32x8; 4], out: &mut [f32x8]) {
+    let keys = c.p0.iter().zip(c.p1).zip(c.m0).zip(c.m1);
+    for ((((p0, p1), m0), m1), o) in keys.zip(out) {
+        *o = hermite(h, *p0, *p1, *m0, *m1);
     }
 }
 
 /// Velocities of vector channels: `rate (dh . controls)`.
 #[inline]
-pub(crate) fn vector_velocities(
-    a: &[f32x8],
-    b: &[f32x8],
-    dh: &[f32x8; 4],
-    rate: f32x8,
-    out: &mut [f32x8],
-) {
-    let keys = a
-        .as_chunks::<KEY_STRIDE>()
-        .0
-        .iter()
-        .zip(b.as_chunks::<KEY_STRIDE>().0);
-    for ((a, b), o) in keys.zip(out) {
-        *o = hermite(dh, a[0], b[0], a[1], b[2]) * rate;
+pub(crate) fn vector_velocities(c: Segment, dh: &[f32x8; 4], rate: f32x8, out: &mut [f32x8]) {
+    let keys = c.p0.iter().zip(c.p1).zip(c.m0).zip(c.m1);
+    for ((((p0, p1), m0), m1), o) in keys.zip(out) {
+        *o = hermite(dh, *p0, *p1, *m0, *m1) * rate;
     }
 }
 
@@ -61,54 +47,60 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
     }
 }
 
-/// Rotations between keys `a` and `b`: four components, then normalized;
-/// `vel` gets `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
+/// Rotations on segment `c` (four planes per block, `x y z w`): four
+/// components, then normalized; `vel` gets
+/// `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
 #[inline]
 pub(crate) fn hermite_quats(
-    a: &[f32x8],
-    b: &[f32x8],
+    c: Segment,
     h: &[f32x8; 4],
     dh: &[f32x8; 4],
     rate: f32x8,
     out: &mut [f32x8],
     vel: Option<&mut [f32x8]>,
 ) {
-    let keys = a
-        .as_chunks::<HQ_STRIDE>()
-        .0
-        .iter()
-        .zip(b.as_chunks::<HQ_STRIDE>().0);
+    let keys =
+        c.p0.as_chunks::<4>()
+            .0
+            .iter()
+            .zip(c.p1.as_chunks::<4>().0)
+            .zip(c.m0.as_chunks::<4>().0)
+            .zip(c.m1.as_chunks::<4>().0);
     let out = out.as_chunks_mut::<4>().0;
     // One loop with velocities and one without, the block written once.
     match vel {
         None => {
-            for ((a, b), o) in keys.zip(out) {
-                hermite_quat_block(a, b, h, None, o, None);
+            for (k, o) in keys.zip(out) {
+                hermite_quat_block(k, h, None, o, None);
             }
         }
         Some(vel) => {
             let vel = vel.as_chunks_mut::<4>().0;
-            for (((a, b), o), v) in keys.zip(out).zip(vel) {
-                hermite_quat_block(a, b, h, Some((dh, rate)), o, Some(v));
+            for ((k, o), v) in keys.zip(out).zip(vel) {
+                hermite_quat_block(k, h, Some((dh, rate)), o, Some(v));
             }
         }
     }
 }
 
+/// `P0 P1 M0 M1` of one rotation block (four planes each).
+type QuatKeys<'a> = (
+    ((&'a [f32x8; 4], &'a [f32x8; 4]), &'a [f32x8; 4]),
+    &'a [f32x8; 4],
+);
+
 /// One block of [`hermite_quats`]: 8 rotations.
 #[inline(always)]
 fn hermite_quat_block(
-    a: &[f32x8; HQ_STRIDE],
-    b: &[f32x8; HQ_STRIDE],
+    (((p0, p1), m0), m1): QuatKeys,
     h: &[f32x8; 4],
     dh: Option<(&[f32x8; 4], f32x8)>,
     out: &mut [f32x8; 4],
     vel: Option<&mut [f32x8; 4]>,
 ) {
-    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, a[c], b[c], a[4 + c], b[8 + c]));
-    let dp = dh.map(|(dh, rate)| {
-        std::array::from_fn(|c| hermite(dh, a[c], b[c], a[4 + c], b[8 + c]) * rate)
-    });
+    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, p0[c], p1[c], m0[c], m1[c]));
+    let dp = dh
+        .map(|(dh, rate)| std::array::from_fn(|c| hermite(dh, p0[c], p1[c], m0[c], m1[c]) * rate));
     let (q, qv) = normalize(p, dp);
     *out = q;
     let mut vel = vel;

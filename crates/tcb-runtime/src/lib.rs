@@ -48,6 +48,7 @@ pub mod pose;
 pub mod quant;
 pub mod rig;
 pub mod skeleton;
+mod store;
 
 #[cfg(feature = "rayon")]
 pub mod batch;

@@ -1,8 +1,10 @@
 //! Optional 16-bit storage of a group's per-key controls, chosen when a
 //! clip is compiled ([`crate::CompileOptions::quantize`]).
 //!
-//! Per lane (channel) and per control (`P`, `TO`, `TI`; for rotations per
-//! component too), over all of the group's keys:
+//! Per lane (channel) and plane (for rotations per component too), over all
+//! of the group's keys, one range for `P` and one shared by `TO` and `TI`
+//! (so that a `TI` stored as its key's `TO`, see `crate::store`, stays
+//! equal to it):
 //!
 //! ```text
 //! scale = (max - min) / 65535      q = round((x - min) / scale)      x' = min + q scale
@@ -24,90 +26,109 @@
 
 use wide::{f32x8, i32x8, u16x8};
 
-/// One group's controls (vectors or rotations) in 16 bits.
+/// One group's controls in 16 bits, laid out as the f32 ones
+/// ([`crate::store`]): `[P TO]` per key and `TI` where it differs.
 #[derive(Clone, Debug)]
 pub(crate) struct Quantized {
-    /// `[key][block][j]`, like the f32 layout.
+    /// At the same offsets as the f32 layout.
     data: Vec<u16x8>,
-    /// `[block][j]`: each lane's minimum and step.
+    /// `[P planes][T planes]`: each lane's minimum and step, `T` shared by
+    /// `TO` and `TI` (so that a `TI` equal to its `TO` stays equal).
     min: Vec<f32x8>,
     scale: Vec<f32x8>,
-    /// Vectors per key and block (`KEY_STRIDE` or `HQ_STRIDE`).
-    stride: usize,
-    blocks: usize,
+    planes: usize,
 }
 
 impl Quantized {
-    /// Quantize `packed` (`[key][block][j]`, `keys` keys of `blocks` blocks
-    /// of `stride` vectors). Also returns, per block and j, each lane's
-    /// largest error on any key.
-    pub fn new(
-        packed: &[f32x8],
-        keys: usize,
-        blocks: usize,
-        stride: usize,
-    ) -> (Self, Vec<[f32; 8]>) {
-        let at = |k: usize, b: usize, j: usize| packed[(k * blocks + b) * stride + j].to_array();
-        let mut min = Vec::with_capacity(blocks * stride);
-        let mut scale = Vec::with_capacity(blocks * stride);
-        for b in 0..blocks {
-            for j in 0..stride {
+    /// Quantize `packed` (the f32 layout of [`crate::store`]: key `k`'s
+    /// `P` and `TO` from `at[k][0]`, its `TI` at `at[k][1]`, `planes`
+    /// vectors each). Also returns, per control (`P`, `TO`, `TI`), plane
+    /// and lane, the largest error on any key.
+    pub fn new(packed: &[f32x8], at: &[[u32; 2]], planes: usize) -> (Self, [Vec<[f32; 8]>; 3]) {
+        // Section start of control j at key k.
+        let start = |k: usize, j: usize| match j {
+            0 => at[k][0] as usize,
+            1 => at[k][0] as usize + planes,
+            _ => at[k][1] as usize,
+        };
+        let mut min = Vec::with_capacity(2 * planes);
+        let mut scale = Vec::with_capacity(2 * planes);
+        for range in [&[0usize][..], &[1, 2][..]] {
+            for p in 0..planes {
                 let (mut lo, mut hi) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
-                for k in 0..keys {
-                    let x = at(k, b, j);
-                    for l in 0..8 {
-                        lo[l] = lo[l].min(x[l]);
-                        hi[l] = hi[l].max(x[l]);
+                for k in 0..at.len() {
+                    for &j in range {
+                        let x = packed[start(k, j) + p].to_array();
+                        for l in 0..8 {
+                            lo[l] = lo[l].min(x[l]);
+                            hi[l] = hi[l].max(x[l]);
+                        }
                     }
                 }
                 min.push(f32x8::new(lo));
+                // Halved first: `hi - lo` overflows f32 for a range spanning it.
                 scale.push(f32x8::new(std::array::from_fn(|l| {
-                    (hi[l] - lo[l]) / 65535.0
+                    (hi[l] / 2.0 - lo[l] / 2.0) / 32767.5
                 })));
             }
         }
-        let mut data = Vec::with_capacity(packed.len());
-        let mut error = vec![[0.0f32; 8]; blocks * stride];
-        for k in 0..keys {
-            for b in 0..blocks {
-                for j in 0..stride {
+        let data: Vec<u16x8> = packed.iter().map(|_| u16x8::ZERO).collect();
+        let mut q = Quantized {
+            data,
+            min,
+            scale,
+            planes,
+        };
+        let mut error: [Vec<[f32; 8]>; 3] = std::array::from_fn(|_| vec![[0.0f32; 8]; planes]);
+        for k in 0..at.len() {
+            for (j, error) in error.iter_mut().enumerate() {
+                let r = usize::from(j > 0) * planes;
+                for (p, error) in error.iter_mut().enumerate() {
+                    let i = start(k, j) + p;
                     let (x, lo, s) = (
-                        at(k, b, j),
-                        min[b * stride + j].to_array(),
-                        scale[b * stride + j].to_array(),
+                        packed[i].to_array(),
+                        q.min[r + p].to_array(),
+                        q.scale[r + p].to_array(),
                     );
-                    let q: [u16; 8] = std::array::from_fn(|l| {
+                    let v: [u16; 8] = std::array::from_fn(|l| {
                         if s[l] > 0.0 {
                             ((x[l] - lo[l]) / s[l]).round().clamp(0.0, 65535.0) as u16
                         } else {
                             0
                         }
                     });
-                    for l in 0..8 {
-                        let back = lo[l] + f32::from(q[l]) * s[l];
-                        let e = &mut error[b * stride + j][l];
+                    for (l, e) in error.iter_mut().enumerate() {
+                        let back = lo[l] + f32::from(v[l]) * s[l];
                         *e = e.max((back - x[l]).abs());
                     }
-                    data.push(u16x8::new(q));
+                    q.data[i] = u16x8::new(v);
                 }
             }
         }
-        let q = Quantized {
-            data,
-            min,
-            scale,
-            stride,
-            blocks,
-        };
         (q, error)
     }
 
-    /// Expand key `k` (all blocks) into `out` (`blocks * stride` vectors).
+    /// Expand the `P` and `TO` sections starting at `at` into `out`
+    /// (`2 planes` vectors).
     #[inline]
-    pub fn expand(&self, k: usize, out: &mut [f32x8]) {
-        let n = self.blocks * self.stride;
-        let src = &self.data[k * n..(k + 1) * n];
+    pub fn expand(&self, at: usize, out: &mut [f32x8]) {
+        let src = &self.data[at..at + 2 * self.planes];
         for (((o, q), lo), s) in out.iter_mut().zip(src).zip(&self.min).zip(&self.scale) {
+            *o = *lo + f32x8::from_i32x8(i32x8::from_u16x8(*q)) * *s;
+        }
+    }
+
+    /// Expand the `TI` section starting at `at` into `out` (`planes` vectors).
+    #[inline]
+    pub fn expand_ti(&self, at: usize, out: &mut [f32x8]) {
+        let n = self.planes;
+        let src = &self.data[at..at + n];
+        for (((o, q), lo), s) in out
+            .iter_mut()
+            .zip(src)
+            .zip(&self.min[n..])
+            .zip(&self.scale[n..])
+        {
             *o = *lo + f32x8::from_i32x8(i32x8::from_u16x8(*q)) * *s;
         }
     }

@@ -1,0 +1,271 @@
+//! A group's controls, stored once per key.
+//!
+//! Every key (and sentinel pseudo-key, see `clip::per_key`) holds three
+//! sections of `planes` vectors of 8 lanes: `P`, `TO` (the outgoing
+//! tangent, `M0` of the segment it starts) and `TI` (the incoming one,
+//! `M1` of the segment it ends). A group's planes are its vector blocks
+//! (one plane each) then its rotation blocks (four planes each, `x y z w`),
+//! as the pose lays them out. `TI` is stored only where it differs from
+//! `TO` in some bit of some lane; elsewhere the key's `TI` *is* its `TO`
+//! section. On keys of even spacing with continuity 0 the two are equal
+//! (2750 of the 2752 keys of the CMU capture in `hermite` mode), so such a
+//! clip stores two sections per key, not three, and the kernels read
+//! exactly the numbers they read before.
+//!
+//! ```text
+//! key k at at[k][0]:  [P; planes] [TO; planes] ([TI; planes] where TI != TO)
+//! TI of key k:        at[k][1] (at[k][0] + planes where TI == TO)
+//! ```
+//!
+//! With quantization ([`crate::CompileOptions::quantize`]) the same layout
+//! holds 16-bit numbers; `TO` and `TI` of a plane share one range, so a
+//! `TI` equal to its `TO` quantizes to the same numbers (see `crate::quant`).
+
+use crate::quant::Quantized;
+use wide::f32x8;
+
+/// The four controls of one stored segment from key `a` to key `b`
+/// (`planes` vectors each): `P0 = a.P`, `M0 = a.TO`, `P1 = b.P`,
+/// `M1 = b.TI`.
+#[derive(Clone, Copy)]
+pub(crate) struct Segment<'a> {
+    pub p0: &'a [f32x8],
+    pub m0: &'a [f32x8],
+    pub p1: &'a [f32x8],
+    pub m1: &'a [f32x8],
+}
+
+impl<'a> Segment<'a> {
+    /// The first `n` planes and the rest.
+    #[inline(always)]
+    pub fn split_at(self, n: usize) -> (Segment<'a>, Segment<'a>) {
+        let (p0, q0) = self.p0.split_at(n);
+        let (m0, n0) = self.m0.split_at(n);
+        let (p1, q1) = self.p1.split_at(n);
+        let (m1, n1) = self.m1.split_at(n);
+        (
+            Segment { p0, m0, p1, m1 },
+            Segment {
+                p0: q0,
+                m0: n0,
+                p1: q1,
+                m1: n1,
+            },
+        )
+    }
+}
+
+/// The numbers, in f32 or in 16 bits.
+#[derive(Clone, Debug)]
+enum Data {
+    F32(Vec<f32x8>),
+    Q16(Quantized),
+}
+
+/// One group's controls per key (see the module docs).
+#[derive(Clone, Debug)]
+pub(crate) struct KeyStore {
+    planes: usize,
+    /// Per key: where its `P` section starts (`TO` follows) and where its
+    /// `TI` section starts.
+    at: Vec<[u32; 2]>,
+    data: Data,
+}
+
+/// Per control (`P`, `TO`, `TI`), plane and lane: the largest error
+/// quantization made on any key.
+pub(crate) type QuantError = [Vec<[f32; 8]>; 3];
+
+impl KeyStore {
+    /// Store `keys` keys of `planes` planes; `control(k, j, p)` is control
+    /// `j` (`0` P, `1` TO, `2` TI) of plane `p` at key `k`. Quantized, it
+    /// also returns the error made per control, plane and lane.
+    pub fn new(
+        keys: usize,
+        planes: usize,
+        quantize: bool,
+        control: impl Fn(usize, usize, usize) -> f32x8,
+    ) -> (Self, Option<QuantError>) {
+        let mut at = Vec::with_capacity(keys);
+        let mut data = Vec::with_capacity(keys * 2 * planes);
+        let offset =
+            |x: usize| u32::try_from(x).expect("a group's controls under 2^32 vectors (128 GiB)");
+        for k in 0..keys {
+            let start = data.len();
+            data.extend((0..planes).map(|p| control(k, 0, p)));
+            data.extend((0..planes).map(|p| control(k, 1, p)));
+            let ti: Vec<f32x8> = (0..planes).map(|p| control(k, 2, p)).collect();
+            let to = &data[start + planes..];
+            let ti_at = if ti.iter().zip(to).all(|(i, o)| bits(*i) == bits(*o)) {
+                start + planes
+            } else {
+                data.extend(ti);
+                start + 2 * planes
+            };
+            at.push([offset(start), offset(ti_at)]);
+        }
+        if !quantize {
+            let store = KeyStore {
+                planes,
+                at,
+                data: Data::F32(data),
+            };
+            return (store, None);
+        }
+        let (q, error) = Quantized::new(&data, &at, planes);
+        let store = KeyStore {
+            planes,
+            at,
+            data: Data::Q16(q),
+        };
+        (store, Some(error))
+    }
+
+    /// Planes per section.
+    pub fn planes(&self) -> usize {
+        self.planes
+    }
+
+    /// Heap bytes.
+    pub fn heap_bytes(&self) -> usize {
+        std::mem::size_of_val(self.at.as_slice())
+            + match &self.data {
+                Data::F32(d) => std::mem::size_of_val(d.as_slice()),
+                Data::Q16(q) => q.heap_bytes(),
+            }
+    }
+
+    /// Whether the numbers are 16-bit.
+    pub fn quantized(&self) -> bool {
+        matches!(self.data, Data::Q16(_))
+    }
+
+    /// The controls of the segment from key `a` to key `b`: slices of the
+    /// f32 storage, or, quantized, expanded into `cache` (only the keys it
+    /// does not hold yet).
+    #[inline(always)]
+    pub fn segment<'a>(&'a self, a: usize, b: usize, cache: &'a mut KeyCache) -> Segment<'a> {
+        let n = self.planes;
+        match &self.data {
+            Data::F32(d) => {
+                let [pa, _] = self.at[a];
+                let [pb, ib] = self.at[b];
+                let (pa, pb, ib) = (pa as usize, pb as usize, ib as usize);
+                Segment {
+                    p0: &d[pa..pa + n],
+                    m0: &d[pa + n..pa + 2 * n],
+                    p1: &d[pb..pb + n],
+                    m1: &d[ib..ib + n],
+                }
+            }
+            Data::Q16(q) => {
+                let mut slot_of = |k: usize, keep: usize| -> usize {
+                    if let Some(s) = cache.keys.iter().position(|&c| c == k) {
+                        return s;
+                    }
+                    let s = usize::from(cache.keys[0] == keep);
+                    let out = &mut cache.data[3 * n * s..3 * n * (s + 1)];
+                    let [p, i] = self.at[k];
+                    q.expand(p as usize, out);
+                    q.expand_ti(i as usize, &mut out[2 * n..]);
+                    cache.keys[s] = k;
+                    s
+                };
+                let sa = slot_of(a, b);
+                let sb = slot_of(b, a);
+                let d = &cache.data;
+                let (a, b) = (3 * n * sa, 3 * n * sb);
+                Segment {
+                    p0: &d[a..a + n],
+                    m0: &d[a + n..a + 2 * n],
+                    p1: &d[b..b + n],
+                    m1: &d[b + 2 * n..b + 3 * n],
+                }
+            }
+        }
+    }
+
+    /// A cache for [`segment`](Self::segment), per instance.
+    pub fn cache(&self) -> KeyCache {
+        let n = if self.quantized() { 3 * self.planes } else { 0 };
+        KeyCache {
+            keys: [usize::MAX; 2],
+            data: vec![f32x8::ZERO; 2 * n],
+        }
+    }
+}
+
+/// Two expanded keys of a quantized group (forward playback reuses the
+/// previous frame's second key as this one's first), `[P TO TI]` each.
+#[derive(Clone, Debug)]
+pub(crate) struct KeyCache {
+    keys: [usize; 2],
+    data: Vec<f32x8>,
+}
+
+fn bits(x: f32x8) -> [u32; 8] {
+    x.to_array().map(f32::to_bits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three keys of two planes: key 1's `TI` equals its `TO` and is not
+    /// stored; keys 0 and 2 differ in one lane of one plane and are.
+    fn controls(k: usize, j: usize, p: usize) -> f32x8 {
+        let mut x = [0.0f32; 8];
+        for (l, x) in x.iter_mut().enumerate() {
+            let to = (10 * k + p) as f32 + 0.25 * l as f32;
+            *x = match j {
+                0 => -((10 * k + p) as f32) - l as f32,
+                2 if k != 1 && p == 1 && l == 5 => to + 1.0,
+                _ => to,
+            };
+        }
+        f32x8::new(x)
+    }
+
+    #[test]
+    fn ti_is_stored_only_where_it_differs() {
+        let (store, err) = KeyStore::new(3, 2, false, controls);
+        assert!(err.is_none());
+        // Keys 0 and 2: P TO TI; key 1: P TO.
+        assert_eq!(store.heap_bytes(), 2 * 32 * (3 + 2 + 3) + 3 * 8);
+        let mut cache = store.cache();
+        for (a, b) in [(0, 1), (1, 2), (2, 0), (1, 1)] {
+            let s = store.segment(a, b, &mut cache);
+            for p in 0..2 {
+                assert_eq!(bits(s.p0[p]), bits(controls(a, 0, p)), "{a} {b} {p}");
+                assert_eq!(bits(s.m0[p]), bits(controls(a, 1, p)), "{a} {b} {p}");
+                assert_eq!(bits(s.p1[p]), bits(controls(b, 0, p)), "{a} {b} {p}");
+                assert_eq!(bits(s.m1[p]), bits(controls(b, 2, p)), "{a} {b} {p}");
+            }
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // p indexes four slices and the errors
+    fn quantized_keys_expand_within_their_error() {
+        let (store, err) = KeyStore::new(3, 2, true, controls);
+        let err = err.expect("quantized");
+        assert!(store.quantized());
+        let mut cache = store.cache();
+        for (a, b) in [(0, 1), (1, 2), (2, 0), (0, 2), (1, 1)] {
+            let s = store.segment(a, b, &mut cache);
+            for p in 0..2 {
+                let near = |x: f32x8, j: usize, k: usize| {
+                    let (x, want) = (x.to_array(), controls(k, j, p).to_array());
+                    (0..8).all(|l| (x[l] - want[l]).abs() <= err[j][p][l] && err[j][p][l] < 1e-3)
+                };
+                assert!(near(s.p0[p], 0, a) && near(s.m0[p], 1, a), "{a} {b} {p}");
+                assert!(near(s.p1[p], 0, b) && near(s.m1[p], 2, b), "{a} {b} {p}");
+            }
+            // A TI equal to its TO stays equal once quantized.
+            if b == 1 {
+                let s = store.segment(b, b, &mut cache);
+                assert_eq!(bits(s.m0[0]), bits(s.m1[0]));
+            }
+        }
+    }
+}
