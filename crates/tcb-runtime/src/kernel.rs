@@ -50,6 +50,10 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
 /// Rotations on segment `c` (four planes per block, `x y z w`): four
 /// components, then normalized; `vel` gets
 /// `d/dt (p/|p|) = (p' - q (q . p')) / |p|`.
+///
+/// Whether `|p|^2` stays well inside f32's range is checked for every lane
+/// but acted on once per call: the rare segment where some lane leaves it
+/// (explicit tangents of 1e36, say) is redone block by block, cold.
 #[inline]
 pub(crate) fn hermite_quats(
     c: Segment,
@@ -57,29 +61,27 @@ pub(crate) fn hermite_quats(
     dh: &[f32x8; 4],
     rate: f32x8,
     out: &mut [f32x8],
-    vel: Option<&mut [f32x8]>,
+    mut vel: Option<&mut [f32x8]>,
 ) {
-    let keys =
-        c.p0.as_chunks::<4>()
-            .0
-            .iter()
-            .zip(c.p1.as_chunks::<4>().0)
-            .zip(c.m0.as_chunks::<4>().0)
-            .zip(c.m1.as_chunks::<4>().0);
-    let out = out.as_chunks_mut::<4>().0;
+    let keys = quat_keys(c);
+    let blocks = out.as_chunks_mut::<4>().0;
+    let mut ok = f32x8::splat(f32::from_bits(u32::MAX));
     // One loop with velocities and one without, the block written once.
-    match vel {
+    match vel.as_deref_mut() {
         None => {
-            for (k, o) in keys.zip(out) {
-                hermite_quat_block(k, h, None, o, None);
+            for (k, o) in keys.zip(blocks) {
+                ok &= hermite_quat_block(k, h, None, o, None);
             }
         }
         Some(vel) => {
             let vel = vel.as_chunks_mut::<4>().0;
-            for ((k, o), v) in keys.zip(out).zip(vel) {
-                hermite_quat_block(k, h, Some((dh, rate)), o, Some(v));
+            for ((k, o), v) in keys.zip(blocks).zip(vel) {
+                ok &= hermite_quat_block(k, h, Some((dh, rate)), o, Some(v));
             }
         }
+    }
+    if ok.to_bitmask() != 0xff {
+        rescale_quats(c, h, dh, rate, out, vel);
     }
 }
 
@@ -89,37 +91,80 @@ type QuatKeys<'a> = (
     &'a [f32x8; 4],
 );
 
-/// One block of [`hermite_quats`]: 8 rotations.
+/// The rotation blocks of segment `c`.
+#[inline(always)]
+fn quat_keys(c: Segment) -> impl Iterator<Item = QuatKeys> {
+    c.p0.as_chunks::<4>()
+        .0
+        .iter()
+        .zip(c.p1.as_chunks::<4>().0)
+        .zip(c.m0.as_chunks::<4>().0)
+        .zip(c.m1.as_chunks::<4>().0)
+}
+
+/// The cubic of one rotation block and, with `dh`, its derivative times `rate`.
+#[inline(always)]
+fn quat_curve(
+    (((p0, p1), m0), m1): QuatKeys,
+    h: &[f32x8; 4],
+    dh: Option<(&[f32x8; 4], f32x8)>,
+) -> ([f32x8; 4], Option<[f32x8; 4]>) {
+    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, p0[c], p1[c], m0[c], m1[c]));
+    let dp = dh
+        .map(|(dh, rate)| std::array::from_fn(|c| hermite(dh, p0[c], p1[c], m0[c], m1[c]) * rate));
+    (p, dp)
+}
+
+/// One block of [`hermite_quats`]: 8 rotations. Returns the lanes whose
+/// `|p|^2` is in range ([`in_range`]).
 #[inline(always)]
 fn hermite_quat_block(
-    (((p0, p1), m0), m1): QuatKeys,
+    k: QuatKeys,
     h: &[f32x8; 4],
     dh: Option<(&[f32x8; 4], f32x8)>,
     out: &mut [f32x8; 4],
     vel: Option<&mut [f32x8; 4]>,
-) {
-    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, p0[c], p1[c], m0[c], m1[c]));
-    let dp = dh
-        .map(|(dh, rate)| std::array::from_fn(|c| hermite(dh, p0[c], p1[c], m0[c], m1[c]) * rate));
+) -> f32x8 {
+    let (p, dp) = quat_curve(k, h, dh);
     let (q, qv) = normalize(p, dp);
     *out = q;
-    let mut vel = vel;
-    if let (Some(v), Some(qv)) = (vel.as_deref_mut(), qv) {
+    if let (Some(v), Some(qv)) = (vel, qv) {
         *v = qv;
     }
-    if !in_range(&p) {
-        renormalize_scaled(&p, dp.as_ref(), out, vel.map(|v| v.as_mut_slice()));
+    in_range(&p)
+}
+
+/// [`hermite_quats`] again for the blocks with a lane out of range, each
+/// lane first divided by its largest component ([`renormalize_scaled`]).
+#[cold]
+#[inline(never)]
+fn rescale_quats(
+    c: Segment,
+    h: &[f32x8; 4],
+    dh: &[f32x8; 4],
+    rate: f32x8,
+    out: &mut [f32x8],
+    mut vel: Option<&mut [f32x8]>,
+) {
+    for (b, k) in quat_keys(c).enumerate() {
+        let (p, dp) = quat_curve(k, h, vel.is_some().then_some((dh, rate)));
+        if in_range(&p).to_bitmask() != 0xff {
+            let planes = 4 * b..4 * b + 4;
+            let v = vel.as_deref_mut().map(|v| &mut v[planes.clone()]);
+            renormalize_scaled(&p, dp.as_ref(), &mut out[planes], v);
+        }
     }
 }
 
 pub(crate) use tcb_core::quat::normalize;
 
-/// Whether `|p|^2` of every lane is well inside f32's range, so that
-/// [`normalize`] may run as it is (one compare per block).
+/// The lanes where `|p|^2` is well inside f32's range, so that
+/// [`normalize`] may run as it is (all bits set there, none elsewhere; NaN
+/// is out of range).
 #[inline(always)]
-pub(crate) fn in_range(p: &[f32x8; 4]) -> bool {
+pub(crate) fn in_range(p: &[f32x8; 4]) -> f32x8 {
     let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
-    (n2.simd_gt(f32x8::splat(1e-30)) & n2.simd_lt(f32x8::splat(1e30))).all()
+    n2.simd_gt(f32x8::splat(1e-30)) & n2.simd_lt(f32x8::splat(1e30))
 }
 
 /// Rewrite `out` (and `vel`) with [`normalize`] of a block where `|p|^2`
@@ -168,7 +213,7 @@ fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
     if let (Some(d), Some(qv)) = (vel.as_deref_mut(), qv) {
         *d = qv;
     }
-    if !in_range(&p) {
+    if in_range(&p).to_bitmask() != 0xff {
         renormalize_scaled(&p, dp.as_ref(), v, vel.map(|d| d.as_mut_slice()));
     }
 }
