@@ -13,7 +13,6 @@
 use crate::Rng;
 use crate::baseline::Baseline;
 use crate::peer::SplinesPeer;
-use rayon::prelude::*;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -129,27 +128,21 @@ impl Scenario {
         }
     }
 
-    /// One pass of the runtime, each frame's instances split into one
-    /// contiguous chunk per rayon thread (one job per core per frame, as a
-    /// game's job system would). The frame loop runs inside the pool, so
-    /// the calling thread works rather than sleeping on every frame.
+    /// One pass of the runtime through [`tcb_runtime::batch::sample_all`]
+    /// (rayon over the instances; the plain loop in a one-thread pool). The
+    /// frame loop runs inside the pool, so the calling thread works rather
+    /// than sleeping on every frame.
     pub fn parallel_pass(&self) -> impl FnMut() + '_ {
         let mut instances = self.instances();
-        let chunk = instances
-            .len()
-            .div_ceil(rayon::current_num_threads())
-            .max(1);
+        let mut at = vec![0.0; instances.len()];
         move || {
             rayon::scope(|_| {
                 for &t in &self.times {
-                    instances
-                        .par_chunks_mut(chunk)
-                        .zip(self.phases.par_chunks(chunk))
-                        .for_each(|(insts, phases)| {
-                            for (inst, &p) in insts.iter_mut().zip(phases) {
-                                black_box(inst.sample(t + p));
-                            }
-                        });
+                    for (a, &p) in at.iter_mut().zip(&self.phases) {
+                        *a = t + p;
+                    }
+                    tcb_runtime::batch::sample_all(&mut instances, &at);
+                    black_box(&instances);
                 }
             })
         }

@@ -6,6 +6,11 @@ use rayon::prelude::*;
 
 /// Sample `instances[i]` at `times[i]`, in parallel.
 ///
+/// In a pool of one thread (`RAYON_NUM_THREADS=1`, or a one-thread pool
+/// this is `install`ed in) it is the plain loop of [`sample_all_sequential`]
+/// on the calling thread: handing each frame to the pool's one worker and
+/// waiting for it would cost the hand-over and gain nothing.
+///
 /// ```
 /// # use std::sync::Arc;
 /// # let text = r#"{"format": "tcb-clip/1", "tracks": [{"name": "x", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#;
@@ -15,6 +20,9 @@ use rayon::prelude::*;
 /// tcb_runtime::batch::sample_all(&mut crowd, &times);
 /// ```
 pub fn sample_all(instances: &mut [Instance], times: &[f64]) {
+    if rayon::current_num_threads() <= 1 {
+        return sample_all_sequential(instances, times);
+    }
     instances
         .par_iter_mut()
         .zip(times.par_iter())
