@@ -793,7 +793,9 @@ fn step_segments_hold_their_keys_past_overflowing_tangents() {
 /// A `hermite` rotation with explicit tangents of 1e36: the cubic's squared
 /// length overflows f32, and normalizing it gave a zero quaternion where
 /// the reference (normalizing in f64) gives a rotation (found by the
-/// `runtime` fuzz target).
+/// `runtime` fuzz target). Alone it is a loose lane; among 9 rotations on
+/// one grid it takes the group kernel, whose range check acts once per
+/// call (`kernel::hermite_quats`).
 #[test]
 fn rotations_with_huge_tangents_stay_unit() {
     let t = vec![0.0, 1.0, 2.0];
@@ -803,43 +805,49 @@ fn rotations_with_huge_tangents_stay_unit() {
         Quat::IDENTITY,
     ];
     let huge = Quat::from_xyzw(2.3e36, 1.9, 1.9, 7.0);
-    let keys = vec![
-        KeyParams::default(),
-        KeyParams {
-            tangent_in: Some(huge),
-            tangent_out: Some(huge),
-            ..KeyParams::default()
-        },
-        KeyParams::default(),
-    ];
     let s = TrackSettings {
         rotation: RotationMode::Hermite,
         ..TrackSettings::default()
     };
-    let track = RotationTrack::new(t, q, keys, &s).expect("finite tangents");
-    let clip = tcb_core::Clip::new(
-        "huge",
-        vec![NamedTrack {
-            name: "r".into(),
-            data: TrackData::Quat(track),
-        }],
-    )
-    .expect("unique track names");
-    let mut inst = Instance::new(Arc::new(Clip::compile(&clip)));
-    for time in [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0] {
-        let (mut got, mut want) = ([0.0f32; 4], [0.0f32; 4]);
-        inst.sample(time).write_row(&mut got, None);
-        clip.sample_into(time, &mut want, None);
-        assert!(want.iter().all(|x| x.is_finite()), "{want:?}");
-        let close = |sign: f32| {
-            got.iter()
-                .zip(&want)
-                .all(|(g, w)| (g * sign - w).abs() <= 1e-6)
-        };
-        assert!(
-            close(1.0) || close(-1.0),
-            "at {time}: runtime {got:?}, reference {want:?}"
-        );
+    for (tracks, at) in [(1, 0), (9, 0), (9, 5), (16, 15)] {
+        let named = (0..tracks)
+            .map(|i| {
+                let mut keys = vec![KeyParams::default(); 3];
+                if i == at {
+                    keys[1].tangent_in = Some(huge);
+                    keys[1].tangent_out = Some(huge);
+                }
+                let track =
+                    RotationTrack::new(t.clone(), q.clone(), keys, &s).expect("finite tangents");
+                NamedTrack {
+                    name: format!("r{i}"),
+                    data: TrackData::Quat(track),
+                }
+            })
+            .collect();
+        let clip = tcb_core::Clip::new("huge", named).expect("unique track names");
+        let compiled = Arc::new(Clip::compile(&clip));
+        assert_eq!(compiled.group_count(), usize::from(tracks > 1));
+        for velocities in [false, true] {
+            let mut inst = Instance::new(compiled.clone());
+            if velocities {
+                inst = inst.with_velocities();
+            }
+            for time in [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0] {
+                let (mut got, mut want) = (vec![0.0f32; 4 * tracks], vec![0.0f32; 4 * tracks]);
+                inst.sample(time).write_row(&mut got, None);
+                clip.sample_into(time, &mut want, None);
+                for (g, w) in got.chunks(4).zip(want.chunks(4)) {
+                    assert!(w.iter().all(|x| x.is_finite()), "{w:?}");
+                    let close =
+                        |sign: f32| g.iter().zip(w).all(|(g, w)| (g * sign - w).abs() <= 1e-6);
+                    assert!(
+                        close(1.0) || close(-1.0),
+                        "{tracks} tracks at {time}: runtime {g:?}, reference {w:?}"
+                    );
+                }
+            }
+        }
     }
 }
 
