@@ -7,6 +7,7 @@
 //! | `wide` | 10,000 scalar channels on one key grid (61 keys), 60 fps over 2 s |
 //! | `sparse` | 500 scalar tracks, each with its own random key times |
 //! | `sparse-rotations` | 128 rotations (64 `hermite`, 64 `squad`), each with its own random key times |
+//! | `character-quantized` | `character-hermite` compiled with 16-bit controls |
 //! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
 //! | `character-reduced` | the CMU clip (hermite) reduced by `tcb reduce` at the default shell tolerance, as `character` |
 
@@ -236,6 +237,17 @@ pub fn character(bvh: &Path, rotation: RotationMode) -> Result<Scenario, tcb_io:
         // Catmull-Rom on the components is hermite with tcb 0 on even keys.
         s.peer = Some(SplinesPeer::new(&s.source));
     }
+    Ok(s)
+}
+
+/// `character-quantized`: `character-hermite` compiled with 16-bit
+/// controls (`CompileOptions::quantize`).
+pub fn character_quantized(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
+    let mut s = character(bvh, RotationMode::Hermite)?;
+    s.name = "character-quantized".into();
+    let options = tcb_runtime::CompileOptions { quantize: true };
+    s.clip = Arc::new(tcb_runtime::Clip::compile_with(&s.source, &options));
+    s.peer = None;
     Ok(s)
 }
 
@@ -477,9 +489,10 @@ pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
 }
 
 /// The scenario names, in report order.
-pub const NAMES: [&str; 8] = [
+pub const NAMES: [&str; 9] = [
     "character-hermite",
     "character-squad",
+    "character-quantized",
     "crowd",
     "wide",
     "sparse",
@@ -496,6 +509,7 @@ pub fn named(bvh: &Path, want: impl Fn(&str) -> bool) -> Result<Vec<Scenario>, t
         out.push(match name {
             "character-hermite" => character(bvh, RotationMode::Hermite)?,
             "character-squad" => character(bvh, RotationMode::Squad)?,
+            "character-quantized" => character_quantized(bvh)?,
             "crowd" => crowd(bvh)?,
             "wide" => wide(),
             "sparse" => sparse(),

@@ -228,22 +228,20 @@ pub(crate) fn sample_into(
     } = pose;
     for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
         let f = g.grid.frame(time, cursor);
-        let h = kernel::splat4(f.h);
-        let dh = kernel::splat4(f.dh);
-        let rate = f32x8::splat(f.rate);
+        let (h, dh, rate) = (f.h, f.dh, f.rate);
         let seg = f.segment;
         let (ka, kb) = crate::clip::key_pair(&g.grid, seg);
         let (cv, cq) = g.keys.segment(ka, kb, cache).split_at(g.vec_blocks);
         if g.vec_blocks > 0 {
             let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
-            kernel::vectors(cv, &h, out);
+            kernel::vectors(cv, h, out);
             if f.cycles != 0.0 && !g.delta.is_empty() {
                 kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
             }
             if let Some(v) = velocities.as_deref_mut() {
                 kernel::vector_velocities(
                     cv,
-                    &dh,
+                    dh,
                     rate,
                     &mut v[g.vec_out..g.vec_out + g.vec_blocks],
                 );
@@ -260,8 +258,8 @@ pub(crate) fn sample_into(
             } else {
                 kernel::hermite_quats(
                     cq,
-                    &h,
-                    &dh,
+                    h,
+                    dh,
                     rate,
                     &mut values[range.clone()],
                     velocities.as_deref_mut().map(|v| &mut v[range]),

@@ -22,8 +22,16 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
 /// Values of vector channels on segment `c` (one plane per block):
 /// `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula of
 /// [`tcb_core::basis::hermite`] itself.
+///
+/// The kernels take the frame's rows as numbers and splat them where their
+/// loop starts, so that nothing of 8 lanes is live between them (with the
+/// rows splatted once for all, an unrelated change to `sample_into` made
+/// `wide` 11% more instructions, reloading the rows from the stack in
+/// every block: SSE2 has 16 registers, and `h`, `dh` and `rate` as
+/// `f32x8` are 18 of them).
 #[inline]
-pub(crate) fn vectors(c: Segment, h: &[f32x8; 4], out: &mut [f32x8]) {
+pub(crate) fn vectors(c: Segment, h: [f32; 4], out: &mut [f32x8]) {
+    let h = &splat4(h);
     let keys = c.p0.iter().zip(c.p1).zip(c.m0).zip(c.m1);
     for ((((p0, p1), m0), m1), o) in keys.zip(out) {
         *o = hermite(h, *p0, *p1, *m0, *m1);
@@ -32,7 +40,8 @@ pub(crate) fn vectors(c: Segment, h: &[f32x8; 4], out: &mut [f32x8]) {
 
 /// Velocities of vector channels: `rate (dh . controls)`.
 #[inline]
-pub(crate) fn vector_velocities(c: Segment, dh: &[f32x8; 4], rate: f32x8, out: &mut [f32x8]) {
+pub(crate) fn vector_velocities(c: Segment, dh: [f32; 4], rate: f32, out: &mut [f32x8]) {
+    let (dh, rate) = (&splat4(dh), f32x8::splat(rate));
     let keys = c.p0.iter().zip(c.p1).zip(c.m0).zip(c.m1);
     for ((((p0, p1), m0), m1), o) in keys.zip(out) {
         *o = hermite(dh, *p0, *p1, *m0, *m1) * rate;
@@ -57,12 +66,14 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
 #[inline]
 pub(crate) fn hermite_quats(
     c: Segment,
-    h: &[f32x8; 4],
-    dh: &[f32x8; 4],
-    rate: f32x8,
+    h: [f32; 4],
+    dh: [f32; 4],
+    rate: f32,
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
+    let (rows, rows_d, rate_s) = (h, dh, rate);
+    let (h, dh, rate) = (&splat4(h), &splat4(dh), f32x8::splat(rate));
     let keys = quat_keys(c);
     let blocks = out.as_chunks_mut::<4>().0;
     let mut ok = f32x8::splat(f32::from_bits(u32::MAX));
@@ -81,7 +92,7 @@ pub(crate) fn hermite_quats(
         }
     }
     if ok.to_bitmask() != 0xff {
-        rescale_quats(c, h, dh, rate, out, vel);
+        rescale_quats(c, rows, rows_d, rate_s, out, vel);
     }
 }
 
@@ -140,12 +151,13 @@ fn hermite_quat_block(
 #[inline(never)]
 fn rescale_quats(
     c: Segment,
-    h: &[f32x8; 4],
-    dh: &[f32x8; 4],
-    rate: f32x8,
+    h: [f32; 4],
+    dh: [f32; 4],
+    rate: f32,
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
+    let (h, dh, rate) = (&splat4(h), &splat4(dh), f32x8::splat(rate));
     for (b, k) in quat_keys(c).enumerate() {
         let (p, dp) = quat_curve(k, h, vel.is_some().then_some((dh, rate)));
         if in_range(&p).to_bitmask() != 0xff {

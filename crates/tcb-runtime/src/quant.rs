@@ -108,27 +108,15 @@ impl Quantized {
         (q, error)
     }
 
-    /// Expand the `P` and `TO` sections starting at `at` into `out`
-    /// (`2 planes` vectors).
+    /// Expand the section (`planes` vectors) starting at `at` into `out`:
+    /// a `P` section, or with `tangent` a `TO` or `TI` one.
     #[inline]
-    pub fn expand(&self, at: usize, out: &mut [f32x8]) {
-        let src = &self.data[at..at + 2 * self.planes];
-        for (((o, q), lo), s) in out.iter_mut().zip(src).zip(&self.min).zip(&self.scale) {
-            *o = *lo + f32x8::from_i32x8(i32x8::from_u16x8(*q)) * *s;
-        }
-    }
-
-    /// Expand the `TI` section starting at `at` into `out` (`planes` vectors).
-    #[inline]
-    pub fn expand_ti(&self, at: usize, out: &mut [f32x8]) {
+    pub fn expand(&self, at: usize, tangent: bool, out: &mut [f32x8]) {
         let n = self.planes;
+        let r = usize::from(tangent) * n;
         let src = &self.data[at..at + n];
-        for (((o, q), lo), s) in out
-            .iter_mut()
-            .zip(src)
-            .zip(&self.min[n..])
-            .zip(&self.scale[n..])
-        {
+        let (min, scale) = (&self.min[r..r + n], &self.scale[r..r + n]);
+        for (((o, q), lo), s) in out.iter_mut().zip(src).zip(min).zip(scale) {
             *o = *lo + f32x8::from_i32x8(i32x8::from_u16x8(*q)) * *s;
         }
     }

@@ -158,49 +158,100 @@ impl KeyStore {
                     m1: &d[ib..ib + n],
                 }
             }
-            Data::Q16(q) => {
-                let mut slot_of = |k: usize, keep: usize| -> usize {
-                    if let Some(s) = cache.keys.iter().position(|&c| c == k) {
-                        return s;
-                    }
-                    let s = usize::from(cache.keys[0] == keep);
-                    let out = &mut cache.data[3 * n * s..3 * n * (s + 1)];
-                    let [p, i] = self.at[k];
-                    q.expand(p as usize, out);
-                    q.expand_ti(i as usize, &mut out[2 * n..]);
-                    cache.keys[s] = k;
-                    s
-                };
-                let sa = slot_of(a, b);
-                let sb = slot_of(b, a);
-                let d = &cache.data;
-                let (a, b) = (3 * n * sa, 3 * n * sb);
-                Segment {
-                    p0: &d[a..a + n],
-                    m0: &d[a + n..a + 2 * n],
-                    p1: &d[b..b + n],
-                    m1: &d[b + 2 * n..b + 3 * n],
-                }
-            }
+            Data::Q16(q) => self.expanded(q, a, b, cache),
+        }
+    }
+
+    /// [`segment`](Self::segment) of a quantized group. Only the sections the
+    /// segment reads are expanded: `P` and `TO` of its first key, `P` and
+    /// `TI` (`TO`'s where shared) of its second; a key read again keeps what
+    /// it has.
+    #[inline(always)]
+    fn expanded<'a>(
+        &self,
+        q: &Quantized,
+        a: usize,
+        b: usize,
+        cache: &'a mut KeyCache,
+    ) -> Segment<'a> {
+        let n = self.planes;
+        let sa = cache.slot(a, b);
+        let sb = cache.slot(b, a);
+        let ([pa, _], [pb, ib]) = (self.at[a], self.at[b]);
+        let (pa, pb, ib) = (pa as usize, pb as usize, ib as usize);
+        let ti = if ib == pb + n { TO } else { TI };
+        cache.ensure(q, sa, P, pa);
+        cache.ensure(q, sa, TO, pa + n);
+        cache.ensure(q, sb, P, pb);
+        cache.ensure(q, sb, ti, ib);
+        Segment {
+            p0: cache.section(sa, P, n),
+            m0: cache.section(sa, TO, n),
+            p1: cache.section(sb, P, n),
+            m1: cache.section(sb, ti, n),
         }
     }
 
     /// A cache for [`segment`](Self::segment), per instance.
     pub fn cache(&self) -> KeyCache {
-        let n = if self.quantized() { 3 * self.planes } else { 0 };
+        let n = if self.quantized() { self.planes } else { 0 };
         KeyCache {
             keys: [usize::MAX; 2],
-            data: vec![f32x8::ZERO; 2 * n],
+            valid: [0; 2],
+            planes: n,
+            data: vec![f32x8::ZERO; 2 * 3 * n],
         }
     }
 }
 
 /// Two expanded keys of a quantized group (forward playback reuses the
-/// previous frame's second key as this one's first), `[P TO TI]` each.
+/// previous frame's second key as this one's first), `[P TO TI]` each,
+/// each section expanded when a segment first reads it.
 #[derive(Clone, Debug)]
 pub(crate) struct KeyCache {
     keys: [usize; 2],
+    /// Per slot, the sections expanded (bit `P`, `TO`, `TI`).
+    valid: [u8; 2],
+    planes: usize,
     data: Vec<f32x8>,
+}
+
+/// Sections of a key: `P`, `TO`, `TI`.
+const P: usize = 0;
+const TO: usize = 1;
+const TI: usize = 2;
+
+impl KeyCache {
+    /// The slot holding key `k`, or a slot given to it (not the one
+    /// holding `keep`, the other key of the segment), emptied.
+    #[inline(always)]
+    fn slot(&mut self, k: usize, keep: usize) -> usize {
+        if let Some(s) = self.keys.iter().position(|&c| c == k) {
+            return s;
+        }
+        let s = usize::from(self.keys[0] == keep);
+        self.keys[s] = k;
+        self.valid[s] = 0;
+        s
+    }
+
+    /// Expand section `j` of slot `s` from the quantized numbers at `at`,
+    /// unless it is there.
+    #[inline(always)]
+    fn ensure(&mut self, q: &Quantized, s: usize, j: usize, at: usize) {
+        if self.valid[s] & (1 << j) == 0 {
+            let n = self.planes;
+            let start = (3 * s + j) * n;
+            q.expand(at, j != P, &mut self.data[start..start + n]);
+            self.valid[s] |= 1 << j;
+        }
+    }
+
+    #[inline(always)]
+    fn section(&self, s: usize, j: usize, n: usize) -> &[f32x8] {
+        let start = (3 * s + j) * n;
+        &self.data[start..start + n]
+    }
 }
 
 fn bits(x: f32x8) -> [u32; 8] {
