@@ -49,8 +49,8 @@ pub fn locate(times: &[f64], time: f64) -> (usize, f64) {
 /// Segment `k` with `times[k] <= time < times[k+1]`, clamped to
 /// `0..=n-2` (times before the first key and NaN give 0, times from the
 /// last key on give n-2), for `times` with at least 2 strictly increasing
-/// entries. Segment `hint` is tried first, then later ones at offsets 1,
-/// 2, 4, ... from it, so forward playback finds its segment in O(1) and a
+/// entries. Segment `hint` is tried first, then the two after it, then
+/// later ones at offsets 1, 2, 4, ... from it, so forward playback finds its segment in O(1) and a
 /// jump of d keys forward in O(log d); going back is a binary search.
 /// The one segment search of the reference and the runtime.
 ///
@@ -68,6 +68,16 @@ pub fn segment_from(times: &[f64], time: f64, hint: usize) -> usize {
     if times[k] <= time {
         if time < times[k + 1] {
             return k;
+        }
+        // The next two segments, one compare each: capture at 120 fps
+        // played at 60 moves two keys a frame.
+        for s in k + 1..k + 3 {
+            if s > last {
+                return last;
+            }
+            if time < times[s + 1] {
+                return s;
+            }
         }
         // Gallop forward from the hint (offsets 1, 2, 4, ...), then search
         // between the last two probes: a cursor that moves several keys per
