@@ -82,6 +82,33 @@ fn config(cases: u32) -> ProptestConfig {
 proptest! {
     #![proptest_config(config(200))]
 
+    /// Keys clustered over 15 orders of magnitude, spans that overflow
+    /// f64 when subtracted: the seek's guess (evenly spaced keys) lands
+    /// far off, or nowhere, and the search still finds the segment.
+    #[test]
+    fn segment_search_with_uneven_keys_is_the_binary_search(
+        n in 2..70usize,
+        exps in prop::collection::vec(-9.0..6.0f64, 70),
+        start in prop::sample::select(vec![0.0, -1e300, 1e290, -5.0]),
+        scale in prop::sample::select(vec![1.0, 1e295]),
+        hint in 0..80usize,
+        probe in 0.0..1.0f64,
+    ) {
+        let mut times = vec![start];
+        for e in &exps[..n - 1] {
+            let next = times[times.len() - 1] + 10f64.powf(*e) * scale;
+            prop_assume!(next.is_finite() && next > times[times.len() - 1]);
+            times.push(next);
+        }
+        let (t0, tn) = (times[0], times[n - 1]);
+        let mut probes: Vec<f64> = times.clone();
+        probes.extend([t0 + probe * (tn - t0), t0 * (1.0 - probe) + tn * probe, -f64::MAX, f64::MAX]);
+        for t in probes {
+            let plain = times.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2);
+            prop_assert_eq!(tcb_core::track::segment_from(&times, t, hint), plain, "time {}", t);
+        }
+    }
+
     #[test]
     fn segment_search_from_any_hint_is_the_binary_search(
         n in 2..70usize,
