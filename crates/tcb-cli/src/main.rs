@@ -525,6 +525,14 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         args.output.display(),
         started.elapsed().as_secs_f64()
     );
+    if reduced.after.bytes > reduced.before.bytes {
+        eprintln!(
+            "tcb: note: the reduced clip compiles to more bytes than the input ({} against {}): \
+             tracks on key times of their own play as loose lanes, which hold more per key \
+             than a key grid the tracks share (--knots clip keeps one grid)",
+            reduced.after.bytes, reduced.before.bytes
+        );
+    }
     println!("{}", reduced.summary_line());
     Ok(())
 }

@@ -88,6 +88,7 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     assert_eq!(k0, 32.0 * 240.0);
     assert!(k1 < k0 && v1 < v0 && b1 < b0, "{stdout}");
     assert!(e <= 0.05, "{stdout}");
+    assert!(!stderr(&o).contains("note:"), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("metric shell, tolerance 5e-2"),
         "{}",
@@ -105,6 +106,28 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
         let o = tcb(&args);
         assert!(o.status.success(), "{args:?}: {}", stderr(&o));
     }
+}
+
+/// At the default tolerance the jittery capture keeps most keys, and its
+/// tracks split into a shared grid and loose lanes: the result compiles to
+/// more bytes than the input, and `tcb reduce` says so (on stderr; the
+/// summary line is the contract's).
+#[test]
+fn a_reduction_that_compiles_larger_says_so() {
+    let input = short_cmu(240);
+    let out = dir().join("short-default.json");
+    let o = tcb(&[
+        "reduce",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
+    assert!(b1 > b0, "{stdout}");
+    let note = format!("compiles to more bytes than the input ({b1} against {b0})");
+    assert!(stderr(&o).contains(&note), "{}", stderr(&o));
 }
 
 /// `tcb sample --at` of `clip` at `times`: one row of numbers per time.
