@@ -616,8 +616,8 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     for (i, g) in stats.grids.iter().enumerate() {
         writeln!(
             out,
-            "  grid {i}: {} keys, {} vector channels, {} rotations",
-            g.keys, g.vector_channels, g.rotations
+            "  grid {i}: {} keys ({} with incoming tangents stored apart), {} vector channels, {} rotations",
+            g.keys, g.keys_with_own_incoming, g.vector_channels, g.rotations
         )?;
     }
     writeln!(

@@ -88,6 +88,9 @@ pub struct GridStats {
     pub vector_channels: usize,
     /// Rotations on it (any mode).
     pub rotations: usize,
+    /// Keys whose incoming tangents are stored apart from their outgoing
+    /// ones (in some bit of some channel they differ); the others store one.
+    pub keys_with_own_incoming: usize,
 }
 
 /// The layout and size of a compiled clip (see [`Clip::stats`]).
@@ -1071,6 +1074,7 @@ impl Clip {
                 .groups
                 .iter()
                 .map(|g| GridStats {
+                    keys_with_own_incoming: g.keys.own_ti(g.grid.keys()),
                     keys: g.grid.keys(),
                     vector_channels: g.lanes[0],
                     rotations: g.lanes[1],

@@ -121,6 +121,16 @@ impl KeyStore {
         (store, Some(error))
     }
 
+    /// Of the first `keys` keys, those whose `TI` is stored apart.
+    pub fn own_ti(&self, keys: usize) -> usize {
+        let n = self.planes as u32;
+        self.at
+            .iter()
+            .take(keys)
+            .filter(|[p, i]| *i != p + n)
+            .count()
+    }
+
     /// Planes per section.
     pub fn planes(&self) -> usize {
         self.planes
@@ -283,6 +293,7 @@ mod tests {
         assert!(err.is_none());
         // Keys 0 and 2: P TO TI; key 1: P TO.
         assert_eq!(store.heap_bytes(), 2 * 32 * (3 + 2 + 3) + 3 * 8);
+        assert_eq!((store.own_ti(3), store.own_ti(2)), (2, 1));
         let mut cache = store.cache();
         for (a, b) in [(0, 1), (1, 2), (2, 0), (1, 1)] {
             let s = store.segment(a, b, &mut cache);
