@@ -376,7 +376,11 @@ impl RotationTrack {
                 (q, d * rate)
             }
             (_, Shape::Hermite(track)) => {
-                let (p, dp) = track.sample_with_velocity(time);
+                // The time is already mapped into the keys: evaluate the
+                // curve there, rather than through `sample_with_velocity`,
+                // which would map it again (a time that rounding left a hair
+                // past the last key would wrap to the first under `repeat`).
+                let (p, dp) = track.evaluate(time);
                 let (p, dp) = (p.as_dvec4(), dp.as_dvec4());
                 if p.length() == 0.0 {
                     return (self.keys[k], DVec4::ZERO);
@@ -452,6 +456,56 @@ fn squad_segments(
 mod tests {
     use super::*;
     use crate::params::Tcb;
+
+    /// `repeat` maps 1.36e138 to `t0 + r`, which rounding leaves a hair past
+    /// the last key (-0.5781249989999999 against -0.578124999). A `hermite`
+    /// rotation evaluated its curve through `Track::sample_with_velocity`,
+    /// which mapped that time again and wrapped it to the first key; the
+    /// runtime (one mapping, `u` clamped) gave the last key (found by the
+    /// `runtime` fuzz target).
+    #[test]
+    fn a_time_mapped_past_the_last_key_is_not_mapped_again() {
+        let times = vec![
+            -3.625,
+            -3.0703125,
+            -2.34375,
+            -1.8671875,
+            -0.578125,
+            -0.578124999,
+        ];
+        let q = [
+            [7.0686035, 1.5070801, 2.8857422, 3.9448242],
+            [1.590332, 1.4650879, -2.5888672, -6.1728516],
+            [6.0126953, 2.011963, 2.239746, -2.4262695],
+            [-2.7609863; 4],
+            [-2.7609863; 4],
+            [-2.7609863, 3.9890137, -4.284912, 1.1933594],
+        ]
+        .map(|v| Quat::from_array(v).normalize());
+        let settings = TrackSettings {
+            rotation: RotationMode::Hermite,
+            post: crate::Extrapolation::Repeat,
+            ..TrackSettings::default()
+        };
+        let track = RotationTrack::new(times, q.to_vec(), Vec::new(), &settings).unwrap();
+        let t = 1.3599676637654653e138;
+        let mapped = match crate::extrapolate::map_time(
+            t,
+            -3.625,
+            -0.578124999,
+            settings.pre,
+            settings.post,
+        ) {
+            crate::extrapolate::Mapped::Inside { time, .. } => time,
+            other => panic!("{other:?}"),
+        };
+        assert!(mapped > -0.578124999, "{mapped}");
+        let (got, last) = (track.sample(t), track.sample(-0.578124999));
+        assert!(
+            got.abs_diff_eq(last, 1e-6) || got.abs_diff_eq(-last, 1e-6),
+            "{got:?} against {last:?}"
+        );
+    }
 
     fn close_f32(a: Quat, b: Quat) -> bool {
         close(a.as_dquat(), b.as_dquat(), 1e-6)

@@ -404,8 +404,9 @@ impl<V: Value> Track<V> {
         }
     }
 
-    /// Value and velocity at a time inside the keys.
-    fn evaluate(&self, time: f64) -> (V, V) {
+    /// Value and velocity at a time inside the keys (`u` clamped to the
+    /// segment where rounding left it a hair outside).
+    pub(crate) fn evaluate(&self, time: f64) -> (V, V) {
         let (k, u) = locate(&self.times, time);
         let seg = &self.segments[k];
         // A `step` segment stays P_k (math.md) exactly, at rate 0: as the
