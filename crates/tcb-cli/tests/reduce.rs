@@ -41,7 +41,11 @@ fn short_cmu(frames: usize) -> PathBuf {
         "{head}MOTION\nFrames: {frames}\n{frame_time}\n{}\n",
         rows.join("\n")
     );
-    let path = dir().join(format!("cmu-{frames}.bvh"));
+    // A file per call: tests run in parallel, and two rewriting one path
+    // could hand a `tcb` child a file being truncated.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = dir().join(format!("cmu-{frames}-{n}.bvh"));
     std::fs::write(&path, out).unwrap();
     path
 }

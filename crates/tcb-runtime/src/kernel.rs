@@ -66,14 +66,13 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
 #[inline]
 pub(crate) fn hermite_quats(
     c: Segment,
-    h: [f32; 4],
-    dh: [f32; 4],
-    rate: f32,
+    rows: [f32; 4],
+    rows_d: [f32; 4],
+    rate_s: f32,
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
-    let (rows, rows_d, rate_s) = (h, dh, rate);
-    let (h, dh, rate) = (&splat4(h), &splat4(dh), f32x8::splat(rate));
+    let (h, dh, rate) = (&splat4(rows), &splat4(rows_d), f32x8::splat(rate_s));
     let keys = quat_keys(c);
     let blocks = out.as_chunks_mut::<4>().0;
     let mut ok = f32x8::splat(f32::from_bits(u32::MAX));

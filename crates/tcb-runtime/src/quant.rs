@@ -72,9 +72,8 @@ impl Quantized {
                 })));
             }
         }
-        let data: Vec<u16x8> = packed.iter().map(|_| u16x8::ZERO).collect();
         let mut q = Quantized {
-            data,
+            data: vec![u16x8::ZERO; packed.len()],
             min,
             scale,
             planes,

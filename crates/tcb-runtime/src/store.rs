@@ -94,12 +94,12 @@ impl KeyStore {
             let start = data.len();
             data.extend((0..planes).map(|p| control(k, 0, p)));
             data.extend((0..planes).map(|p| control(k, 1, p)));
-            let ti: Vec<f32x8> = (0..planes).map(|p| control(k, 2, p)).collect();
-            let to = &data[start + planes..];
+            data.extend((0..planes).map(|p| control(k, 2, p)));
+            let (to, ti) = data[start + planes..].split_at(planes);
             let ti_at = if ti.iter().zip(to).all(|(i, o)| bits(*i) == bits(*o)) {
+                data.truncate(start + 2 * planes);
                 start + planes
             } else {
-                data.extend(ti);
                 start + 2 * planes
             };
             at.push([offset(start), offset(ti_at)]);
