@@ -112,12 +112,15 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     }
 }
 
-/// At the default tolerance the jittery capture keeps most keys, and its
-/// tracks split into a shared grid and loose lanes: the result compiles to
-/// more bytes than the input, and `tcb reduce` says so (on stderr; the
-/// summary line is the contract's).
+/// At the default tolerance the jittery capture keeps most keys. Fitted
+/// onto key times of their own, such tracks play as loose lanes, which hold
+/// about twice the bytes per key of the shared grid: before `tcb reduce`
+/// put those tracks back on the input's grid, this clip compiled to more
+/// bytes than its input (`bytes 314901 -> 326161` for a file of
+/// these 240 frames; now `314901 -> 275069`). Now it compiles to fewer, and
+/// no note is printed.
 #[test]
-fn a_reduction_that_compiles_larger_says_so() {
+fn a_reduction_keeping_most_keys_stays_on_the_grid() {
     let input = short_cmu(240);
     let out = dir().join("short-default.json");
     let o = tcb(&[
@@ -129,9 +132,8 @@ fn a_reduction_that_compiles_larger_says_so() {
     assert!(o.status.success(), "{}", stderr(&o));
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
     let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
-    assert!(b1 > b0, "{stdout}");
-    let note = format!("compiles to more bytes than the input ({b1} against {b0})");
-    assert!(stderr(&o).contains(&note), "{}", stderr(&o));
+    assert!(b1 < b0, "{stdout}");
+    assert!(!stderr(&o).contains("more bytes"), "{}", stderr(&o));
 }
 
 /// `tcb sample --at` of `clip` at `times`: one row of numbers per time.

@@ -25,6 +25,10 @@
 //!    move a joint over the tolerance by r get κ / (1.05 r)^0.5 and are
 //!    refitted; the others keep their fit. Only a clip that holds is
 //!    returned.
+//! 5. Bytes: fits that keep most of their keys (a loose lane stores about
+//!    twice a shared grid's bytes per key) are put back on the input's
+//!    keys, those keeping the largest share first, where the compiled clip
+//!    gets smaller and still holds.
 //!
 //! Tracks the fitter does not take are kept as they are (exact): tracks
 //! whose `linear` or `offset-repeat` extrapolation is checked outside their
@@ -309,6 +313,12 @@ const STEP: f64 = 0.5;
 /// Below this budget scale a group is kept as it is.
 const MIN_SCALE: f64 = 1.0 / 64.0;
 
+/// Fits keeping fewer than this share of their track's keys are never put
+/// back for bytes: a loose lane holds at most about 3.5 times a grid
+/// lane's bytes per key (a scalar: time, order entry, `P TO TI`, against
+/// `P TO`).
+const MIN_SHARE: f64 = 0.25;
+
 /// Reduce `input`. `progress(done, total)` is called as groups of tracks are
 /// fitted (from several threads).
 pub fn reduce(
@@ -400,8 +410,9 @@ pub fn reduce(
     let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let mut attempts = Vec::new();
     let mut round = 0;
+    let no_revert = vec![false; input.doc.tracks.len()];
     let (doc, clip, compiled, worst, kept) = loop {
-        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress);
+        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress, &no_revert);
         let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
         let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
         let measured = verify(&compiled);
@@ -435,6 +446,59 @@ pub fn reduce(
                 };
             }
         }
+    };
+    // Bytes: a fitted track on key times of its own plays as a loose lane,
+    // which holds about twice the bytes per key of a key grid that tracks
+    // share. A fit that keeps most of its keys can so make the clip larger
+    // than keeping the original keys on the input's grid. The fits that
+    // keep the largest share of their keys are put back (exact) in prefixes
+    // of 1, 2, 4, ... tracks; the prefix whose compiled clip is smallest is
+    // taken if it is smaller than the fitted clip and still holds.
+    let mut candidates: Vec<(f64, usize)> = (0..kept.len())
+        .filter(|&i| !kept[i])
+        .map(|i| {
+            let share = doc.tracks[i].times.len() as f64 / input.doc.tracks[i].times.len() as f64;
+            (share, i)
+        })
+        .filter(|&(share, _)| share >= MIN_SHARE)
+        .collect();
+    candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut best: Option<(usize, usize)> = None;
+    let mut size = 1;
+    while size <= candidates.len() {
+        let mut revert = no_revert.clone();
+        for &(_, i) in &candidates[..size] {
+            revert[i] = true;
+        }
+        let (d, _, _) = plan.run(&scale, &mut cache, progress, &revert);
+        let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
+        let bytes = tcb_runtime::Clip::compile(&c).memory_bytes();
+        if bytes < best.map_or(compiled.memory_bytes(), |b| b.1) {
+            best = Some((size, bytes));
+        }
+        size = if size == candidates.len() {
+            size + 1
+        } else {
+            (2 * size).min(candidates.len())
+        };
+    }
+    let (doc, clip, compiled, worst, kept) = match best {
+        Some((size, _)) => {
+            let mut revert = no_revert.clone();
+            for &(_, i) in &candidates[..size] {
+                revert[i] = true;
+            }
+            let (d, k, _) = plan.run(&scale, &mut cache, progress, &revert);
+            let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
+            let cc = Arc::new(tcb_runtime::Clip::compile(&c));
+            let measured = verify(&cc);
+            if measured.worst.ratio <= 1.0 {
+                (d, c, cc, measured.worst, k)
+            } else {
+                (doc, clip, compiled, worst, kept)
+            }
+        }
+        None => (doc, clip, compiled, worst, kept),
     };
     let after = counts(&doc, &compiled);
     let kept = (0..kept.len())
@@ -595,6 +659,7 @@ impl<'a> Plan<'a> {
         scales: &[f64],
         cache: &mut [Option<(f64, Option<Fit>)>],
         progress: &(dyn Fn(usize, usize) + Sync),
+        revert: &[bool],
     ) -> (ClipDoc, Vec<bool>, usize) {
         let done = AtomicUsize::new(0);
         let todo: Vec<usize> = (0..self.groups.len())
@@ -622,7 +687,7 @@ impl<'a> Plan<'a> {
         for (g, c) in self.groups.iter().zip(cache.iter()) {
             if let Some((_, Some(f))) = c {
                 for (s, &i) in g.iter().enumerate() {
-                    fitted[i] = Some((f, s));
+                    fitted[i] = (!revert[i]).then_some((f, s));
                 }
             }
         }
