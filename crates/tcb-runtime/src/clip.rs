@@ -134,25 +134,37 @@ pub(crate) struct Group {
     pub exact_at: Vec<u32>,
     /// Rotation blocks evaluated exactly (squad in f64) on some segment.
     pub exact: Vec<Exact>,
+    /// The squad controls `exact` entries read (`Exact::controls`): the
+    /// pieces of a split segment share their segment's.
+    pub exact_controls: Vec<[f64x4; 2 * SQ_STRIDE]>,
 }
 
 /// One rotation block on one stored segment, evaluated exactly: the lanes
-/// of `mask` take squad in f64 from `controls` (two halves of 4 lanes; the
-/// other lanes hold the identity and are not used). The lanes of
-/// `value_mask` are those whose cubic misses the values; the others miss
-/// only the velocities, so an instance without velocities leaves them to
-/// the cubic (and skips entries whose `value_mask` is empty).
+/// of `mask` take squad in f64 from `Group::exact_controls[controls]` (two
+/// halves of 4 lanes; the other lanes hold the identity and are not used).
+/// The lanes of `value_mask` are those whose cubic misses the values; the
+/// others miss only the velocities, so an instance without velocities
+/// leaves them to the cubic (and skips entries whose `value_mask` is
+/// empty). `piece` (`[a, w]`) places the stored segment in the squad
+/// segment, `s = a + w u`: `[0, 1]` but for a piece of a split segment
+/// (`split_rotation`, which splits only the rotation of a group of one, so
+/// one `piece` serves the block).
 #[derive(Clone, Debug)]
 pub(crate) struct Exact {
-    pub block: usize,
     pub mask: f32x8,
     pub value_mask: f32x8,
+    pub piece: [f64; 2],
+    pub block: u32,
+    pub controls: u32,
     pub values: bool,
-    pub controls: [f64x4; 2 * SQ_STRIDE],
 }
 
-/// The exact entries of one group's rotations, per stored segment.
-fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>, Vec<Exact>) {
+/// The exact entries of one group's rotations, per stored segment: offsets
+/// per stored segment, the entries, and the squad controls they read.
+fn exact_table(
+    rows: &[(usize, RotationControls)],
+    segments: usize,
+) -> (Vec<u32>, Vec<Exact>, Vec<[f64x4; 2 * SQ_STRIDE]>) {
     let identity = {
         let mut c = [0.0; SQ_STRIDE];
         c[3] = 1.0;
@@ -161,6 +173,7 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
     };
     let mut at = Vec::with_capacity(segments + 1);
     let mut out = Vec::new();
+    let mut pool: Vec<[f64x4; 2 * SQ_STRIDE]> = Vec::new();
     for seg in 0..segments {
         at.push(out.len() as u32);
         for (b, block) in rows.chunks(8).enumerate() {
@@ -176,18 +189,34 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
             };
             let mask = mask_of(&|l| lane(l).is_some());
             let value_mask = mask_of(&values);
-            let controls = std::array::from_fn(|k| {
+            let controls: [f64x4; 2 * SQ_STRIDE] = std::array::from_fn(|k| {
                 let (half, j) = (k / SQ_STRIDE, k % SQ_STRIDE);
                 f64x4::new(std::array::from_fn(|l| {
                     lane(4 * half + l).unwrap_or(identity)[j]
                 }))
             });
+            let same = |a: &[f64x4; 2 * SQ_STRIDE]| {
+                (0..2 * SQ_STRIDE).all(|k| a[k].to_array() == controls[k].to_array())
+            };
+            if !pool.last().is_some_and(same) {
+                pool.push(controls);
+            }
+            let pieces: Vec<[f64; 2]> = block
+                .iter()
+                .filter(|r| r.1.exact[seg].is_some())
+                .map(|r| r.1.piece[seg])
+                .collect();
+            debug_assert!(
+                pieces.iter().all(|p| *p == pieces[0]),
+                "one piece per block"
+            );
             out.push(Exact {
-                block: b,
                 mask,
                 value_mask,
+                piece: pieces[0],
+                block: u32::try_from(b).expect("fewer than 2^32 blocks"),
+                controls: u32::try_from(pool.len() - 1).expect("fewer than 2^32 entries"),
                 values: value_mask.any(),
-                controls,
             });
         }
     }
@@ -195,7 +224,7 @@ fn exact_table(rows: &[(usize, RotationControls)], segments: usize) -> (Vec<u32>
     if out.is_empty() {
         at = Vec::new(); // nothing exact: no table to keep
     }
-    (at, out)
+    (at, out, pool)
 }
 
 /// A compiled clip: immutable, `Send + Sync`, shared between instances by `Arc`.
@@ -387,12 +416,16 @@ pub(crate) fn key_pair(grid: &TimeGrid, seg: usize) -> (usize, usize) {
 /// A rotation's hermite controls per component over the stored segments
 /// `0..=n`, and per stored segment the exact squad controls where the cubic
 /// misses the reference (`None` where it holds).
+#[derive(Clone)]
 struct RotationControls {
     comps: Vec<Controls>,
     exact: Vec<Option<[f64; SQ_STRIDE]>>,
     /// Per stored segment: its cubic holds the values, and misses only
     /// the velocities (meaningful where `exact` is set).
     velocity_only: Vec<bool>,
+    /// Per stored segment `[a, w]`: it is `s` in `[a, a + w]` of the squad
+    /// segment `exact` holds (`[0, 1]` but for pieces of a split segment).
+    piece: Vec<[f64; 2]>,
 }
 
 /// Largest rotation component error the compiled cubic may have (the
@@ -472,6 +505,7 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
         comps,
         exact,
         velocity_only,
+        piece: vec![[0.0, 1.0]; n + 1],
     }
 }
 
@@ -601,80 +635,110 @@ fn cubic_holds(
     holds
 }
 
-/// A rotation on key times of its own whose segments the cubic misses
-/// (`exact`), as a lane of its own: each such segment split into 2, 4, 8 or
-/// 16 equal pieces, each the cubic through squad's values and derivatives at
-/// its ends, the fewest that pass [`cubic_holds`]. The keys of the result are
-/// the track's own plus the split points, so nothing is evaluated in f64 per
-/// frame. `None` where that cannot be done: an eased or step segment among
-/// them, a segment too short to split, or 16 pieces still missing.
-fn split_rotation(grid: &TimeGrid, rot: &RotationControls) -> Option<(TimeGrid, Vec<Controls>)> {
+/// A rotation whose segments the cubic misses (`exact`), split: each such
+/// segment becomes 2, 4, 8 or 16 equal pieces, each the cubic through
+/// squad's values and derivatives at its ends, the fewest that pass
+/// [`cubic_holds`]. The keys of the result are the track's own plus the
+/// split points. Segments that cannot be split stay as they were, exact: an
+/// eased or step segment, one too short to split, or one where 16 pieces
+/// still miss.
+///
+/// For a loose lane (`on_group` false), pieces must hold values and
+/// velocities, and a result with no exact segment left needs no f64 per
+/// frame. On a group (`on_group` true), pieces need only hold the values:
+/// they keep the segment's squad for velocities (`piece` says where they
+/// lie in it), so an instance that samples velocities gets them in f64 as
+/// before and one that does not plays cubics; segments whose cubic misses
+/// only the velocities stay as they are.
+fn split_rotation(
+    grid: &TimeGrid,
+    rot: &RotationControls,
+    on_group: bool,
+) -> (TimeGrid, RotationControls) {
     let n = grid.times.len();
     let mut times = vec![grid.times[0]];
     let (mut eases, mut steps) = (Vec::new(), Vec::new());
-    let mut comps: Vec<Controls> = rot.comps.iter().map(|c| vec![c[0]]).collect();
+    let mut out = RotationControls {
+        comps: rot.comps.iter().map(|c| vec![c[0]]).collect(),
+        exact: vec![None],
+        velocity_only: vec![false],
+        piece: vec![[0.0, 1.0]],
+    };
+    let push = |out: &mut RotationControls, ctl: [[f32; 4]; 4], exact, velocity_only, piece| {
+        for (c, ctl) in out.comps.iter_mut().zip(ctl) {
+            c.push(ctl);
+        }
+        out.exact.push(exact);
+        out.velocity_only.push(velocity_only);
+        out.piece.push(piece);
+    };
     for k in 0..n - 1 {
         let (t0, t1) = (grid.times[k], grid.times[k + 1]);
-        let Some(c) = &rot.exact[k + 1] else {
+        let pieces = rot.exact[k + 1]
+            .filter(|_| grid.ease(k).is_none() && !grid.is_step(k))
+            .filter(|_| !(on_group && rot.velocity_only[k + 1]))
+            .and_then(|c| {
+                [2usize, 4, 8, 16].into_iter().find_map(|m| {
+                    let w = 1.0 / m as f64;
+                    // Split times strictly increasing (not so in f64 on
+                    // keys a few ulps apart).
+                    let at = |j: usize| t0 + (t1 - t0) * (j as f64 * w);
+                    if (1..m).any(|j| at(j) <= at(j - 1)) || at(m - 1) >= t1 {
+                        return None;
+                    }
+                    (0..m)
+                        .map(|j| {
+                            let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
+                            let (qa, da) = tcb_core::squad::squad_with_derivative(&c, a);
+                            let (qb, db) = tcb_core::squad::squad_with_derivative(&c, b);
+                            let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
+                                // The segment's own ends stay its keys.
+                                let p0 = if j == 0 {
+                                    rot.comps[i][k + 1][0]
+                                } else {
+                                    qa[i] as f32
+                                };
+                                let p1 = if j + 1 == m {
+                                    rot.comps[i][k + 1][1]
+                                } else {
+                                    qb[i] as f32
+                                };
+                                [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
+                            });
+                            let holds = cubic_holds(&c, &ctl, 2.0 / (w * (t1 - t0)), (a, b));
+                            let enough = if on_group { holds.values } else { holds.both() };
+                            enough.then_some((ctl, [a, w], holds.both()))
+                        })
+                        .collect::<Option<Vec<_>>>()
+                })
+            });
+        let Some(pieces) = pieces else {
             times.push(t1);
             eases.push(grid.ease(k));
             steps.push(grid.is_step(k));
-            for (out, c) in comps.iter_mut().zip(&rot.comps) {
-                out.push(c[k + 1]);
-            }
+            let ctl = std::array::from_fn(|i| rot.comps[i][k + 1]);
+            let (exact, vo) = (rot.exact[k + 1], rot.velocity_only[k + 1]);
+            push(&mut out, ctl, exact, vo, rot.piece[k + 1]);
             continue;
         };
-        if !grid.ease(k).is_none() || grid.is_step(k) {
-            return None;
-        }
-        let pieces = [2usize, 4, 8, 16].into_iter().find_map(|m| {
-            let w = 1.0 / m as f64;
-            (0..m)
-                .map(|j| {
-                    let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
-                    let (qa, da) = tcb_core::squad::squad_with_derivative(c, a);
-                    let (qb, db) = tcb_core::squad::squad_with_derivative(c, b);
-                    let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
-                        // The segment's own ends stay its keys.
-                        let p0 = if j == 0 {
-                            rot.comps[i][k + 1][0]
-                        } else {
-                            qa[i] as f32
-                        };
-                        let p1 = if j + 1 == m {
-                            rot.comps[i][k + 1][1]
-                        } else {
-                            qb[i] as f32
-                        };
-                        [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
-                    });
-                    cubic_holds(c, &ctl, 2.0 / (w * (t1 - t0)), (a, b))
-                        .both()
-                        .then_some(ctl)
-                })
-                .collect::<Option<Vec<_>>>()
-        })?;
-        let m = pieces.len();
-        for (j, ctl) in pieces.iter().enumerate() {
-            let t = if j + 1 == m {
+        let (m, c) = (pieces.len(), rot.exact[k + 1]);
+        for (j, (ctl, piece, both)) in pieces.into_iter().enumerate() {
+            times.push(if j + 1 == m {
                 t1
             } else {
                 t0 + (t1 - t0) * ((j + 1) as f64 / m as f64)
-            };
-            if t <= times[times.len() - 1] {
-                return None;
-            }
-            times.push(t);
+            });
             eases.push(SegmentEase::default());
             steps.push(false);
-            for (out, ctl) in comps.iter_mut().zip(ctl) {
-                out.push(*ctl);
-            }
+            // On a group, squad gives the velocities, as it did for the
+            // whole segment (the cubic's, within 5e-5 of the speed, may be
+            // 1e-5 off, which `tcb sample --velocity` is checked to).
+            let exact = if on_group || !both { c } else { None };
+            push(&mut out, ctl, exact, exact.is_some(), piece);
         }
     }
-    for (out, c) in comps.iter_mut().zip(&rot.comps) {
-        out.push(c[n]);
-    }
+    let ctl = std::array::from_fn(|i| rot.comps[i][n]);
+    push(&mut out, ctl, None, false, [0.0, 1.0]);
     let grid = TimeGrid {
         times,
         eases,
@@ -682,7 +746,7 @@ fn split_rotation(grid: &TimeGrid, rot: &RotationControls) -> Option<(TimeGrid, 
         pre: grid.pre,
         post: grid.post,
     };
-    Some((grid.compact(), comps))
+    (grid.compact(), out)
 }
 
 /// Lay per-lane control rows into blocks of `N` lanes (`f32x8`: 8,
@@ -798,22 +862,33 @@ impl Clip {
             // as the cubic pieces of `split_rotation`, or stays too.
             let resets = [grids[g].pre, grids[g].post].contains(&Extrapolation::Reset);
             if vec_rows[g].is_empty() && !hq_rows[g].is_empty() && hq_rows[g].len() < 8 && !resets {
-                let lanes: Option<Vec<(usize, LooseLane)>> = hq_rows[g]
+                let split: Vec<(TimeGrid, RotationControls)> = hq_rows[g]
                     .iter()
-                    .map(|(track, rot)| {
-                        let (grid, comps) = if rot.exact.iter().all(Option::is_none) {
-                            (grids[g].clone(), rot.comps.clone())
+                    .map(|(_, rot)| {
+                        if rot.exact.iter().all(Option::is_none) {
+                            (grids[g].clone(), rot.clone())
                         } else {
-                            split_rotation(&grids[g], rot)?
-                        };
-                        let comps: Vec<&Controls> = comps.iter().collect();
-                        Some((*track, LooseLane::new(grid, &comps)))
+                            split_rotation(&grids[g], rot, false)
+                        }
                     })
                     .collect();
-                if let Some(lanes) = lanes {
+                if split
+                    .iter()
+                    .all(|(_, r)| r.exact.iter().all(Option::is_none))
+                {
                     keep[g] = false;
-                    loose_rots.extend(lanes);
+                    for ((track, _), (grid, rot)) in hq_rows[g].iter().zip(split) {
+                        let comps: Vec<&Controls> = rot.comps.iter().collect();
+                        loose_rots.push((*track, LooseLane::new(grid, &comps)));
+                    }
                     continue;
+                }
+                // A rotation with segments no split holds stays a group of
+                // its own, split where pieces hold the values, so that
+                // squad runs in f64 for values only inside the segments
+                // left (and for velocities where they were before).
+                if let [(_, rot)] = hq_rows[g].as_mut_slice() {
+                    (grids[g], *rot) = split_rotation(&grids[g], rot, true);
                 }
             }
             if hq_rows[g].is_empty() && vec_rows[g].len() < 8 {
@@ -895,7 +970,7 @@ impl Clip {
                 .collect();
             let vkeys: Vec<Vec<[f32; KEY_STRIDE]>> = vrows.iter().map(per_key).collect();
             let keys = grid.times.len() + 4;
-            let (exact_at, exact) = exact_table(&hq_rows[g], segments);
+            let (exact_at, exact, exact_controls) = exact_table(&hq_rows[g], segments);
             // Plane p, control j (P TO TI) of key k: vector blocks, then
             // rotation blocks of 4 planes (x y z w); unused lanes 0, or the
             // identity for rotations.
@@ -934,6 +1009,7 @@ impl Clip {
                 lanes: [vrows.len(), hq_rows[g].len(), exact.len()],
                 exact_at,
                 exact,
+                exact_controls,
                 keys: store,
                 delta,
                 vec_blocks,
@@ -1060,6 +1136,7 @@ impl Clip {
                     + size_of_val(g.delta.as_slice())
                     + size_of_val(g.exact_at.as_slice())
                     + size_of_val(g.exact.as_slice())
+                    + size_of_val(g.exact_controls.as_slice())
             })
             .sum();
         let loose = self.loose.heap_bytes() + self.loose_rot.heap_bytes();

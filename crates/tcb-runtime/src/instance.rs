@@ -276,10 +276,11 @@ pub(crate) fn sample_into(
                         None if e.values => e.value_mask,
                         None => continue,
                     };
-                    let at = hq_out + 4 * e.block;
+                    let at = hq_out + 4 * e.block as usize;
                     let planes = at..at + 4;
                     kernel::exact_quats(
                         e,
+                        &g.exact_controls[e.controls as usize],
                         mask,
                         f.s,
                         f.rate,

@@ -236,9 +236,14 @@ fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
 /// This runs in f64 (four lanes per [`f64x4`], two halves per block): the
 /// inner slerp between nearly opposite quaternions amplifies its inputs'
 /// errors by about `1 / sin(angle)`, and in f32 such segments miss 1e-6.
+///
+/// `e.piece` (`[a, w]`) places the stored segment inside the squad segment
+/// `controls`: it is evaluated at `a + w s`, its velocity scaled by `w` (for
+/// a whole segment, `[0, 1]`, this changes no bit).
 #[inline]
 pub(crate) fn exact_quats(
     e: &crate::clip::Exact,
+    controls: &[f64x4; 2 * SQ_STRIDE],
     mask: f32x8,
     s: f64,
     rate: f32,
@@ -246,13 +251,14 @@ pub(crate) fn exact_quats(
     vel: Option<&mut [f32x8]>,
 ) {
     use tcb_core::squad::{CONTROLS, squad, squad_with_derivative};
-    let s = f64x4::splat(s);
-    let rate = f64x4::splat(f64::from(rate));
     let want_v = vel.is_some();
     let mut q = [[0.0f32; 8]; 4];
     let mut dq = [[0.0f32; 8]; 4];
+    let [a, w] = e.piece;
+    let s = f64x4::splat(a + w * s);
+    let rate = f64x4::splat(w * f64::from(rate));
     for h in 0..2 {
-        let c: &[f64x4; CONTROLS] = e.controls[h * CONTROLS..(h + 1) * CONTROLS]
+        let c: &[f64x4; CONTROLS] = controls[h * CONTROLS..(h + 1) * CONTROLS]
             .try_into()
             .expect("16 controls");
         let (v, d) = if want_v {

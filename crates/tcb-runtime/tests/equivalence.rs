@@ -266,9 +266,20 @@ fn sample_times(rng: &mut Rng, clip: &tcb_core::Clip) -> Vec<f64> {
     t
 }
 
+/// How far a rotation's velocity (`want`, its 4 components) may be off, in
+/// each component: 1e-4 of its speed (the largest component, at least 1).
+/// Relative to the rotation's speed rather than to each component's own
+/// velocity: a component passing through zero velocity while the rotation
+/// turns fast keeps the error of the others (f32 cancellation in
+/// `6 (P1 - P0)` on short segments), as the compiled cubic is checked.
+fn rotation_velocity_tol(want: &[f32]) -> f32 {
+    1e-4 * want.iter().fold(1.0f32, |m, v| m.max(v.abs()))
+}
+
 /// Compare rows: vector channels bit for bit (values and velocities: the
 /// runtime runs the reference's formulas on the same f32 controls), rotations
-/// up to sign to 1e-6 relative (absolute below 1), their velocities to 1e-4.
+/// up to sign to 1e-6 relative (absolute below 1), their velocities to 1e-4
+/// of the rotation's speed ([`rotation_velocity_tol`]).
 fn assert_rows_match(
     clip: &tcb_core::Clip,
     time: f64,
@@ -310,7 +321,7 @@ fn assert_rows_match(
                 sign * w[c],
                 describe(&t.data, time)
             );
-            let vtol = 1e-4 * wv[c].abs().max(1.0);
+            let vtol = rotation_velocity_tol(wv);
             assert!(
                 (gv[c] - sign * wv[c]).abs() <= vtol,
                 "{} t={time} velocity {c}: runtime {} reference {}",
@@ -442,7 +453,7 @@ fn wild_rotations_stay_within_1e_6() {
             worst = worst.max(d.min(e));
             let sign = if d <= e { 1.0 } else { -1.0 };
             for c in 0..4 {
-                let tol = 1e-4 * want_v[c].abs().max(1.0);
+                let tol = rotation_velocity_tol(&want_v);
                 assert!(
                     (got_v[c] - sign * want_v[c]).abs() <= tol,
                     "seed {seed} t={time} velocity {c}: {} vs {}",
@@ -526,6 +537,56 @@ fn rotations_on_their_own_grids() {
         check_clip(&clip, seed);
     }
     assert!(loose > 300, "only {loose} rotations took the loose path");
+}
+
+/// A squad rotation on key times of its own with one pair of keys so close
+/// (0.5 ms) that f32 cannot carry the velocity of its segment: that segment
+/// stays exact (f64 squad on the group path) and only it. Every other
+/// segment the cubic misses is split into cubic pieces, so the f64 work per
+/// frame for values is confined to the short segment (before, the whole
+/// track's 24 segments stayed exact).
+#[test]
+fn a_segment_no_split_holds_leaves_the_others_split() {
+    use glam::Quat;
+    let mut rng = Rng(0x5ba5e4);
+    let mut t: Vec<f64> = (0..24).map(|k| k as f64 * 0.08).collect();
+    t.insert(12, t[11] + 0.0005);
+    let mut q = Quat::IDENTITY;
+    let values: Vec<Quat> = (0..t.len())
+        .map(|k| {
+            let axis = Vec3::new(rng.f(-1.0, 1.0) as f32, rng.f(-1.0, 1.0) as f32, 1.0).normalize();
+            // The close key barely turns: a slow segment, whose velocity
+            // f32 keys cannot resolve.
+            let angle = if k == 12 { 1e-4 } else { rng.f(0.3, 0.5) };
+            q = (q * Quat::from_axis_angle(axis, angle as f32)).normalize();
+            q
+        })
+        .collect();
+    let s = TrackSettings {
+        rotation: RotationMode::Squad,
+        ..TrackSettings::default()
+    };
+    let n = t.len();
+    let track = RotationTrack::new(t, values, vec![KeyParams::default(); n], &s)
+        .expect("valid rotation keys");
+    let clip = tcb_core::Clip::new(
+        "short segment",
+        vec![NamedTrack {
+            name: "r".into(),
+            data: TrackData::Quat(track),
+        }],
+    )
+    .expect("one track");
+    let stats = Clip::compile(&clip).stats();
+    assert_eq!(stats.loose_rotation_tracks, 0, "{stats:?}");
+    // Squad in f64 for values on the short segment alone (pieces whose
+    // cubic misses only the velocity take squad's velocity in f64).
+    assert!(
+        stats.exact_segments - stats.exact_for_velocity_only <= 1,
+        "{stats:?}"
+    );
+    assert!(stats.grids[0].keys > n, "nothing was split: {stats:?}");
+    check_clip(&clip, 7);
 }
 
 /// Tracks that each have their own key times (as DCC tools export them) are
