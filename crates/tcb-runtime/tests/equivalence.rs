@@ -266,20 +266,9 @@ fn sample_times(rng: &mut Rng, clip: &tcb_core::Clip) -> Vec<f64> {
     t
 }
 
-/// How far a rotation's velocity (`want`, its 4 components) may be off, in
-/// each component: 1e-4 of its speed (the largest component, at least 1).
-/// Relative to the rotation's speed rather than to each component's own
-/// velocity: a component passing through zero velocity while the rotation
-/// turns fast keeps the error of the others (f32 cancellation in
-/// `6 (P1 - P0)` on short segments), as the compiled cubic is checked.
-fn rotation_velocity_tol(want: &[f32]) -> f32 {
-    1e-4 * want.iter().fold(1.0f32, |m, v| m.max(v.abs()))
-}
-
 /// Compare rows: vector channels bit for bit (values and velocities: the
 /// runtime runs the reference's formulas on the same f32 controls), rotations
-/// up to sign to 1e-6 relative (absolute below 1), their velocities to 1e-4
-/// of the rotation's speed ([`rotation_velocity_tol`]).
+/// up to sign to 1e-6 relative (absolute below 1), their velocities to 1e-4.
 fn assert_rows_match(
     clip: &tcb_core::Clip,
     time: f64,
@@ -321,7 +310,7 @@ fn assert_rows_match(
                 sign * w[c],
                 describe(&t.data, time)
             );
-            let vtol = rotation_velocity_tol(wv);
+            let vtol = 1e-4 * wv[c].abs().max(1.0);
             assert!(
                 (gv[c] - sign * wv[c]).abs() <= vtol,
                 "{} t={time} velocity {c}: runtime {} reference {}",
@@ -453,7 +442,7 @@ fn wild_rotations_stay_within_1e_6() {
             worst = worst.max(d.min(e));
             let sign = if d <= e { 1.0 } else { -1.0 };
             for c in 0..4 {
-                let tol = rotation_velocity_tol(&want_v);
+                let tol = 1e-4 * want_v[c].abs().max(1.0);
                 assert!(
                     (got_v[c] - sign * want_v[c]).abs() <= tol,
                     "seed {seed} t={time} velocity {c}: {} vs {}",
