@@ -313,3 +313,43 @@ fn an_imported_clip_keeps_its_skeleton_and_reduces_by_shell() {
     // The reduced clip carries the rig on.
     assert_eq!(tcb_io::load(&out).unwrap().skeleton.unwrap(), from_bvh);
 }
+
+/// docs/reduce.md: "a constant track becomes 2 keys", even where putting
+/// its keys back on the grid the other tracks share would compile smaller
+/// (here 8 jittery tracks keep all their keys on that grid, and the
+/// constant one alone on key times of its own costs a loose block).
+#[test]
+fn a_constant_track_becomes_two_keys_even_beside_a_kept_grid() {
+    let times = "0, 0.1, 0.2, 0.3, 0.4, 0.5";
+    let mut tracks: Vec<String> = (0..8)
+        .map(|i| {
+            let values: Vec<String> = (0..6)
+                .map(|k| format!("{}", ((i * 7 + k * 13) % 11) as f64 * 0.37 - 1.0))
+                .collect();
+            format!(
+                r#"{{"name": "j{i}", "kind": "scalar", "times": [{times}], "values": [{}]}}"#,
+                values.join(", ")
+            )
+        })
+        .collect();
+    tracks.push(format!(
+        r#"{{"name": "c", "kind": "scalar", "times": [{times}], "values": [0.25, 0.25, 0.25, 0.25, 0.25, 0.25]}}"#
+    ));
+    let text = format!(
+        r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
+        tracks.join(",\n")
+    );
+    let input = dir().join("constant-beside-grid.json");
+    std::fs::write(&input, text).unwrap();
+    let out = dir().join("constant-beside-grid-reduced.json");
+    let o = tcb(&[
+        "reduce",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let written = tcb_io::read_clip_doc(&out).unwrap();
+    let c = written.tracks.iter().find(|t| t.name == "c").unwrap();
+    assert_eq!(c.times.len(), 2, "{:?}", c.times);
+}

@@ -454,8 +454,9 @@ pub fn reduce(
     // keep the largest share of their keys are put back (exact) in prefixes
     // of 1, 2, 4, ... tracks; the prefix whose compiled clip is smallest is
     // taken if it is smaller than the fitted clip and still holds.
+    // Fits of 2 keys stay (docs/reduce.md: "a constant track becomes 2 keys").
     let mut candidates: Vec<(f64, usize)> = (0..kept.len())
-        .filter(|&i| !kept[i])
+        .filter(|&i| !kept[i] && doc.tracks[i].times.len() > 2)
         .map(|i| {
             let share = doc.tracks[i].times.len() as f64 / input.doc.tracks[i].times.len() as f64;
             (share, i)
