@@ -50,6 +50,20 @@ fn short_cmu(frames: usize) -> PathBuf {
     path
 }
 
+/// `tcb reduce INPUT -o OUT [EXTRA...]`, which must succeed.
+fn reduce_ok(input: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "reduce",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = tcb(&args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
 /// `reduced: tracks T, keys K0 -> K1, values V0 -> V1, bytes B0 -> B1,
 /// max error e (METRIC, joint J, time t)`, its numbers.
 fn summary(stdout: &str, metric: &str) -> [f64; 8] {
@@ -77,15 +91,7 @@ fn summary(stdout: &str, metric: &str) -> [f64; 8] {
 fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     let input = short_cmu(240);
     let out = dir().join("short.json");
-    let o = tcb(&[
-        "reduce",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--tolerance",
-        "0.05",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = reduce_ok(&input, &out, &["--tolerance", "0.05"]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
     let [tracks, k0, k1, v0, v1, b0, b1, e] = summary(&stdout, "shell");
     assert_eq!(tracks, 32.0);
@@ -123,13 +129,7 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
 fn a_reduction_keeping_most_keys_stays_on_the_grid() {
     let input = short_cmu(240);
     let out = dir().join("short-default.json");
-    let o = tcb(&[
-        "reduce",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = reduce_ok(&input, &out, &[]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
     let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
     assert!(b1 < b0, "{stdout}");
@@ -167,13 +167,7 @@ fn a_clip_without_skeleton_reduces_by_value() {
     let input = dir().join("dense-smooth.json");
     std::fs::write(&input, text).unwrap();
     let out = dir().join("dense-smooth-reduced.json");
-    let o = tcb(&[
-        "reduce",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = reduce_ok(&input, &out, &[]);
     assert!(
         stderr(&o).contains("metric value, tolerance 1e-4, rotation tolerance 0.01 degrees"),
         "{}",
@@ -298,15 +292,7 @@ fn an_imported_clip_keeps_its_skeleton_and_reduces_by_shell() {
     assert_eq!(from_json, from_bvh);
     assert!(from_json.joint("Head_end").is_some());
     let out = dir().join("short-import-reduced.json");
-    let o = tcb(&[
-        "reduce",
-        json.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--tolerance",
-        "0.05",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = reduce_ok(&json, &out, &["--tolerance", "0.05"]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
     let [.., e] = summary(&stdout, "shell");
     assert!(e <= 0.05, "{stdout}");
@@ -342,13 +328,7 @@ fn a_constant_track_becomes_two_keys_even_beside_a_kept_grid() {
     let input = dir().join("constant-beside-grid.json");
     std::fs::write(&input, text).unwrap();
     let out = dir().join("constant-beside-grid-reduced.json");
-    let o = tcb(&[
-        "reduce",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    reduce_ok(&input, &out, &[]);
     let written = tcb_io::read_clip_doc(&out).unwrap();
     let c = written.tracks.iter().find(|t| t.name == "c").unwrap();
     assert_eq!(c.times.len(), 2, "{:?}", c.times);
