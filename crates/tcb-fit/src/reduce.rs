@@ -410,9 +410,8 @@ pub fn reduce(
     let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let mut attempts = Vec::new();
     let mut round = 0;
-    let no_revert = vec![false; input.doc.tracks.len()];
     let (doc, clip, compiled, worst, kept) = loop {
-        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress, &no_revert);
+        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress);
         let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
         let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
         let measured = verify(&compiled);
@@ -452,8 +451,9 @@ pub fn reduce(
     // share. A fit that keeps most of its keys can so make the clip larger
     // than keeping the original keys on the input's grid. The fits that
     // keep the largest share of their keys are put back (exact) in prefixes
-    // of 1, 2, 4, ... tracks; the prefix whose compiled clip is smallest is
-    // taken if it is smaller than the fitted clip and still holds.
+    // of 1, 2, 4, ... tracks (compiled in parallel); the prefix whose
+    // compiled clip is smallest is taken if it is smaller than the fitted
+    // clip and still holds.
     // Fits of 2 keys stay (docs/reduce.md: "a constant track becomes 2 keys").
     let mut candidates: Vec<(f64, usize)> = (0..kept.len())
         .filter(|&i| !kept[i] && doc.tracks[i].times.len() > 2)
@@ -464,32 +464,33 @@ pub fn reduce(
         .filter(|&(share, _)| share >= MIN_SHARE)
         .collect();
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut best: Option<(usize, usize)> = None;
-    let mut size = 1;
-    while size <= candidates.len() {
-        let mut revert = no_revert.clone();
+    let revert = |size: usize| {
+        let mut r = vec![false; input.doc.tracks.len()];
         for &(_, i) in &candidates[..size] {
-            revert[i] = true;
+            r[i] = true;
         }
-        let (d, _, _) = plan.run(&scale, &mut cache, progress, &revert);
-        let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-        let bytes = tcb_runtime::Clip::compile(&c).memory_bytes();
-        if bytes < best.map_or(compiled.memory_bytes(), |b| b.1) {
-            best = Some((size, bytes));
-        }
-        size = if size == candidates.len() {
-            size + 1
-        } else {
-            (2 * size).min(candidates.len())
-        };
-    }
-    let (doc, clip, compiled, worst, kept) = match best {
-        Some((size, _)) => {
-            let mut revert = no_revert.clone();
-            for &(_, i) in &candidates[..size] {
-                revert[i] = true;
-            }
-            let (d, k, _) = plan.run(&scale, &mut cache, progress, &revert);
+        r
+    };
+    let sizes: Vec<usize> = std::iter::successors(Some(1usize), |&n| Some(2 * n))
+        .take_while(|&n| n < candidates.len())
+        .chain((!candidates.is_empty()).then_some(candidates.len()))
+        .collect();
+    // Only the bytes are kept: one compiled clip per thread at a time.
+    let tried: Vec<(usize, usize)> = sizes
+        .par_iter()
+        .map(|&size| {
+            let (d, _) = plan.write_fits(&cache, &revert(size));
+            let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
+            Ok((tcb_runtime::Clip::compile(&c).memory_bytes(), size))
+        })
+        .collect::<Result<_, ReduceError>>()?;
+    let smallest = tried
+        .into_iter()
+        .filter(|&(bytes, _)| bytes < compiled.memory_bytes())
+        .min();
+    let (doc, clip, compiled, worst, kept) = match smallest {
+        Some((_, size)) => {
+            let (d, k) = plan.write_fits(&cache, &revert(size));
             let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
             let cc = Arc::new(tcb_runtime::Clip::compile(&c));
             let measured = verify(&cc);
@@ -660,7 +661,6 @@ impl<'a> Plan<'a> {
         scales: &[f64],
         cache: &mut [Option<(f64, Option<Fit>)>],
         progress: &(dyn Fn(usize, usize) + Sync),
-        revert: &[bool],
     ) -> (ClipDoc, Vec<bool>, usize) {
         let done = AtomicUsize::new(0);
         let todo: Vec<usize> = (0..self.groups.len())
@@ -683,6 +683,17 @@ impl<'a> Plan<'a> {
                 *c = None;
             }
         }
+        let (doc, kept) = self.write_fits(cache, &vec![false; self.tracks.len()]);
+        (doc, kept, total)
+    }
+
+    /// The clip of the fits in `cache`, with the tracks of `revert` as
+    /// they were; and per track whether it was kept as it was.
+    fn write_fits(
+        &self,
+        cache: &[Option<(f64, Option<Fit>)>],
+        revert: &[bool],
+    ) -> (ClipDoc, Vec<bool>) {
         // Per track: its fit and its place in the group.
         let mut fitted: Vec<Option<(&Fit, usize)>> = vec![None; self.tracks.len()];
         for (g, c) in self.groups.iter().zip(cache.iter()) {
@@ -692,8 +703,7 @@ impl<'a> Plan<'a> {
                 }
             }
         }
-        let (doc, kept) = self.write(&fitted);
-        (doc, kept, total)
+        self.write(&fitted)
     }
 
     fn fit_group(&self, gi: usize, scale: f64) -> Option<Fit> {
