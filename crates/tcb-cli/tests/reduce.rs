@@ -136,6 +136,22 @@ fn a_reduction_keeping_most_keys_stays_on_the_grid() {
     assert!(!stderr(&o).contains("more bytes"), "{}", stderr(&o));
 }
 
+/// Where the reduction still compiles larger (at a tenth of the default
+/// tolerance only a few nearly constant tracks are fitted: the grid keeps
+/// its blocks of 8 and a block of loose lanes is added), `tcb reduce` says
+/// so on stderr; the summary line is the contract's.
+#[test]
+fn a_reduction_that_compiles_larger_says_so() {
+    let input = short_cmu(240);
+    let out = dir().join("short-tight.json");
+    let o = reduce_ok(&input, &out, &["--tolerance", "1.087e-4"]);
+    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
+    assert!(b1 > b0, "{stdout}");
+    let note = format!("compiles to more bytes than the input ({b1} against {b0})");
+    assert!(stderr(&o).contains(&note), "{}", stderr(&o));
+}
+
 /// `tcb sample --at` of `clip` at `times`: one row of numbers per time.
 fn sample_at(clip: &Path, times: &[f64]) -> Vec<Vec<f64>> {
     let at: Vec<String> = times.iter().map(|t| t.to_string()).collect();

@@ -201,19 +201,16 @@ fn exact_table(
             if !pool.last().is_some_and(same) {
                 pool.push(controls);
             }
-            let pieces: Vec<[f64; 2]> = block
+            let mut pieces = block
                 .iter()
                 .filter(|r| r.1.exact[seg].is_some())
-                .map(|r| r.1.piece[seg])
-                .collect();
-            debug_assert!(
-                pieces.iter().all(|p| *p == pieces[0]),
-                "one piece per block"
-            );
+                .map(|r| r.1.piece[seg]);
+            let piece = pieces.next().expect("a lane of the entry is exact");
+            debug_assert!(pieces.all(|p| p == piece), "one piece per block");
             out.push(Exact {
                 mask,
                 value_mask,
-                piece: pieces[0],
+                piece,
                 block: u32::try_from(b).expect("fewer than 2^32 blocks"),
                 controls: u32::try_from(pool.len() - 1).expect("fewer than 2^32 entries"),
                 values: value_mask.any(),
@@ -682,8 +679,8 @@ fn split_rotation(
                     let w = 1.0 / m as f64;
                     // Split times strictly increasing (not so in f64 on
                     // keys a few ulps apart).
-                    let at = |j: usize| t0 + (t1 - t0) * (j as f64 * w);
-                    if (1..m).any(|j| at(j) <= at(j - 1)) || at(m - 1) >= t1 {
+                    let at = |j: usize| split_time(t0, t1, j, m);
+                    if (1..=m).any(|j| at(j) <= at(j - 1)) {
                         return None;
                     }
                     (0..m)
@@ -707,7 +704,7 @@ fn split_rotation(
                             });
                             let holds = cubic_holds(&c, &ctl, 2.0 / (w * (t1 - t0)), (a, b));
                             let enough = if on_group { holds.values } else { holds.both() };
-                            enough.then_some((ctl, [a, w], holds.both()))
+                            enough.then_some((ctl, [a, w]))
                         })
                         .collect::<Option<Vec<_>>>()
                 })
@@ -721,19 +718,16 @@ fn split_rotation(
             push(&mut out, ctl, exact, vo, rot.piece[k + 1]);
             continue;
         };
-        let (m, c) = (pieces.len(), rot.exact[k + 1]);
-        for (j, (ctl, piece, both)) in pieces.into_iter().enumerate() {
-            times.push(if j + 1 == m {
-                t1
-            } else {
-                t0 + (t1 - t0) * ((j + 1) as f64 / m as f64)
-            });
+        let m = pieces.len();
+        // On a group, squad gives the pieces' velocities, as it did for the
+        // whole segment (the cubic's, within 5e-5 of the speed, may be 1e-5
+        // off, which `tcb sample --velocity` is checked to); a loose lane's
+        // pieces hold both.
+        let exact = rot.exact[k + 1].filter(|_| on_group);
+        for (j, (ctl, piece)) in pieces.into_iter().enumerate() {
+            times.push(split_time(t0, t1, j + 1, m));
             eases.push(SegmentEase::default());
             steps.push(false);
-            // On a group, squad gives the velocities, as it did for the
-            // whole segment (the cubic's, within 5e-5 of the speed, may be
-            // 1e-5 off, which `tcb sample --velocity` is checked to).
-            let exact = if on_group || !both { c } else { None };
             push(&mut out, ctl, exact, exact.is_some(), piece);
         }
     }
@@ -747,6 +741,16 @@ fn split_rotation(
         post: grid.post,
     };
     (grid.compact(), out)
+}
+
+/// Time `j` of `m` (`t0` at 0, `t1` exactly at `m`) splitting `[t0, t1]`
+/// into equal pieces.
+fn split_time(t0: f64, t1: f64, j: usize, m: usize) -> f64 {
+    if j == m {
+        t1
+    } else {
+        t0 + (t1 - t0) * (j as f64 / m as f64)
+    }
 }
 
 /// Lay per-lane control rows into blocks of `N` lanes (`f32x8`: 8,
