@@ -53,6 +53,12 @@ pub(crate) struct LooseLane {
     /// Per key (and sentinel pseudo-key, see `clip::per_key`), per
     /// component: `[P, TO, TI]`, at `key(key * dim + c)`.
     keys: Keys,
+    /// Where lane 0 of its first control plane is in the instance's
+    /// controls, as f32s (set by [`Loose::new`]).
+    ctl_at: u32,
+    /// No segment eases or steps: a real segment loads as
+    /// [`LooseState::load_plain`] does.
+    plain: bool,
 }
 
 /// A loose lane's keys, in f32 or in 16 bits with a range per component
@@ -81,6 +87,8 @@ impl LooseLane {
             grid,
             dim,
             keys: Keys::F32(keys),
+            ctl_at: 0,
+            plain: false,
         }
     }
 
@@ -258,7 +266,7 @@ impl Loose {
             + size_of_val(self.order.as_slice())
     }
 
-    pub fn new(lanes: Vec<LooseLane>, out: usize) -> Self {
+    pub fn new(mut lanes: Vec<LooseLane>, out: usize) -> Self {
         let blocks = lanes.len().div_ceil(8);
         let lane = |i: usize| lanes.get(i);
         let half = |f: &dyn Fn(&LooseLane) -> f64, pad: f64| -> Vec<f64x4> {
@@ -299,7 +307,7 @@ impl Loose {
         }
         let block_lanes = |b: usize| (8 * b..8 * b + 8).filter_map(lane);
         let mut ctl_planes = 0;
-        let block = (0..blocks)
+        let block: Vec<Block> = (0..blocks)
             .map(|b| {
                 let planes = 4 * block_lanes(b).map(|l| l.dim).max().unwrap_or(0);
                 ctl_planes += planes;
@@ -313,6 +321,12 @@ impl Loose {
                 }
             })
             .collect();
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let ctl: &Block = &block[l / 8];
+            lane.ctl_at = index_u32(8 * ctl.ctl.start + l % 8);
+            let g = &lane.grid;
+            lane.plain = g.eases.iter().all(|e| e.is_none()) && !g.steps.contains(&true);
+        }
         let mut order: Vec<(f64, u32, u32)> = lanes
             .iter()
             .enumerate()
@@ -512,22 +526,78 @@ impl LooseState {
     #[inline(never)]
     fn stream(&mut self, loose: &Loose, time: f64) {
         let mut budget = 4 * loose.lanes.len() + 64;
-        // `next_time` is infinite past the end, which an infinite `time` passes.
-        while time >= self.next_time && self.next < loose.order.len() {
+        while let Some(&[l, seg]) = loose.order.get(self.next) {
+            let (l, seg) = (l as usize, seg as usize);
+            let lane = &loose.lanes[l];
+            let t = lane.grid.times.as_slice();
+            // The entry's time is its segment's first key (`seg >= 1`).
+            let start = t[seg - 1];
+            if time < start {
+                self.next_time = start;
+                return;
+            }
             if budget == 0 {
                 return self.seek(loose, time);
             }
             budget -= 1;
-            let [l, seg] = loose.order[self.next].map(|x| x as usize);
-            // A lane that also passed the segment's end has its next entry
-            // due in this same loop (dense keys, sampled at a lower rate):
-            // only the last one is loaded.
-            let t = &loose.lanes[l].grid.times;
-            if t.get(seg).is_none_or(|&end| time < end) {
-                self.load_inline(loose, l, seg);
+            match t.get(seg) {
+                // A lane that also passed the segment's end has its next
+                // entry due in this same loop (dense keys, sampled at a
+                // lower rate): only the last one is loaded.
+                Some(&end) if time >= end => {}
+                Some(&end) if lane.plain => match (&lane.keys, lane.dim) {
+                    (Keys::F32(k), 1) => self.load_plain::<1>(lane, l, seg, start, end, k),
+                    (Keys::F32(k), 2) => self.load_plain::<2>(lane, l, seg, start, end, k),
+                    (Keys::F32(k), 3) => self.load_plain::<3>(lane, l, seg, start, end, k),
+                    (Keys::F32(k), _) => self.load_plain::<4>(lane, l, seg, start, end, k),
+                    _ => self.load_inline(loose, l, seg),
+                },
+                _ => self.load_inline(loose, l, seg),
             }
             self.next += 1;
-            self.next_time = loose.order_time(self.next);
+        }
+        // `next_time` is infinite past the end, which an infinite `time` passes.
+        self.next_time = f64::INFINITY;
+    }
+
+    /// [`Self::load_inline`] for real segment `seg` (window `[ws, we)`) of
+    /// a lane with `N` components, no ease and no step, and keys `k` in
+    /// f32: what forward playback loads nearly every time, in straight-line
+    /// code (two bounds checks).
+    #[inline(always)]
+    fn load_plain<const N: usize>(
+        &mut self,
+        lane: &LooseLane,
+        l: usize,
+        seg: usize,
+        ws: f64,
+        we: f64,
+        k: &[[f32; KEY_STRIDE]],
+    ) {
+        debug_assert!(lane.plain && lane.dim == N && seg >= 1);
+        debug_assert_eq!((seg - 1, seg), key_pair(&lane.grid, seg));
+        let d = we - ws;
+        let (b, i) = (l / 8, l % 8);
+        let block = &mut self.block[b];
+        let half = &mut block.half[i / 4];
+        let j = i % 4;
+        half.ws.as_mut_array()[j] = ws;
+        half.d.as_mut_array()[j] = d;
+        half.we.as_mut_array()[j] = we;
+        // The ease stays the none every load of a plain lane writes.
+        block.rate.as_mut_array()[i] = (1.0 / d) as f32;
+        block.seg[i] = seg;
+        // Keys `seg - 1` and `seg`, `N` components each.
+        let keys = &k[(seg - 1) * N..][..2 * N];
+        // Component `c`'s planes `[P0, P1, M0, M1]` at `32 c + 8 p` from
+        // the lane's first.
+        let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl);
+        let out = &mut ctl[lane.ctl_at as usize..][..32 * N - 7];
+        for c in 0..N {
+            out[32 * c] = keys[c][0];
+            out[32 * c + 8] = keys[N + c][0];
+            out[32 * c + 16] = keys[c][1];
+            out[32 * c + 24] = keys[N + c][2];
         }
     }
 
