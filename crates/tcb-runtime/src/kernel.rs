@@ -239,8 +239,9 @@ fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
 ///
 /// `e.piece` (`[a, w]`) places the stored segment inside the squad segment
 /// `controls`: it is evaluated at `a + w s`, its velocity scaled by `w` (for
-/// a whole segment, `[0, 1]`, this changes no bit).
-#[inline]
+/// a whole segment, `[0, 1]`, this changes no bit). Out of line: few
+/// frames reach an exact entry.
+#[inline(never)]
 pub(crate) fn exact_quats(
     e: &crate::clip::Exact,
     controls: &[f64x4; 2 * SQ_STRIDE],
@@ -257,7 +258,12 @@ pub(crate) fn exact_quats(
     let [a, w] = e.piece;
     let s = f64x4::splat(a + w * s);
     let rate = f64x4::splat(w * f64::from(rate));
+    let lanes = mask.to_bitmask();
     for h in 0..2 {
+        // Most exact entries have one lane: the half without one is skipped.
+        if lanes >> (4 * h) & 0xf == 0 {
+            continue;
+        }
         let c: &[f64x4; CONTROLS] = controls[h * CONTROLS..(h + 1) * CONTROLS]
             .try_into()
             .expect("16 controls");
