@@ -149,6 +149,31 @@ impl Scenario {
         }
     }
 
+    /// [`parallel_pass`](Self::parallel_pass) without a scheduler: the
+    /// instances cut into one contiguous share per rayon thread, each share
+    /// played through every frame on a thread of its own, with no
+    /// synchronization between frames. Where rayon is as fast, what keeps
+    /// both from the core count is the machine's (shared caches and
+    /// memory, other tenants), not the scheduling.
+    pub fn threads_pass(&self) -> impl FnMut() + '_ {
+        let mut instances = self.instances();
+        let threads = rayon::current_num_threads().max(1);
+        move || {
+            let share = instances.len().div_ceil(threads).max(1);
+            std::thread::scope(|scope| {
+                for (insts, phases) in instances.chunks_mut(share).zip(self.phases.chunks(share)) {
+                    scope.spawn(move || {
+                        for &t in &self.times {
+                            for (inst, &p) in insts.iter_mut().zip(phases) {
+                                black_box(inst.sample(t + p));
+                            }
+                        }
+                    });
+                }
+            });
+        }
+    }
+
     /// One pass of the `splines` crate over `times`.
     pub fn peer_pass(&self, times: Vec<f64>) -> Option<impl FnMut() + '_> {
         let peer = self.peer.as_ref()?;

@@ -692,9 +692,12 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
     if let Some(p) = row.parallel_speedup {
         writeln!(
             out,
-            "rayon: {:.2}x one thread, on {} thread(s)",
+            "rayon: {:.2}x one thread, on {} thread(s){}",
             p,
-            pool.current_num_threads()
+            pool.current_num_threads(),
+            row.threads_speedup.map_or(String::new(), |c| format!(
+                " (plain threads with no per-frame sync, same run: {c:.2}x)"
+            ))
         )?;
     }
     writeln!(out, "bytes: {} compiled", mb(row.bytes))?;
