@@ -549,6 +549,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     let clip = &loaded.clip;
     let options = tcb_runtime::CompileOptions {
         quantize: args.quantize,
+        ..Default::default()
     };
     let runtime = tcb_runtime::Clip::compile_with(clip, &options);
     let stats = runtime.stats();
@@ -646,6 +647,7 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
         import: import_options(&args.clip, args.rotation, args.animation.as_ref())?,
         compile: tcb_runtime::CompileOptions {
             quantize: args.quantize,
+            ..Default::default()
         },
     };
     let scenario = tcb_bench::scenarios::file_with(&args.clip, &options)?;
@@ -796,7 +798,13 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
             clip.sample_into(t, v, d)
         })?;
     } else {
-        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile(&clip));
+        // Velocities printed are squad's own (the contract's numbers), not
+        // the cubic's that a game loop plays (5e-5 of the speed off).
+        let options = tcb_runtime::CompileOptions {
+            exact_velocities: args.velocity,
+            ..Default::default()
+        };
+        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile_with(&clip, &options));
         let mut instance = tcb_runtime::Instance::new(runtime);
         if args.velocity {
             instance = instance.with_velocities();

@@ -181,6 +181,37 @@ fn scalar_flag_gives_the_same_numbers() {
     }
 }
 
+/// The contract's check (`tools/check/check.py`): every value and velocity
+/// of the runtime's `tcb sample --velocity` within 1e-5 of the reference's
+/// (relative, absolute below 1), here on dense squad motion capture, where
+/// the cubic a game loop plays for squad is 1.5e-4 off in a velocity
+/// component (`CompileOptions::exact_velocities`).
+#[test]
+fn sampled_squad_velocities_are_the_references() {
+    let at = "0.1,1.2345,2.277074225,6.4833333,10.73125,14.752083";
+    let run = |scalar: bool| {
+        let mut args = vec!["sample", "--at", at, "--velocity"];
+        let bvh = data("cmu-01_01.bvh");
+        args.insert(1, &bvh);
+        if scalar {
+            args.push("--scalar");
+        }
+        let o = tcb(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let (a, b) = (run(false), run(true));
+    assert_eq!(a.lines().next(), b.lines().next());
+    let mut worst: f64 = 0.0;
+    for (la, lb) in a.lines().zip(b.lines()).skip(1) {
+        for (x, y) in la.split(',').zip(lb.split(',')) {
+            let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+            worst = worst.max((x - y).abs() / y.abs().max(1.0));
+        }
+    }
+    assert!(worst <= 1e-5, "worst relative difference {worst}");
+}
+
 #[test]
 fn usage_errors() {
     for args in [

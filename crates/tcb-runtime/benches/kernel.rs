@@ -167,7 +167,10 @@ fn benches(c: &mut Criterion) {
     let turning = skeleton_turning(31, 200, RotationMode::Squad, 30.0);
     assert!(Clip::compile(&turning).stats().exact_segments > 1000);
     play(c, "skeleton_squad_exact", &turning, 31);
-    let quantize = CompileOptions { quantize: true };
+    let quantize = CompileOptions {
+        quantize: true,
+        ..Default::default()
+    };
     play_with(
         c,
         "skeleton_hermite_quantized",

@@ -251,6 +251,16 @@ pub struct CompileOptions {
     /// [`Clip::quantization_error`] for each track's). Tracks on their own
     /// key times are expanded only when they cross a key.
     pub quantize: bool,
+    /// Evaluate every squad (and slerp) segment's velocity by squad's own
+    /// formula in f64, as [`crate::kernel`] does where the cubic misses,
+    /// instead of by the cubic that plays its values. The cubic's velocity
+    /// is within 5e-5 of the rotation's speed; this one is the reference's
+    /// to about 1e-7, for tools that print or compare velocities (`tcb
+    /// sample --velocity`). Values and instances without velocities are
+    /// unchanged; instances with velocities run squad in f64 on every such
+    /// segment, and the clip stores its squad controls (about 1 KB per
+    /// block of 8 rotations per segment: 11 MB more for the CMU capture).
+    pub exact_velocities: bool,
 }
 
 /// Flat pose indices of component planes x..w of `lane` in blocks of 8
@@ -446,7 +456,7 @@ const CUBIC_VELOCITY_TOL: f32 = 5e-5;
 /// arithmetic against the f64 formula (value and velocity). Segments where
 /// the cubic misses keep their squad controls, and the kernel evaluates
 /// those lanes exactly ([`kernel::exact_quats`]).
-fn rotation_controls(t: &RotationTrack) -> RotationControls {
+fn rotation_controls(t: &RotationTrack, exact_velocities: bool) -> RotationControls {
     let keys = t.keys();
     let n = keys.len();
     let interps = t.interps();
@@ -486,6 +496,7 @@ fn rotation_controls(t: &RotationTrack) -> RotationControls {
                 (ctl, holds) = (fitted, h);
             }
         }
+        holds.velocities &= !exact_velocities;
         for (i, comp) in comps.iter_mut().enumerate() {
             comp[k + 1] = ctl[i];
         }
@@ -819,7 +830,7 @@ impl Clip {
     /// # */
     /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
     /// let plain = tcb_runtime::Clip::compile(&source);
-    /// let options = tcb_runtime::CompileOptions { quantize: true };
+    /// let options = tcb_runtime::CompileOptions { quantize: true, ..Default::default() };
     /// let small = tcb_runtime::Clip::compile_with(&source, &options);
     /// assert!(small.memory_bytes() * 3 < plain.memory_bytes() * 2);
     /// let hips = small.track("Hips.translation").unwrap();
@@ -849,7 +860,9 @@ impl Clip {
                 TrackData::Vec2(v) => vectors(vector_controls(v)),
                 TrackData::Vec3(v) => vectors(vector_controls(v)),
                 TrackData::Vec4(v) => vectors(vector_controls(v)),
-                TrackData::Quat(r) => hq_rows[g].push((i, rotation_controls(r))),
+                TrackData::Quat(r) => {
+                    hq_rows[g].push((i, rotation_controls(r, options.exact_velocities)))
+                }
             }
         }
 
@@ -882,9 +895,12 @@ impl Clip {
                         }
                     })
                     .collect();
-                if split
-                    .iter()
-                    .all(|(_, r)| r.exact.iter().all(Option::is_none))
+                // Loose lanes play the pieces' cubic velocities: not with
+                // `exact_velocities` (every squad segment's stays exact).
+                if !options.exact_velocities
+                    && split
+                        .iter()
+                        .all(|(_, r)| r.exact.iter().all(Option::is_none))
                 {
                     keep[g] = false;
                     for ((track, _), (grid, rot)) in hq_rows[g].iter().zip(split) {

@@ -209,7 +209,13 @@ fn quantizing_extreme_ranges() {
         }],
     )
     .expect("one track");
-    let c = Arc::new(Clip::compile_with(&src, &CompileOptions { quantize: true }));
+    let c = Arc::new(Clip::compile_with(
+        &src,
+        &CompileOptions {
+            quantize: true,
+            ..Default::default()
+        },
+    ));
     let id = c.track("v").unwrap();
     let mut i = Instance::new(c);
     for t in [0.0, 0.5, 1.0] {

@@ -653,6 +653,14 @@ fn cmu_capture_in_both_rotation_modes() {
         let clip = bvh.to_clip_doc("cmu", mode).unwrap().build().unwrap();
         let compiled = Arc::new(Clip::compile(&clip));
         let mut inst = Instance::new(compiled).with_velocities();
+        // With `exact_velocities`, every velocity within 1e-5 of the
+        // reference's, per component (the contract's check).
+        let options = tcb_runtime::CompileOptions {
+            exact_velocities: true,
+            ..Default::default()
+        };
+        let mut exact = Instance::new(Arc::new(Clip::compile_with(&clip, &options)));
+        exact = exact.with_velocities();
         let n = clip.channel_count();
         let (mut got, mut got_v) = (vec![0.0; n], vec![0.0; n]);
         let (mut want, mut want_v) = (vec![0.0; n], vec![0.0; n]);
@@ -663,6 +671,14 @@ fn cmu_capture_in_both_rotation_modes() {
                 inst.sample(time).write_row(&mut got, Some(&mut got_v));
                 clip.sample_into(time, &mut want, Some(&mut want_v));
                 assert_rows_match(&clip, time, (&got, &got_v), (&want, &want_v));
+                exact.sample(time).write_row(&mut got, Some(&mut got_v));
+                assert_rows_match(&clip, time, (&got, &got_v), (&want, &want_v));
+                for (c, (g, w)) in got_v.iter().zip(&want_v).enumerate() {
+                    assert!(
+                        (g - w).abs() <= 1e-5 * w.abs().max(1.0),
+                        "exact_velocities, t={time}, channel {c}: {g} against {w}"
+                    );
+                }
             }
         }
     }
@@ -1112,7 +1128,10 @@ fn batch_equals_sequential() {
 /// ease and channel count; and the bound is not vacuous.
 #[test]
 fn quantized_clips_stay_within_their_stated_bound() {
-    let options = tcb_runtime::CompileOptions { quantize: true };
+    let options = tcb_runtime::CompileOptions {
+        quantize: true,
+        ..Default::default()
+    };
     let mut bounded = 0;
     for (seed, channels) in (0..60u64).zip([0, 1, 7, 8, 9, 63, 64, 65].into_iter().cycle()) {
         let clip = random_clip(seed + 1000, channels);
@@ -1173,7 +1192,10 @@ fn quantized_clips_stay_within_their_stated_bound() {
 /// random access (a fresh instance per time), bit for bit.
 #[test]
 fn quantized_forward_playback_equals_random_access() {
-    let options = tcb_runtime::CompileOptions { quantize: true };
+    let options = tcb_runtime::CompileOptions {
+        quantize: true,
+        ..Default::default()
+    };
     for seed in 0..20u64 {
         let clip = random_clip(seed + 77, 9 + seed as usize);
         let small = Arc::new(Clip::compile_with(&clip, &options));

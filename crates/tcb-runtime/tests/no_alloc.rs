@@ -59,7 +59,10 @@ fn steady_playback_and_blending_allocate_nothing() {
     ] {
         let clip = tcb_io::load_clip(format!("{root}/{name}").as_ref()).unwrap();
         clips.push(Arc::new(tcb_runtime::Clip::compile(&clip)));
-        let quantize = tcb_runtime::CompileOptions { quantize: true };
+        let quantize = tcb_runtime::CompileOptions {
+            quantize: true,
+            ..Default::default()
+        };
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
     }
     for clip in clips {
