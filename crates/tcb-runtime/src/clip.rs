@@ -252,14 +252,15 @@ pub struct CompileOptions {
     /// key times are expanded only when they cross a key.
     pub quantize: bool,
     /// Evaluate every squad (and slerp) segment's velocity by squad's own
-    /// formula in f64, as [`crate::kernel`] does where the cubic misses,
-    /// instead of by the cubic that plays its values. The cubic's velocity
-    /// is within 5e-5 of the rotation's speed; this one is the reference's
-    /// to about 1e-7, for tools that print or compare velocities (`tcb
-    /// sample --velocity`). Values and instances without velocities are
-    /// unchanged; instances with velocities run squad in f64 on every such
-    /// segment, and the clip stores its squad controls (about 1 KB per
-    /// block of 8 rotations per segment: 11 MB more for the CMU capture).
+    /// formula in f64, as the kernel does where the cubic misses, instead
+    /// of by the cubic that plays its values. The cubic's velocity is within
+    /// 5e-5 of the rotation's speed; this one is the reference's to about
+    /// 1e-7, for tools that print or compare velocities (`tcb sample
+    /// --velocity`). Instances without velocities are unchanged; instances
+    /// with velocities run squad in f64 (values and velocities) on every such
+    /// segment, and the clip stores its squad controls (about 1 KB per block
+    /// of 8 rotations per segment: the CMU capture compiles to 15.6 MB
+    /// instead of 3.8).
     pub exact_velocities: bool,
 }
 
