@@ -31,7 +31,7 @@ use crate::grid::{TimeGrid, sentinel_rows};
 use crate::kernel::KEY_STRIDE;
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
-use tcb_core::ease::ease;
+use tcb_core::ease::{SegmentEase, ease};
 use tcb_core::extrapolate::{ModeLanes, map_lanes};
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
@@ -159,21 +159,21 @@ impl LooseLane {
     }
 
     /// `[P0, P1, M0, M1]` of each component from keys `ka` and `kb` (see
-    /// [`key_pair`]) into lane `i` of `out` (4 planes per component, `dim`
-    /// components).
+    /// [`key_pair`]) into the lane's planes of the instance's controls
+    /// (`ctl`, as f32s; see [`put_controls`]).
     #[inline(always)]
-    fn segment(&self, ka: usize, kb: usize, out: &mut [f32x8], i: usize) {
+    fn segment(&self, ka: usize, kb: usize, ctl: &mut [f32]) {
         // One copy per dimension, so that each is straight-line code.
         match self.dim {
-            1 => self.segment_of::<1>(ka, kb, out, i),
-            2 => self.segment_of::<2>(ka, kb, out, i),
-            3 => self.segment_of::<3>(ka, kb, out, i),
-            _ => self.segment_of::<4>(ka, kb, out, i),
+            1 => self.segment_of::<1>(ka, kb, ctl),
+            2 => self.segment_of::<2>(ka, kb, ctl),
+            3 => self.segment_of::<3>(ka, kb, ctl),
+            _ => self.segment_of::<4>(ka, kb, ctl),
         }
     }
 
     #[inline(always)]
-    fn segment_of<const N: usize>(&self, ka: usize, kb: usize, out: &mut [f32x8], i: usize) {
+    fn segment_of<const N: usize>(&self, ka: usize, kb: usize, ctl: &mut [f32]) {
         let (a, b): ([[f32; KEY_STRIDE]; N], [[f32; KEY_STRIDE]; N]) = match &self.keys {
             Keys::F32(k) => (
                 k[ka * N..][..N].try_into().expect("N components"),
@@ -184,18 +184,25 @@ impl LooseLane {
                 std::array::from_fn(|c| self.key(kb * N + c)),
             ),
         };
-        let out: &mut [[f32x8; 4]; N] = out
-            .as_chunks_mut::<4>()
-            .0
-            .get_mut(..N)
-            .and_then(|o| o.try_into().ok())
-            .expect("4 planes per component");
-        for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
-            o[0].as_mut_array()[i] = a[0];
-            o[1].as_mut_array()[i] = b[0];
-            o[2].as_mut_array()[i] = a[1];
-            o[3].as_mut_array()[i] = b[2];
-        }
+        put_controls(&mut ctl[self.ctl_at as usize..], a, b);
+    }
+}
+
+/// A segment's controls from its keys `a` and `b` (`[P, TO, TI]` per
+/// component) into one lane's planes: component `c`'s `[P0, P1, M0, M1]` at
+/// `32 c + 8 p` from the start of `out` (planes of 8 lanes, as f32s).
+#[inline(always)]
+fn put_controls<const N: usize>(
+    out: &mut [f32],
+    a: [[f32; KEY_STRIDE]; N],
+    b: [[f32; KEY_STRIDE]; N],
+) {
+    let out = &mut out[..32 * N - 7];
+    for c in 0..N {
+        out[32 * c] = a[c][0];
+        out[32 * c + 8] = b[c][0];
+        out[32 * c + 16] = a[c][1];
+        out[32 * c + 24] = b[c][2];
     }
 }
 
@@ -474,6 +481,20 @@ impl LooseState {
             )
         };
         debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
+        self.set_window(l, seg, [ws, we, d], Some(ease));
+        lane.segment(ka, kb, bytemuck::cast_slice_mut(&mut self.ctl));
+    }
+
+    /// Lane `l`'s window `[ws, we)` and width `d`, its ease (`None` leaves
+    /// the none every load of a plain lane writes), rate and stored segment.
+    #[inline(always)]
+    fn set_window(
+        &mut self,
+        l: usize,
+        seg: usize,
+        [ws, we, d]: [f64; 3],
+        ease: Option<SegmentEase>,
+    ) {
         let (b, i) = (l / 8, l % 8);
         let block = &mut self.block[b];
         let half = &mut block.half[i / 4];
@@ -481,12 +502,13 @@ impl LooseState {
         half.ws.as_mut_array()[j] = ws;
         half.d.as_mut_array()[j] = d;
         half.we.as_mut_array()[j] = we;
-        half.from.as_mut_array()[j] = ease.from();
-        half.to.as_mut_array()[j] = ease.to();
+        if let Some(e) = ease {
+            half.from.as_mut_array()[j] = e.from();
+            half.to.as_mut_array()[j] = e.to();
+        }
         // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
         block.rate.as_mut_array()[i] = (1.0 / d) as f32;
         block.seg[i] = seg;
-        lane.segment(ka, kb, &mut self.ctl[loose.block[b].ctl.clone()], i);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -576,29 +598,16 @@ impl LooseState {
     ) {
         debug_assert!(lane.plain && lane.dim == N && seg >= 1);
         debug_assert_eq!((seg - 1, seg), key_pair(&lane.grid, seg));
-        let d = we - ws;
-        let (b, i) = (l / 8, l % 8);
-        let block = &mut self.block[b];
-        let half = &mut block.half[i / 4];
-        let j = i % 4;
-        half.ws.as_mut_array()[j] = ws;
-        half.d.as_mut_array()[j] = d;
-        half.we.as_mut_array()[j] = we;
-        // The ease stays the none every load of a plain lane writes.
-        block.rate.as_mut_array()[i] = (1.0 / d) as f32;
-        block.seg[i] = seg;
+        self.set_window(l, seg, [ws, we, we - ws], None);
         // Keys `seg - 1` and `seg`, `N` components each.
         let keys = &k[(seg - 1) * N..][..2 * N];
-        // Component `c`'s planes `[P0, P1, M0, M1]` at `32 c + 8 p` from
-        // the lane's first.
+        let (a, b) = keys.split_at(N);
         let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl);
-        let out = &mut ctl[lane.ctl_at as usize..][..32 * N - 7];
-        for c in 0..N {
-            out[32 * c] = keys[c][0];
-            out[32 * c + 8] = keys[N + c][0];
-            out[32 * c + 16] = keys[c][1];
-            out[32 * c + 24] = keys[N + c][2];
-        }
+        put_controls::<N>(
+            &mut ctl[lane.ctl_at as usize..],
+            a.try_into().expect("N components"),
+            b.try_into().expect("N components"),
+        );
     }
 
     /// Every lane's segment at `time` by binary search, and the position
