@@ -292,15 +292,10 @@ pub(crate) fn sample_into(
         }
     }
     if clip.loose.blocks > 0 {
-        crate::loose::sample(&clip.loose, loose, time, values, velocities.as_deref_mut());
+        crate::loose::sample::<false>(&clip.loose, loose, time, values, velocities.as_deref_mut());
     }
     let r = &clip.loose_rot;
     if r.blocks > 0 {
-        crate::loose::sample(r, loose_rot, time, values, velocities.as_deref_mut());
-        let planes = r.out..r.out + 4 * r.blocks;
-        kernel::normalize_blocks(
-            &mut values[planes.clone()],
-            velocities.as_deref_mut().map(|v| &mut v[planes]),
-        );
+        crate::loose::sample::<true>(r, loose_rot, time, values, velocities.as_deref_mut());
     }
 }

@@ -199,24 +199,11 @@ pub(crate) fn renormalize_scaled(
     }
 }
 
-/// [`normalize`] in place over blocks of 4 planes (rotations sampled as
-/// loose lanes: the curve and its derivative, then normalized).
-pub(crate) fn normalize_blocks(values: &mut [f32x8], vel: Option<&mut [f32x8]>) {
-    let values = values.as_chunks_mut::<4>().0;
-    match vel {
-        None => values.iter_mut().for_each(|v| normalize_block(v, None)),
-        Some(vel) => {
-            let vel = vel.as_chunks_mut::<4>().0;
-            for (v, d) in values.iter_mut().zip(vel) {
-                normalize_block(v, Some(d));
-            }
-        }
-    }
-}
-
-/// One block of [`normalize_blocks`].
+/// [`normalize`] in place on one block of 4 planes (rotations sampled as
+/// loose lanes: the curve and its derivative, normalized as soon as a block
+/// is evaluated).
 #[inline(always)]
-fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
+pub(crate) fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
     let p = *v;
     let dp = vel.as_deref().copied();
     let (q, qv) = normalize(p, dp);

@@ -788,7 +788,10 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
 }
 
 /// Sample every loose track at `time` into its pose planes.
-pub(crate) fn sample(
+///
+/// `ROTATIONS`: the lanes are rotations, each block normalized
+/// ([`crate::kernel::normalize_block`]) as soon as it is evaluated.
+pub(crate) fn sample<const ROTATIONS: bool>(
     loose: &Loose,
     st: &mut LooseState,
     time: f64,
@@ -818,9 +821,12 @@ pub(crate) fn sample(
             }
             if let Some(vel) = velocities.as_deref_mut() {
                 let dh = hermite_basis_derivative(s);
-                for (k, o) in ctl.chunks_exact(4).zip(&mut vel[out]) {
+                for (k, o) in ctl.chunks_exact(4).zip(&mut vel[out.clone()]) {
                     *o = hermite(&dh, k[0], k[1], k[2], k[3]) * rate;
                 }
+            }
+            if ROTATIONS {
+                normalize(values, velocities.as_deref_mut(), out);
             }
             continue;
         }
@@ -836,5 +842,18 @@ pub(crate) fn sample(
                 vel[out.start + c] = hermite(&rows.dh, k[0], k[1], k[2], k[3]) * rows.rate;
             }
         }
+        if ROTATIONS {
+            normalize(values, velocities.as_deref_mut(), out);
+        }
     }
+}
+
+/// Normalize the rotation block at planes `out` (and its velocities).
+#[inline(always)]
+fn normalize(values: &mut [f32x8], vel: Option<&mut [f32x8]>, out: std::ops::Range<usize>) {
+    fn block(v: &mut [f32x8], out: std::ops::Range<usize>) -> &mut [f32x8; 4] {
+        (&mut v[out]).try_into().expect("4 planes")
+    }
+    let vel = vel.map(|v| block(v, out.clone()));
+    crate::kernel::normalize_block(block(values, out), vel);
 }
