@@ -585,7 +585,7 @@ impl LooseState {
     /// [`Self::load_inline`] for real segment `seg` (window `[ws, we)`) of
     /// a lane with `N` components, no ease and no step, and keys `k` in
     /// f32: what forward playback loads nearly every time, in straight-line
-    /// code (two bounds checks).
+    /// code (one bounds check each for the block, the keys and the controls).
     #[inline(always)]
     fn load_plain<const N: usize>(
         &mut self,
