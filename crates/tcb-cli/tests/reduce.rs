@@ -66,6 +66,15 @@ fn reduce_ok(input: &Path, out: &Path, extra: &[&str]) -> Output {
 
 /// `reduced: tracks T, keys K0 -> K1, values V0 -> V1, bytes B0 -> B1,
 /// max error e (METRIC, joint J, time t)`, its numbers.
+/// `tcb reduce` of the first 240 frames of the CMU clip into `name` with
+/// `extra`: the output file, the run, and the summary (shell metric).
+fn reduce_short(name: &str, extra: &[&str]) -> (PathBuf, Output, [f64; 8]) {
+    let out = dir().join(name);
+    let o = reduce_ok(&short_cmu(240), &out, extra);
+    let numbers = summary(&String::from_utf8_lossy(&o.stdout), "shell");
+    (out, o, numbers)
+}
+
 fn summary(stdout: &str, metric: &str) -> [f64; 8] {
     let line = stdout.lines().last().unwrap();
     let rest = line.strip_prefix("reduced: tracks ").expect(line);
@@ -89,11 +98,9 @@ fn summary(stdout: &str, metric: &str) -> [f64; 8] {
 
 #[test]
 fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
-    let input = short_cmu(240);
-    let out = dir().join("short.json");
-    let o = reduce_ok(&input, &out, &["--tolerance", "0.05"]);
+    let (out, o, [tracks, k0, k1, v0, v1, b0, b1, e]) =
+        reduce_short("short.json", &["--tolerance", "0.05"]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
-    let [tracks, k0, k1, v0, v1, b0, b1, e] = summary(&stdout, "shell");
     assert_eq!(tracks, 32.0);
     assert_eq!(k0, 32.0 * 240.0);
     assert!(k1 < k0 && v1 < v0 && b1 < b0, "{stdout}");
@@ -127,11 +134,8 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
 /// no note is printed.
 #[test]
 fn a_reduction_keeping_most_keys_stays_on_the_grid() {
-    let input = short_cmu(240);
-    let out = dir().join("short-default.json");
-    let o = reduce_ok(&input, &out, &[]);
+    let (_, o, [_, _, _, _, _, b0, b1, _]) = reduce_short("short-default.json", &[]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
-    let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
     assert!(b1 < b0, "{stdout}");
     assert!(!stderr(&o).contains("more bytes"), "{}", stderr(&o));
 }
@@ -142,11 +146,9 @@ fn a_reduction_keeping_most_keys_stays_on_the_grid() {
 /// so on stderr; the summary line is the contract's.
 #[test]
 fn a_reduction_that_compiles_larger_says_so() {
-    let input = short_cmu(240);
-    let out = dir().join("short-tight.json");
-    let o = reduce_ok(&input, &out, &["--tolerance", "1.087e-4"]);
+    let (_, o, [_, _, _, _, _, b0, b1, _]) =
+        reduce_short("short-tight.json", &["--tolerance", "1.087e-4"]);
     let stdout = String::from_utf8(o.stdout.clone()).unwrap();
-    let [_, _, _, _, _, b0, b1, _] = summary(&stdout, "shell");
     assert!(b1 > b0, "{stdout}");
     let note = format!("compiles to more bytes than the input ({b1} against {b0})");
     assert!(stderr(&o).contains(&note), "{}", stderr(&o));

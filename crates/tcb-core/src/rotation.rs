@@ -122,8 +122,7 @@ impl SquadSegment {
 /// Squad (or slerp, as squad with `a = q0`, `b = q1`) at `s`, normalized, and
 /// the derivative of the normalized curve with respect to `s`.
 fn unit_with_derivative(c: &[f64; crate::squad::CONTROLS], s: f64) -> (DQuat, DVec4) {
-    let (q, dq) = crate::squad::squad_with_derivative(c, s);
-    let (q, dq) = crate::quat::normalize(q, Some(dq));
+    let (q, dq) = crate::squad::unit(c, s, true);
     (
         DQuat::from_array(q),
         DVec4::from_array(dq.expect("asked for")),

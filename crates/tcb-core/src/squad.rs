@@ -121,6 +121,19 @@ pub fn squad_with_derivative<L: Lane>(c: &[L; CONTROLS], s: L) -> ([L; 4], [L; 4
     (q, dq)
 }
 
+/// [`squad`] at `s` normalized, and with `derivative` the derivative of the
+/// normalized curve with respect to `s` ([`crate::quat::normalize`]): what
+/// the reference samples and the runtime's exact path evaluates.
+#[inline(always)]
+pub fn unit<L: Lane>(c: &[L; CONTROLS], s: L, derivative: bool) -> ([L; 4], Option<[L; 4]>) {
+    if derivative {
+        let (q, dq) = squad_with_derivative(c, s);
+        crate::quat::normalize(q, Some(dq))
+    } else {
+        crate::quat::normalize(squad(c, s), None)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -253,9 +253,10 @@ pub struct CompileOptions {
     pub quantize: bool,
     /// Evaluate every squad (and slerp) segment's velocity by squad's own
     /// formula in f64, as the kernel does where the cubic misses, instead
-    /// of by the cubic that plays its values. The cubic's velocity is within
-    /// 5e-5 of the rotation's speed; this one is the reference's to about
-    /// 1e-7, for tools that print or compare velocities (`tcb sample
+    /// of by the cubic that plays its values. The cubic's velocity is
+    /// checked at 17 points of each segment to 5e-5 of the rotation's
+    /// fastest component (1.5e-4 off in one CMU component of 0.15); this
+    /// one is the reference's to about 1e-7, for tools that print or compare velocities (`tcb sample
     /// --velocity`). Instances without velocities are unchanged; instances
     /// with velocities run squad in f64 (values and velocities) on every such
     /// segment, and the clip stores its squad controls (about 1 KB per block
@@ -535,8 +536,7 @@ fn fitted_tangents(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4]) -> [[f32; 4]; 4] {
     let mut rhs = [[0.0f64; 2]; 4];
     for j in 1..POINTS {
         let s = j as f64 / POINTS as f64;
-        let (q, _) =
-            tcb_core::quat::normalize(tcb_core::squad::squad_with_derivative(c, s).0, None);
+        let (q, _) = tcb_core::squad::unit(c, s, false);
         let h = hermite_basis(s);
         a11 += h[2] * h[2];
         a12 += h[2] * h[3];
@@ -627,10 +627,8 @@ fn cubic_holds(
     };
     for j in 0..=16 {
         let s = j as f64 / 16.0;
-        let (q, dq) = tcb_core::squad::squad_with_derivative(c, a + (b - a) * s);
-        let dq = dq.map(|x| x * (b - a));
-        let (q, dq) = tcb_core::quat::normalize(q, Some(dq));
-        let dq = dq.expect("asked for");
+        let (q, dq) = tcb_core::squad::unit(c, a + (b - a) * s, true);
+        let dq = dq.expect("asked for").map(|x| x * (b - a));
         let (h, dh) = (hermite_basis(s as f32), hermite_basis_derivative(s as f32));
         let p = ctl.map(|k| hermite(&h, k[0], k[1], k[2], k[3]));
         let dp = ctl.map(|k| hermite(&dh, k[0], k[1], k[2], k[3]));
@@ -889,19 +887,18 @@ impl Clip {
                 let split: Vec<(TimeGrid, RotationControls)> = hq_rows[g]
                     .iter()
                     .map(|(_, rot)| {
-                        if rot.exact.iter().all(Option::is_none) {
+                        // Loose pieces play their cubic's velocity: not
+                        // with `exact_velocities`.
+                        if rot.exact.iter().all(Option::is_none) || options.exact_velocities {
                             (grids[g].clone(), rot.clone())
                         } else {
                             split_rotation(&grids[g], rot, false)
                         }
                     })
                     .collect();
-                // Loose lanes play the pieces' cubic velocities: not with
-                // `exact_velocities` (every squad segment's stays exact).
-                if !options.exact_velocities
-                    && split
-                        .iter()
-                        .all(|(_, r)| r.exact.iter().all(Option::is_none))
+                if split
+                    .iter()
+                    .all(|(_, r)| r.exact.iter().all(Option::is_none))
                 {
                     keep[g] = false;
                     for ((track, _), (grid, rot)) in hq_rows[g].iter().zip(split) {

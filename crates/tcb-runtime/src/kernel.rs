@@ -289,23 +289,16 @@ pub(crate) fn exact_quats(
     }
 }
 
-/// Squad at `s`, and with `rate` its velocity times `rate`, normalized:
-/// the one formula of [`exact_quats`] for one lane and for four.
+/// The unit squad at `s` ([`tcb_core::squad::unit`]), and with `rate` its
+/// velocity times `rate`: for one lane and for four.
 #[inline(always)]
 fn squad_at<L: tcb_core::lane::Lane>(
     c: &[L; tcb_core::squad::CONTROLS],
     s: L,
     rate: Option<L>,
 ) -> ([L; 4], Option<[L; 4]>) {
-    use tcb_core::squad::{squad, squad_with_derivative};
-    let (v, d) = match rate {
-        Some(r) => {
-            let (v, d) = squad_with_derivative(c, s);
-            (v, Some(d.map(|x| x * r)))
-        }
-        None => (squad(c, s), None),
-    };
-    normalize(v, d)
+    let (v, d) = tcb_core::squad::unit(c, s, rate.is_some());
+    (v, d.zip(rate).map(|(d, r)| d.map(|x| x * r)))
 }
 
 /// Write the identity rotation into quaternion blocks (`reset`).

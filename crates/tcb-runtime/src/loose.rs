@@ -57,7 +57,9 @@ pub(crate) struct LooseLane {
     /// controls, as f32s (set by [`Loose::new`]).
     ctl_at: u32,
     /// No segment eases or steps: a real segment loads as
-    /// [`LooseState::load_plain`] does.
+    /// [`LooseState::load_plain`] does. Derivable from `grid` (two lengths
+    /// on a compacted grid), but kept: deriving it cost `sparse` 1.8% more
+    /// instructions, and it lies in `ctl_at`'s padding.
     plain: bool,
 }
 

@@ -673,6 +673,7 @@ fn cmu_capture_in_both_rotation_modes() {
                 assert_rows_match(&clip, time, (&got, &got_v), (&want, &want_v));
                 exact.sample(time).write_row(&mut got, Some(&mut got_v));
                 assert_rows_match(&clip, time, (&got, &got_v), (&want, &want_v));
+                // Same sign: both evaluate squad itself.
                 for (c, (g, w)) in got_v.iter().zip(&want_v).enumerate() {
                     assert!(
                         (g - w).abs() <= 1e-5 * w.abs().max(1.0),
