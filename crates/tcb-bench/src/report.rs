@@ -12,8 +12,9 @@ use std::time::Duration;
 const DENSE_CMU_BYTES_BEFORE: f64 = 5.6e6;
 
 /// The compile flags in effect: RUSTFLAGS as cargo passed them, the
-/// profile, and the SIMD target features the code was compiled for (what
-/// `wide` chooses its instructions by).
+/// profile, the SIMD target features the code was compiled for (what
+/// `wide` chooses its instructions by), and the sampling pass chosen at
+/// run time ([`tcb_runtime::isa`]).
 pub fn flags() -> String {
     let mut features = Vec::new();
     for (on, name) in [
@@ -31,9 +32,10 @@ pub fn flags() -> String {
     }
     let rustflags = env!("TCB_BENCH_RUSTFLAGS");
     format!(
-        "RUSTFLAGS=\"{rustflags}\" profile={} target-features={}",
+        "RUSTFLAGS=\"{rustflags}\" profile={} target-features={} pass={}",
         env!("TCB_BENCH_PROFILE"),
-        features.join(",")
+        features.join(","),
+        tcb_runtime::isa::isa()
     )
 }
 
