@@ -7,8 +7,7 @@
 //! panics on anything else that is wrong: a panic inside the library, or
 //! the runtime disagreeing with the scalar reference (vector channels bit
 //! for bit (as numbers: -0 equals 0), rotations within 1e-6, as `crates/tcb-runtime/tests/equivalence.rs`
-//! holds them), or the sampling passes of `tcb_runtime::isa` disagreeing
-//! with each other (bit for bit).
+//! holds them).
 
 use arbitrary::{Arbitrary, Unstructured};
 use std::sync::Arc;
@@ -221,28 +220,10 @@ fn check(clip: &tcb_core::Clip, times: &[f64], options: &tcb_runtime::CompileOpt
     let compiled = Arc::new(tcb_runtime::Clip::compile_with(clip, options));
     let n = clip.channel_count();
     let mut playing = Instance::new(compiled.clone()).with_velocities();
-    // The same playback on the baseline pass, where the CPU has another.
-    use tcb_runtime::isa::{Isa, isa, set_isa};
-    let chosen = isa();
-    let mut baseline = Instance::new(compiled.clone()).with_velocities();
     let (mut got, mut got_v) = (vec![0.0f32; n], vec![0.0f32; n]);
     let (mut want, mut want_v) = (vec![0.0f32; n], vec![0.0f32; n]);
     for &t in times {
         let pose = playing.sample(t).clone();
-        if chosen != Isa::Baseline {
-            set_isa(Isa::Baseline).expect("always available");
-            let (mut a, mut b) = ((vec![0.0; n], vec![0.0; n]), (vec![0.0; n], vec![0.0; n]));
-            baseline.sample(t).write_row(&mut b.0, Some(&mut b.1));
-            set_isa(chosen).expect("available before");
-            pose.write_row(&mut a.0, Some(&mut a.1));
-            let bits = |(v, d): (Vec<f32>, Vec<f32>)| {
-                v.iter().chain(&d).map(|x| x.to_bits()).collect::<Vec<_>>()
-            };
-            assert!(
-                bits(a) == bits(b),
-                "the {chosen} pass differs from the baseline pass at {t}"
-            );
-        }
         let mut fresh = Instance::new(compiled.clone()).with_velocities();
         assert!(
             same(pose.as_slice(), fresh.sample(t).as_slice()),

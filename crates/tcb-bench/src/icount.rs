@@ -148,14 +148,7 @@ pub struct Counts {
 /// Count scenario `name` by running `exe --icount-pass NAME --bvh BVH`
 /// under callgrind, or with `clip` the pass over that file
 /// (`--icount-pass NAME --clip FILE`, as `--clip` times it).
-/// `isa` is the sampling pass the counted process runs (`--isa`).
-pub fn count(
-    exe: &Path,
-    name: &str,
-    bvh: &Path,
-    clip: Option<&Path>,
-    isa: tcb_runtime::isa::Isa,
-) -> Result<Counts, String> {
+pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<Counts, String> {
     let toggle = format!("--toggle-collect={}", toggle(name));
     let out = std::env::temp_dir().join(format!(
         "tcb-icount-{}-{name}.callgrind",
@@ -167,7 +160,7 @@ pub fn count(
         .arg(format!("--callgrind-out-file={}", out.display()))
         .arg(&toggle)
         .arg(exe)
-        .args(["--isa", isa.name(), "--icount-pass", name, "--bvh"])
+        .args(["--icount-pass", name, "--bvh"])
         .arg(bvh)
         .args(
             clip.map(|c| [std::ffi::OsStr::new("--clip"), c.as_os_str()])
@@ -220,24 +213,8 @@ pub fn parse(text: &str) -> Option<Counts> {
     })
 }
 
-/// The sampling pass saved counts were taken with: their `isa`, or
-/// `baseline` in files from before there was a choice.
-pub fn saved_isa(saved: &serde_json::Value) -> Result<tcb_runtime::isa::Isa, String> {
-    match saved.get("isa") {
-        None => Ok(tcb_runtime::isa::Isa::Baseline),
-        Some(v) => v
-            .as_str()
-            .and_then(tcb_runtime::isa::Isa::from_name)
-            .ok_or_else(|| format!("saved counts: unknown isa {v}")),
-    }
-}
-
-/// Counts of sampling pass `isa` as the saved JSON.
-pub fn to_json(
-    counts: &BTreeMap<String, Counts>,
-    note: &str,
-    isa: tcb_runtime::isa::Isa,
-) -> String {
+/// Counts as the saved JSON.
+pub fn to_json(counts: &BTreeMap<String, Counts>, note: &str) -> String {
     let scenarios: serde_json::Map<String, serde_json::Value> = counts
         .iter()
         .map(|(k, c)| {
@@ -252,7 +229,7 @@ pub fn to_json(
             )
         })
         .collect();
-    let doc = serde_json::json!({ "note": note, "isa": isa.name(), "scenarios": scenarios });
+    let doc = serde_json::json!({ "note": note, "scenarios": scenarios });
     serde_json::to_string_pretty(&doc).expect("plain JSON") + "\n"
 }
 
@@ -336,15 +313,8 @@ mod tests {
         let saved: serde_json::Value = serde_json::from_str(&to_json(
             &BTreeMap::from([("wide".to_string(), c(100_000))]),
             "",
-            tcb_runtime::isa::Isa::Avx2,
         ))
         .unwrap();
-        // The pass is saved; files from before the choice are baseline.
-        assert_eq!(saved_isa(&saved), Ok(tcb_runtime::isa::Isa::Avx2));
-        assert_eq!(
-            saved_isa(&serde_json::json!({ "scenarios": {} })),
-            Ok(tcb_runtime::isa::Isa::Baseline)
-        );
         let now = |i| BTreeMap::from([("wide".to_string(), c(i))]);
         assert!(check(&now(100_000), &saved, 2.0).1);
         assert!(check(&now(101_900), &saved, 2.0).1);

@@ -26,24 +26,6 @@ pub mod scenarios;
 
 pub use baseline::Baseline;
 
-/// An `--isa` argument: `None` for `auto` (what [`tcb_runtime::isa::isa`]
-/// chooses), else the named sampling pass; an error if the name is
-/// unknown or this CPU cannot run it.
-pub fn parse_isa(name: &str) -> Result<Option<tcb_runtime::isa::Isa>, String> {
-    use tcb_runtime::isa::Isa;
-    if name == "auto" {
-        return Ok(None);
-    }
-    let isa = Isa::from_name(name).ok_or_else(|| {
-        let names: Vec<_> = Isa::ALL.iter().map(|i| i.name()).collect();
-        format!("--isa {name}: one of auto, {}", names.join(", "))
-    })?;
-    if !isa.available() {
-        return Err(format!("--isa {name}: this CPU cannot run it"));
-    }
-    Ok(Some(isa))
-}
-
 /// A small deterministic generator (xorshift64*), so scenarios are the same
 /// on every machine.
 #[derive(Clone, Debug)]

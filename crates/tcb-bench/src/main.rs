@@ -72,11 +72,6 @@ struct Args {
     /// Largest allowed growth of a scenario's instruction count, percent.
     #[arg(long, value_name = "PCT", default_value_t = 2.0)]
     icount_max_growth: f64,
-    /// The sampling pass to time or count (tcb_runtime::isa): auto (the
-    /// best this CPU runs; with --icount-check, the saved counts' pass),
-    /// baseline (the build's own target features) or avx2.
-    #[arg(long, value_name = "ISA", default_value = "auto")]
-    isa: String,
     /// Run one scenario's pass and exit (what --icount runs under valgrind).
     #[arg(long, value_name = "NAME", hide = true)]
     icount_pass: Option<String>,
@@ -136,28 +131,6 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         return Err("--icount-max-growth must be a number >= 0".into());
     }
     let saved = read_json(args.icount_check.as_deref())?;
-    // The pass to count: as asked, else as saved, else the best here.
-    let isa = match (tcb_bench::parse_isa(&args.isa)?, &saved) {
-        (Some(i), _) => i,
-        (None, Some(s)) => icount::saved_isa(s)?,
-        (None, None) => tcb_runtime::isa::detect(),
-    };
-    if let Some(s) = &saved {
-        let then = icount::saved_isa(s)?;
-        if then != isa {
-            return Err(
-                format!("the saved counts are of the {then} pass, not {isa} (--isa)").into(),
-            );
-        }
-        if !isa.available() {
-            // Another machine's gate: nothing here can be compared with it.
-            println!(
-                "tcb-bench --icount: skipped: the saved counts are of the {isa} pass, which this CPU cannot run"
-            );
-            return Ok(true);
-        }
-    }
-    tcb_runtime::isa::set_isa(isa)?;
     // The bundled scenarios, or with --clip the user's files, each named by
     // its file stem as the report names it.
     let scratch = std::env::temp_dir().join(format!("tcb-icount-{}", std::process::id()));
@@ -200,7 +173,7 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     println!("flags: {}", report::flags());
     for (name, clip) in &jobs {
         let name = name.as_str();
-        let c = icount::count(&exe, name, &args.bvh, clip.as_deref(), isa)?;
+        let c = icount::count(&exe, name, &args.bvh, clip.as_deref())?;
         println!(
             "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses  {:>9} bytes",
             c.instructions, c.l1_misses, c.ll_misses, c.bytes
@@ -210,12 +183,12 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     let _ = std::fs::remove_dir_all(&scratch);
     if let Some(path) = &args.icount_save {
         let note = format!(
-            "tcb-bench --icount ({}, {}); regenerate with: cargo run --release -p tcb-bench -- --icount --isa {isa} --icount-save {}",
+            "tcb-bench --icount ({}, {}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
             report::flags(),
             env!("TCB_BENCH_RUSTC"),
             path.display()
         );
-        tcb_io::write_atomically(path, icount::to_json(&counts, &note, isa).as_bytes())?;
+        tcb_io::write_atomically(path, icount::to_json(&counts, &note).as_bytes())?;
     }
     let mut ok = true;
     if let Some(saved) = &saved {
@@ -240,9 +213,6 @@ instruction counts against the saved ones:"
 }
 
 fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
-    if let Some(isa) = tcb_bench::parse_isa(&args.isa)? {
-        tcb_runtime::isa::set_isa(isa)?;
-    }
     if let Some(name) = &args.icount_pass {
         if icount::EXTRA.contains(&name.as_str()) {
             icount::run_extra(name, &args.bvh)?;

@@ -12,9 +12,8 @@ use std::time::Duration;
 const DENSE_CMU_BYTES_BEFORE: f64 = 5.6e6;
 
 /// The compile flags in effect: RUSTFLAGS as cargo passed them, the
-/// profile, the SIMD target features the code was compiled for (what
-/// `wide` chooses its instructions by), and the sampling pass chosen at
-/// run time ([`tcb_runtime::isa`]).
+/// profile, and the SIMD target features the code was compiled for (what
+/// `wide` chooses its instructions by).
 pub fn flags() -> String {
     let mut features = Vec::new();
     for (on, name) in [
@@ -32,10 +31,9 @@ pub fn flags() -> String {
     }
     let rustflags = env!("TCB_BENCH_RUSTFLAGS");
     format!(
-        "RUSTFLAGS=\"{rustflags}\" profile={} target-features={} pass={}",
+        "RUSTFLAGS=\"{rustflags}\" profile={} target-features={}",
         env!("TCB_BENCH_PROFILE"),
-        features.join(","),
-        tcb_runtime::isa::isa()
+        features.join(",")
     )
 }
 

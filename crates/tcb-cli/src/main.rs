@@ -178,10 +178,6 @@ struct BenchArgs {
     /// glTF: the animation, by name or index (default: the first).
     #[arg(long, value_name = "NAME_OR_INDEX")]
     animation: Option<String>,
-    /// The sampling pass: auto (the best this CPU runs), baseline (the
-    /// build's own target features) or avx2 (tcb_runtime::isa).
-    #[arg(long, value_name = "ISA", default_value = "auto")]
-    isa: String,
 }
 
 #[derive(Args)]
@@ -644,9 +640,6 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
     }
     if args.rounds == 0 || args.threads == Some(0) {
         return Err("--rounds and --threads must be at least 1".into());
-    }
-    if let Some(isa) = tcb_bench::parse_isa(&args.isa)? {
-        tcb_runtime::isa::set_isa(isa)?;
     }
     let options = tcb_bench::scenarios::FileOptions {
         fps: args.fps,

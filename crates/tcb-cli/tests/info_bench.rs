@@ -102,15 +102,12 @@ fn bench_reports_ns_per_joint_bytes_and_flags() {
         "--threads",
         "2",
         "--quantize",
-        "--isa",
-        "baseline",
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
     for want in [
         "build:",
         "RUSTFLAGS=",
-        "pass=baseline",
         "ns per joint",
         "ns per channel",
         "bytes:",
@@ -130,7 +127,6 @@ fn bench_and_info_refuse_bad_input() {
         vec!["bench", &bounce, "--instances", "0"],
         vec!["bench", &bounce, "--threads", "0"],
         vec!["bench", &bounce, "--rotation", "hermite"],
-        vec!["bench", &bounce, "--isa", "sse9"],
         vec!["bench", "/no/such/file.json"],
         vec!["info", "/no/such/file.bvh"],
         vec!["info", &bounce, "--animation", "0"],

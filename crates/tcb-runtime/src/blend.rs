@@ -186,27 +186,8 @@ pub fn blend(
             return Err(BlendError::Mask { layer: i });
         }
     }
-    match crate::isa::Avx2::chosen() {
-        Some(a) => a.run(
-            #[inline(always)]
-            || blend_planes(out, &layout, layers, masks),
-        ),
-        None => blend_planes(out, &layout, layers, masks),
-    }
-    Ok(())
-}
-
-/// [`blend`] once its arguments are checked, instantiated once per
-/// [`crate::isa::Isa`].
-#[inline(always)]
-fn blend_planes(
-    out: &mut Pose,
-    layout: &PoseLayout,
-    layers: &[(&Pose, f32)],
-    masks: Option<&[&BlendMask]>,
-) {
     let Some(&(base, _)) = layers.first() else {
-        return;
+        return Ok(());
     };
     let with_velocity = out.velocities.is_some() && layers.iter().all(|l| l.0.velocities.is_some());
     let Pose {
@@ -231,7 +212,7 @@ fn blend_planes(
     };
 
     // Vectors: sum w_i x_i, then divide by sum w_i.
-    for r in vector_runs(layout) {
+    for r in vector_runs(&layout) {
         out_v[r.clone()].fill(zero);
         for (i, (pose, _)) in layers.iter().enumerate() {
             let x = &pose.values[r.clone()];
@@ -303,6 +284,7 @@ fn blend_planes(
             }
         }
     }
+    Ok(())
 }
 
 /// Add an additive layer in place: `pose` ⊕ `weight` (`layer` ⊖ `reference`),
@@ -343,27 +325,6 @@ pub fn add(
     {
         return Err(BlendError::Mask { layer: 0 });
     }
-    match crate::isa::Avx2::chosen() {
-        Some(a) => a.run(
-            #[inline(always)]
-            || add_planes(pose, &layout, layer, reference, weight, mask),
-        ),
-        None => add_planes(pose, &layout, layer, reference, weight, mask),
-    }
-    Ok(())
-}
-
-/// [`add`] once its arguments are checked, instantiated once per
-/// [`crate::isa::Isa`].
-#[inline(always)]
-fn add_planes(
-    pose: &mut Pose,
-    layout: &PoseLayout,
-    layer: &Pose,
-    reference: &Pose,
-    weight: f32,
-    mask: Option<&BlendMask>,
-) {
     let w_at = |b: usize| {
         let w = f32x8::splat(weight);
         mask.map_or(w, |m| w * m.lanes[b])
@@ -374,7 +335,7 @@ fn add_planes(
         Some(l) if pose.velocities.is_some() => Some((l, reference.velocities.as_ref())),
         _ => None,
     };
-    for b in vector_runs(layout).flatten() {
+    for b in vector_runs(&layout).flatten() {
         let w = w_at(b);
         pose.values[b] += w * (layer.values[b] - reference.values[b]);
         if let (Some((l, r)), Some(v)) = (vel, pose.velocities.as_mut()) {
@@ -415,4 +376,5 @@ fn add_planes(
             }
         }
     }
+    Ok(())
 }

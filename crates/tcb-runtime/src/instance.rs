@@ -223,39 +223,6 @@ pub(crate) fn sample_into(
     pose: &mut Pose,
     caches: &mut [KeyCache],
 ) {
-    match crate::isa::Avx2::chosen() {
-        Some(avx2) => avx2.run(
-            #[inline(always)]
-            || {
-                sample_body(
-                    clip,
-                    time,
-                    cursors,
-                    loose,
-                    loose_rot,
-                    pose,
-                    caches,
-                    Some(avx2),
-                )
-            },
-        ),
-        None => sample_body(clip, time, cursors, loose, loose_rot, pose, caches, None),
-    }
-}
-
-/// [`sample_into`]'s body, instantiated once per [`crate::isa::Isa`].
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn sample_body(
-    clip: &Clip,
-    time: f64,
-    cursors: &mut [Cursor],
-    loose: &mut LooseState,
-    loose_rot: &mut LooseState,
-    pose: &mut Pose,
-    caches: &mut [KeyCache],
-    avx2: Option<crate::isa::Avx2>,
-) {
     let Pose {
         values, velocities, ..
     } = pose;
@@ -325,17 +292,10 @@ fn sample_body(
         }
     }
     if clip.loose.blocks > 0 {
-        crate::loose::sample::<false>(
-            &clip.loose,
-            loose,
-            time,
-            values,
-            velocities.as_deref_mut(),
-            avx2,
-        );
+        crate::loose::sample::<false>(&clip.loose, loose, time, values, velocities.as_deref_mut());
     }
     let r = &clip.loose_rot;
     if r.blocks > 0 {
-        crate::loose::sample::<true>(r, loose_rot, time, values, velocities.as_deref_mut(), avx2);
+        crate::loose::sample::<true>(r, loose_rot, time, values, velocities.as_deref_mut());
     }
 }

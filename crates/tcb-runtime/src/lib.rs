@@ -36,15 +36,12 @@
 //! How it works: see [`clip`] (the layout), `grid.rs` (the per-frame basis
 //! and the sentinels that keep the kernels free of per-channel branches).
 
-// Denied rather than forbidden for one block: `isa.rs` calls the AVX2
-// instance of the sampling pass once the CPU is known to have AVX2 and FMA.
-#![deny(unsafe_code)]
+#![forbid(unsafe_code)]
 
 pub mod blend;
 pub mod clip;
 pub(crate) mod grid;
 mod instance;
-pub mod isa;
 mod kernel;
 mod loose;
 pub mod pose;

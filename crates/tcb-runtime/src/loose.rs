@@ -793,41 +793,7 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
 ///
 /// `ROTATIONS`: the lanes are rotations, each block normalized
 /// ([`crate::kernel::normalize_block`]) as soon as it is evaluated.
-/// With `avx2`, compiled for it ([`crate::isa`]); else out of line.
-#[inline(always)]
 pub(crate) fn sample<const ROTATIONS: bool>(
-    loose: &Loose,
-    st: &mut LooseState,
-    time: f64,
-    values: &mut [f32x8],
-    velocities: Option<&mut [f32x8]>,
-    avx2: Option<crate::isa::Avx2>,
-) {
-    match avx2 {
-        Some(a) => a.run(
-            #[inline(always)]
-            || sample_body::<ROTATIONS>(loose, st, time, values, velocities),
-        ),
-        None => sample_baseline::<ROTATIONS>(loose, st, time, values, velocities),
-    }
-}
-
-/// [`sample`]'s baseline pass (out of line, as it always was: inlined
-/// into the pass it costs `sparse-rotations` 3% more instructions).
-#[inline(never)]
-fn sample_baseline<const ROTATIONS: bool>(
-    loose: &Loose,
-    st: &mut LooseState,
-    time: f64,
-    values: &mut [f32x8],
-    velocities: Option<&mut [f32x8]>,
-) {
-    sample_body::<ROTATIONS>(loose, st, time, values, velocities)
-}
-
-/// [`sample`]'s body, instantiated once per [`crate::isa::Isa`].
-#[inline(always)]
-fn sample_body<const ROTATIONS: bool>(
     loose: &Loose,
     st: &mut LooseState,
     time: f64,
