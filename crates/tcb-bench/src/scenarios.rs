@@ -9,6 +9,7 @@
 //! | `sparse-rotations` | 128 rotations (64 `hermite`, 64 `squad`), each with its own random key times |
 //! | `character-quantized` | `character-hermite` compiled with 16-bit controls |
 //! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
+//! | `sparse-seek` | `sparse` at random times, as many as `sparse` (every frame a seek of every lane) |
 //! | `character-reduced` | the CMU clip (hermite) reduced by `tcb reduce` at the default shell tolerance, as `character` |
 
 use crate::Rng;
@@ -436,6 +437,20 @@ pub fn wide() -> Scenario {
 
 /// `sparse`: 500 scalar tracks, each with 10 to 40 random key times in [0, 2] s.
 pub fn sparse() -> Scenario {
+    Scenario::new("sparse", sparse_clip(), frames(2.0, 60.0))
+}
+
+/// `sparse-seek`: [`sparse`]'s clip at as many random times, so that every
+/// frame seeks every lane (scrubbing a timeline of authored curves).
+pub fn sparse_seek() -> Scenario {
+    let mut rng = Rng(0x5eec5);
+    let times = (0..frames(2.0, 60.0).len())
+        .map(|_| rng.range(0.0, 2.0))
+        .collect();
+    Scenario::new("sparse-seek", sparse_clip(), times)
+}
+
+fn sparse_clip() -> tcb_core::Clip {
     let mut rng = Rng(0x5ba5e);
     let tracks = (0..500)
         .map(|i| {
@@ -446,8 +461,7 @@ pub fn sparse() -> Scenario {
             }
         })
         .collect();
-    let clip = tcb_core::Clip::new("sparse", tracks).expect("unique track names");
-    Scenario::new("sparse", clip, frames(2.0, 60.0))
+    tcb_core::Clip::new("sparse", tracks).expect("unique track names")
 }
 
 /// 10 to 40 random key times in [0, 2] s, the first at 0 and the last at 2.
@@ -517,7 +531,7 @@ pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
 }
 
 /// The scenario names, in report order.
-pub const NAMES: [&str; 9] = [
+pub const NAMES: [&str; 10] = [
     "character-hermite",
     "character-squad",
     "character-quantized",
@@ -526,6 +540,7 @@ pub const NAMES: [&str; 9] = [
     "sparse",
     "sparse-rotations",
     "seek",
+    "sparse-seek",
     "character-reduced",
 ];
 
@@ -543,6 +558,7 @@ pub fn named(bvh: &Path, want: impl Fn(&str) -> bool) -> Result<Vec<Scenario>, t
             "sparse" => sparse(),
             "sparse-rotations" => sparse_rotations(),
             "seek" => seek(bvh)?,
+            "sparse-seek" => sparse_seek(),
             _ => character_reduced(bvh)?,
         });
     }
