@@ -172,10 +172,7 @@ pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<
             format!("cannot run valgrind ({e}); install it (apt-get install -y valgrind)")
         })?;
     if !status.status.success() {
-        return Err(format!(
-            "valgrind on {name} failed: {}",
-            String::from_utf8_lossy(&status.stderr)
-        ));
+        return Err(failure(name, &String::from_utf8_lossy(&status.stderr)));
     }
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let _ = std::fs::remove_file(&out);
@@ -187,6 +184,28 @@ pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<
         .and_then(|b| b.trim().parse().ok())
         .ok_or_else(|| format!("the pass of {name} printed no bytes"))?;
     Ok(counts)
+}
+
+/// What to say when valgrind fails on scenario `name` with `stderr`: one
+/// line where valgrind met an instruction it cannot decode (AVX-512, which
+/// a `-C target-cpu=native` build uses on CPUs that have it), else all of
+/// valgrind's output.
+pub fn failure(name: &str, stderr: &str) -> String {
+    if stderr.contains("unhandled instruction bytes") {
+        let why = if cfg!(target_feature = "avx512f") {
+            "; valgrind does not decode AVX-512"
+        } else {
+            ""
+        };
+        format!(
+            "valgrind cannot run the pass of {name}: it stops at an instruction it does not \
+             decode (this build: {}{why}). Count the default build, or one built with \
+             RUSTFLAGS=\"-C target-cpu=x86-64-v3\" (AVX2 and FMA)",
+            crate::report::flags()
+        )
+    } else {
+        format!("valgrind on {name} failed: {stderr}")
+    }
 }
 
 /// Totals from a callgrind output file (its `events:` and `summary:` lines).
@@ -286,6 +305,20 @@ pub fn check(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn undecodable_instructions_are_explained_in_one_line() {
+        let stderr = "==1== Callgrind\nvex amd64->IR: unhandled instruction bytes: 0x62 0xD1\n\
+                      ==1== valgrind: Unrecognised instruction at address 0x33d790.\n";
+        let m = failure("wide", stderr);
+        assert!(
+            m.contains("cannot run the pass of wide") && m.contains("x86-64-v3"),
+            "{m}"
+        );
+        assert_eq!(m.lines().count(), 1);
+        let other = failure("wide", "==1== some other failure\n");
+        assert!(other.contains("some other failure"), "{other}");
+    }
 
     #[test]
     fn parses_callgrind_totals() {
