@@ -231,8 +231,9 @@ pub(crate) struct Loose {
     /// time `t_k`, ordered by that time.
     order: Vec<[u32; 2]>,
     /// A forward step longer than this seeks rather than streams: the
-    /// span in which forward playback passes, on average, more entries of
-    /// `order` than a seek loads lanes (twice the lanes, plus 64).
+    /// span in which forward playback passes, on average, twice as many
+    /// entries of `order` as there are lanes, plus 64 (a seek loads each
+    /// lane once; streaming that far would cost more).
     seek_after: f64,
 }
 
