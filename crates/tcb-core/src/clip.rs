@@ -1,6 +1,7 @@
 //! A clip: named tracks of any kind, sampled together into flat rows of
 //! `f32` channels (the columns of `tcb sample`).
 
+use crate::params::TrackSettings;
 use crate::rotation::RotationTrack;
 use crate::track::Track;
 use crate::vector::Value;
@@ -100,6 +101,17 @@ impl TrackData {
             TrackData::Vec3(t) => t.times(),
             TrackData::Vec4(t) => t.times(),
             TrackData::Quat(t) => t.times(),
+        }
+    }
+
+    /// Its settings.
+    pub fn settings(&self) -> &TrackSettings {
+        match self {
+            TrackData::Scalar(t) => t.settings(),
+            TrackData::Vec2(t) => t.settings(),
+            TrackData::Vec3(t) => t.settings(),
+            TrackData::Vec4(t) => t.settings(),
+            TrackData::Quat(t) => t.settings(),
         }
     }
 

@@ -41,6 +41,41 @@ pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 
     (q, qv)
 }
 
+/// A rotation key made unit length as a track stores it: `p / |p|` with
+/// `|p| = sqrt(x x + y y + z z + w w)` summed in that order and each
+/// component divided (not multiplied by a reciprocal). [`crate::RotationTrack`]
+/// normalizes its keys with it in `f64`, and a packed clip's decoder
+/// (`tcb_runtime::pack`) with it in `f64x4`, so both give the same bits.
+///
+/// ```
+/// assert_eq!(tcb_core::quat::unit_key([0.0f64, 0.0, 3.0, 4.0]), [0.0, 0.0, 0.6, 0.8]);
+/// ```
+#[inline(always)]
+pub fn unit_key<L: Lane>(p: [L; 4]) -> [L; 4] {
+    let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
+    p.map(|x| x / len)
+}
+
+/// The `w` of a unit quaternion from its `x y z` (`w >= 0`), as a packed
+/// clip stores three components of a rotation: `sqrt(max(0, 1 - |xyz|^2))`
+/// in `f64`, rounded to `f32`. The one copy the encoder and the decoder use.
+///
+/// ```
+/// assert_eq!(tcb_core::quat::rebuild_w(0.6, 0.0, 0.0), 0.8);
+/// ```
+#[inline]
+pub fn rebuild_w(x: f32, y: f32, z: f32) -> f32 {
+    rebuild_w_lanes(f64::from(x), f64::from(y), f64::from(z)) as f32
+}
+
+/// [`rebuild_w`] before its rounding to `f32`, on any lane type (the
+/// decoder runs it on `f64x4`).
+#[inline(always)]
+pub fn rebuild_w_lanes<L: Lane>(x: L, y: L, z: L) -> L {
+    let s = L::of(1.0) - (x * x + y * y + z * z);
+    L::select(s.lt(L::of(0.0)), L::of(0.0), s).sqrt()
+}
+
 /// The angular velocity of a unit quaternion `q` with component derivative
 /// `dq`, as a vector in the frame `q` maps into: `2 vec(dq conj(q))`
 /// (radians per unit of time).

@@ -200,7 +200,7 @@ impl RotationTrack {
             if len == 0.0 || !len.is_finite() {
                 return Err(TrackError::ZeroQuaternion { key });
             }
-            let mut v = v / len;
+            let mut v = DVec4::from_array(crate::quat::unit_key(v.to_array()));
             if settings.hemisphere == Hemisphere::Nearest
                 && let Some(prev) = qs.last()
                 && DVec4::from(*prev).dot(v) < 0.0

@@ -31,6 +31,7 @@
 use crate::grid::TimeGrid;
 use crate::kernel::{HQ_STRIDE, KEY_STRIDE, SQ_STRIDE};
 use crate::loose::{Loose, LooseLane};
+use crate::pack::Packed;
 use crate::pose::PoseLayout;
 use crate::store::KeyStore;
 use std::collections::HashMap;
@@ -241,6 +242,9 @@ pub struct Clip {
     pub(crate) time_range: Option<(f64, f64)>,
     /// Per track: the bound on the error quantization adds (0 without).
     pub(crate) quant_error: Vec<f32>,
+    /// The packed clip it was compiled from (`crate::pack`), whose stream
+    /// its group decodes.
+    pub(crate) packed: Option<Arc<Packed>>,
 }
 
 /// Choices made when a clip is compiled.
@@ -836,6 +840,16 @@ impl Clip {
     /// assert!(small.quantization_error(hips).unwrap() < 1e-3); // in the clip's units
     /// ```
     pub fn compile_with(source: &tcb_core::Clip, options: &CompileOptions) -> Self {
+        Clip::compile_impl(source, options, false)
+    }
+
+    /// [`compile_with`](Self::compile_with); with `groups_only`, small
+    /// groups stay groups rather than loose lanes (a packed clip's one group).
+    pub(crate) fn compile_impl(
+        source: &tcb_core::Clip,
+        options: &CompileOptions,
+        groups_only: bool,
+    ) -> Self {
         let mut group_of: HashMap<GridKey, usize> = HashMap::new();
         let mut grids: Vec<TimeGrid> = Vec::new();
         // Per group: vector channel rows (track, component) and rotation rows.
@@ -883,6 +897,9 @@ impl Clip {
             // rotation with exact segments (see `rotation_controls`) goes
             // as the cubic pieces of `split_rotation`, or stays too.
             let resets = [grids[g].pre, grids[g].post].contains(&Extrapolation::Reset);
+            if groups_only {
+                continue;
+            }
             if vec_rows[g].is_empty() && !hq_rows[g].is_empty() && hq_rows[g].len() < 8 && !resets {
                 let split: Vec<(TimeGrid, RotationControls)> = hq_rows[g]
                     .iter()
@@ -1088,6 +1105,7 @@ impl Clip {
             loose_rot_tracks,
             time_range: source.time_range(),
             quant_error,
+            packed: None,
         }
     }
 

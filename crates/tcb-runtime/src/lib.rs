@@ -44,6 +44,7 @@ pub(crate) mod grid;
 mod instance;
 mod kernel;
 mod loose;
+pub mod pack;
 pub mod pose;
 pub mod quant;
 pub mod rig;
@@ -56,6 +57,7 @@ pub mod batch;
 pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
 pub use instance::{Instance, Playback, PlaybackError};
+pub use pack::{PackError, PackSource, PackTrack, Packed};
 
 /// The `mint` crate (feature `mint`): poses' glam values convert with
 /// `.into()`, so an engine on another glam version, nalgebra or cgmath

@@ -21,6 +21,7 @@
 //! holds 16-bit numbers; `TO` and `TI` of a plane share one range, so a
 //! `TI` equal to its `TO` quantizes to the same numbers (see `crate::quant`).
 
+use crate::pack::store::{PackCache, PackedKeys};
 use crate::quant::Quantized;
 use wide::f32x8;
 
@@ -60,6 +61,8 @@ impl<'a> Segment<'a> {
 enum Data {
     F32(Vec<f32x8>),
     Q16(Quantized),
+    /// Values only, decoded per instance (`crate::pack`).
+    Packed(Box<PackedKeys>),
 }
 
 /// One group's controls per key (see the module docs).
@@ -142,6 +145,7 @@ impl KeyStore {
             + match &self.data {
                 Data::F32(d) => std::mem::size_of_val(d.as_slice()),
                 Data::Q16(q) => q.heap_bytes(),
+                Data::Packed(p) => p.heap_bytes(),
             }
     }
 
@@ -169,6 +173,9 @@ impl KeyStore {
                 }
             }
             Data::Q16(q) => self.expanded(q, a, b, cache),
+            Data::Packed(p) => {
+                p.segment(a, b, cache.pack.as_mut().expect("a packed group's cache"))
+            }
         }
     }
 
@@ -210,8 +217,30 @@ impl KeyStore {
             valid: [0; 2],
             planes: n,
             data: vec![f32x8::ZERO; 2 * 3 * n],
+            pack: match &self.data {
+                Data::Packed(p) => Some(Box::new(p.cache())),
+                _ => None,
+            },
         }
     }
+
+    /// Sections `[P, TO, TI]` of key `k` of an f32 store (`None` otherwise).
+    pub fn f32_key(&self, k: usize) -> Option<[&[f32x8]; 3]> {
+        let Data::F32(d) = &self.data else {
+            return None;
+        };
+        let n = self.planes;
+        let [p, i] = self.at[k].map(|x| x as usize);
+        Some([&d[p..p + n], &d[p + n..p + 2 * n], &d[i..i + n]])
+    }
+
+    /// This store with its numbers replaced by `packed` (its key table
+    /// kept only for sizes).
+    pub fn set_packed(&mut self, packed: PackedKeys) {
+        self.at = Vec::new();
+        self.data = Data::Packed(Box::new(packed));
+    }
+
 }
 
 /// Two expanded keys of a quantized group (forward playback reuses the
@@ -224,6 +253,8 @@ pub(crate) struct KeyCache {
     valid: [u8; 2],
     planes: usize,
     data: Vec<f32x8>,
+    /// A packed group's decoder state.
+    pack: Option<Box<PackCache>>,
 }
 
 /// Sections of a key: `P`, `TO`, `TI`.

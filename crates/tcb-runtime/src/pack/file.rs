@@ -1,0 +1,296 @@
+//! The `.tcbc` file: a [`Packed`] clip in bytes (layout in `docs/tcbc.md`).
+//!
+//! Little-endian throughout: a 24-byte header (magic, version, length,
+//! CRC-32 of everything after the header), then the description, the
+//! per-lane widths, the segment table and the stream. Reading checks the
+//! header, the checksum and every length against the bytes left before it
+//! allocates, and refuses a file that claims more keys than its width
+//! fields can describe (so what it allocates grows with the file, not with
+//! what the file claims).
+
+use super::{BLOCK_KEYS, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, err};
+use tcb_core::TrackKind;
+use tcb_core::TrackSettings;
+use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
+
+/// The first 8 bytes of a `.tcbc` file.
+pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
+/// The format version this build writes and reads.
+pub const VERSION: u32 = 1;
+const HEADER: usize = 24;
+const KINDS: [TrackKind; 5] = [
+    TrackKind::Scalar,
+    TrackKind::Vec2,
+    TrackKind::Vec3,
+    TrackKind::Vec4,
+    TrackKind::Quat,
+];
+
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f32(&mut self, v: f32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn len(&mut self, n: usize) {
+        self.u32(u32::try_from(n).expect("lengths under 2^32 (checked when encoding)"));
+    }
+    fn str(&mut self, s: &str) {
+        self.len(s.len());
+        self.0.extend_from_slice(s.as_bytes());
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], PackError> {
+        let left = self.bytes.len() - self.at;
+        if n > left {
+            return err(format!(
+                "truncated: {what} needs {n} bytes at offset {}, {left} left",
+                self.at + HEADER
+            ));
+        }
+        let s = &self.bytes[self.at..self.at + n];
+        self.at += n;
+        Ok(s)
+    }
+    fn u8(&mut self, what: &str) -> Result<u8, PackError> {
+        Ok(self.take(1, what)?[0])
+    }
+    fn u32(&mut self, what: &str) -> Result<u32, PackError> {
+        Ok(u32::from_le_bytes(
+            self.take(4, what)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn f32(&mut self, what: &str) -> Result<f32, PackError> {
+        Ok(f32::from_le_bytes(
+            self.take(4, what)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn f64(&mut self, what: &str) -> Result<f64, PackError> {
+        Ok(f64::from_le_bytes(
+            self.take(8, what)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn str(&mut self, what: &str) -> Result<String, PackError> {
+        let n = self.u32(what)? as usize;
+        let b = self.take(n, what)?;
+        String::from_utf8(b.to_vec()).map_err(|_| PackError(format!("{what} is not UTF-8")))
+    }
+    fn pick<T: Copy>(&mut self, all: &[T], what: &str) -> Result<T, PackError> {
+        let i = self.u8(what)?;
+        all.get(usize::from(i)).copied().ok_or_else(|| {
+            PackError(format!(
+                "{what} {i} is not one of the {} known values",
+                all.len()
+            ))
+        })
+    }
+}
+
+impl Packed {
+    /// The `.tcbc` bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let h = &self.head;
+        let mut w = Writer(Vec::with_capacity(HEADER + self.stream.len() + 4096));
+        w.0.extend_from_slice(&[0; HEADER]);
+        w.str(&h.name);
+        w.str(&self.note);
+        w.f64(h.start);
+        w.f64(h.interval);
+        w.len(h.keys);
+        w.len(BLOCK_KEYS);
+        w.len(SEGMENT_KEYS);
+        w.len(h.tracks.len());
+        for t in &h.tracks {
+            let s = &t.settings;
+            let ix = |i: Option<usize>| i.expect("a known value") as u8;
+            w.str(&t.name);
+            w.u8(ix(KINDS.iter().position(|k| *k == t.kind)));
+            w.u8(ix(TangentRule::ALL
+                .iter()
+                .position(|v| *v == s.tangent_rule)));
+            w.u8(ix(Ends::ALL.iter().position(|v| *v == s.ends)));
+            w.u8(u8::from(s.match_speed));
+            w.u8(u8::from(s.continuity_fade));
+            w.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.pre)));
+            w.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.post)));
+            w.u8(ix(RotationMode::ALL.iter().position(|v| *v == s.rotation)));
+            w.u8(ix(Hemisphere::ALL.iter().position(|v| *v == s.hemisphere)));
+            w.u8(u8::from(t.rebuild_w));
+            w.f64(t.tcb.tension);
+            w.f64(t.tcb.continuity);
+            w.f64(t.tcb.bias);
+            w.f32(t.step);
+        }
+        w.len(self.abs_bits.len());
+        w.0.extend_from_slice(&self.abs_bits);
+        w.0.extend_from_slice(&self.delta_bits);
+        w.len(self.seg_at.len());
+        for s in &self.seg_at {
+            w.u32(*s);
+        }
+        let stream = &self.stream[..self.stream.len() - 8];
+        w.len(stream.len());
+        w.0.extend_from_slice(stream);
+        let total = w.0.len() as u64;
+        let crc = crc32fast::hash(&w.0[HEADER..]);
+        let head = &mut w.0[..HEADER];
+        head[..8].copy_from_slice(&MAGIC);
+        head[8..12].copy_from_slice(&VERSION.to_le_bytes());
+        head[12..20].copy_from_slice(&total.to_le_bytes());
+        head[20..24].copy_from_slice(&crc.to_le_bytes());
+        w.0
+    }
+
+    /// Read `.tcbc` bytes: the header, checksum, every length and value
+    /// checked, and the stream decoded once to validate it. Errors are one
+    /// line naming what is wrong.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Packed, PackError> {
+        if bytes.len() < HEADER || bytes[..8] != MAGIC {
+            return err("not a .tcbc file (no TCBC magic number)");
+        }
+        let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+        if version != VERSION {
+            return err(format!(
+                ".tcbc version {version}; this build reads version {VERSION}"
+            ));
+        }
+        let total = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+        if total != bytes.len() as u64 {
+            return err(format!(
+                "truncated or padded: the header says {total} bytes, the file has {}",
+                bytes.len()
+            ));
+        }
+        let crc = u32::from_le_bytes(bytes[20..24].try_into().expect("4 bytes"));
+        let body = &bytes[HEADER..];
+        if crc32fast::hash(body) != crc {
+            return err("checksum mismatch: the file is corrupted");
+        }
+        let mut r = Reader { bytes: body, at: 0 };
+        let name = r.str("the clip's name")?;
+        let note = r.str("the note")?;
+        let start = r.f64("the start time")?;
+        let interval = r.f64("the key interval")?;
+        let keys = r.u32("the key count")? as usize;
+        let (block, seg) = (r.u32("keys per block")?, r.u32("keys per segment")?);
+        if (block as usize, seg as usize) != (BLOCK_KEYS, SEGMENT_KEYS) {
+            return err(format!(
+                "blocks of {block} and segments of {seg} keys; this build reads {BLOCK_KEYS} and {SEGMENT_KEYS}"
+            ));
+        }
+        let count = r.u32("the track count")? as usize;
+        // A track takes at least 55 bytes: refuse counts the file cannot hold.
+        if count > body.len() / 55 {
+            return err(format!(
+                "{count} tracks claimed in a file of {} bytes",
+                bytes.len()
+            ));
+        }
+        let mut tracks = Vec::with_capacity(count);
+        for i in 0..count {
+            let name = r.str(&format!("track {i}'s name"))?;
+            let what = |f: &str| format!("track {name}: {f}");
+            let kind = r.pick(&KINDS, &what("kind"))?;
+            let tangent_rule = r.pick(TangentRule::ALL, &what("tangent rule"))?;
+            let ends = r.pick(Ends::ALL, &what("ends"))?;
+            let match_speed = r.pick(&[false, true], &what("match_speed"))?;
+            let continuity_fade = r.pick(&[false, true], &what("continuity_fade"))?;
+            let pre = r.pick(Extrapolation::ALL, &what("pre"))?;
+            let post = r.pick(Extrapolation::ALL, &what("post"))?;
+            let rotation = r.pick(RotationMode::ALL, &what("rotation mode"))?;
+            let hemisphere = r.pick(Hemisphere::ALL, &what("hemisphere"))?;
+            let rebuild_w = r.pick(&[false, true], &what("rebuild_w"))?;
+            let tcb = Tcb::new(
+                r.f64(&what("tension"))?,
+                r.f64(&what("continuity"))?,
+                r.f64(&what("bias"))?,
+            );
+            let step = r.f32(&what("step"))?;
+            let settings = TrackSettings {
+                tangent_rule,
+                ends,
+                match_speed,
+                continuity_fade,
+                pre,
+                post,
+                rotation,
+                hemisphere,
+            };
+            tracks.push(PackTrack {
+                name,
+                kind,
+                settings,
+                tcb,
+                step,
+                rebuild_w,
+                values: Vec::new(),
+            });
+        }
+        let lanes = r.u32("the lane count")? as usize;
+        let stored: usize = tracks.iter().map(PackTrack::stored).sum();
+        if lanes != stored {
+            return err(format!(
+                "{lanes} lanes for tracks that store {stored} components"
+            ));
+        }
+        let abs_bits = r.take(lanes, "the block widths")?.to_vec();
+        let delta_bits = r.take(lanes, "the block widths")?.to_vec();
+        if let Some(b) = abs_bits.iter().chain(&delta_bits).find(|b| **b > 31) {
+            return err(format!("a block width of {b} bits (at most 31)"));
+        }
+        let segments = r.u32("the segment count")? as usize;
+        if keys < 2 || segments != keys.div_ceil(SEGMENT_KEYS) + 1 {
+            return err(format!("{segments} segment entries for {keys} keys"));
+        }
+        let table = r.take(4 * segments, "the segment table")?;
+        let seg_at: Vec<u32> = table
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect();
+        let len = r.u32("the stream length")? as usize;
+        let mut stream = r.take(len, "the stream")?.to_vec();
+        if r.at != body.len() {
+            return err(format!("{} bytes after the stream", body.len() - r.at));
+        }
+        // Every segment spends 5 bits per lane on its widths: a file cannot
+        // describe more keys than that.
+        if (segments - 1).saturating_mul(lanes).saturating_mul(5) > 8 * len {
+            return err(format!(
+                "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
+            ));
+        }
+        stream.extend_from_slice(&[0; 8]);
+        let packed = Packed {
+            head: PackSource {
+                name,
+                start,
+                interval,
+                keys,
+                tracks,
+            },
+            abs_bits,
+            delta_bits,
+            seg_at,
+            stream,
+            note,
+        };
+        packed.decode()?;
+        Ok(packed)
+    }
+}

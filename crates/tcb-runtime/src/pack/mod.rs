@@ -1,0 +1,604 @@
+//! Packed clips: values-only keys on one even grid, quantized, predicted
+//! and bit-packed (`.tcbc`, `docs/tcbc.md`).
+//!
+//! A track whose keys are evenly spaced and share one set of tension,
+//! continuity and bias needs only its values: every interior key's
+//! tangents follow from its two neighbours with constant chord weights
+//! (`tcb_core::tangent::ChordWeights`). A packed clip stores, per track,
+//! one quantization step and the integers `x_k = round(v_k / step)` of each
+//! stored component (rotations: `x y z` with `w >= 0` rebuilt, or all four
+//! where `w` changes sign), coded as
+//!
+//! ```text
+//! block of 64 keys:   x_b (absolute), x_{b+1} - x_b (delta), then per key
+//!                     r_k = x_k - (2 x_{k-1} - x_{k-2})          (2nd-order prediction)
+//! segment of 16 keys: a width per component (5 bits), then the residuals
+//!                     key by key, each in its component's width (zigzag)
+//! ```
+//!
+//! so playback decodes one key per key it crosses (shifts and adds), and a
+//! seek decodes from the start of its 64-key block.
+//!
+//! [`PackSource`] is the description in integers (what the encoder in
+//! `tcb-fit` searches over); [`PackSource::to_clip`] is its reference, an
+//! ordinary `tcb_core::Clip` whose values are the dequantized integers;
+//! [`Packed`] is the encoded form and the file. [`crate::Clip::from_packed`]
+//! compiles it: the runtime's controls come from decoding keys as playback
+//! reaches them, checked at compile time to equal, bit for bit, the controls
+//! the reference compiles to.
+
+use std::fmt;
+use tcb_core::params::{RotationMode, Tcb};
+use tcb_core::{
+    Clip as SourceClip, KeyParams, NamedTrack, RotationTrack, Track, TrackData, TrackKind,
+    TrackSettings,
+};
+
+/// Keys per block: a block starts from absolute values (a seek decodes
+/// from the start of its block).
+pub const BLOCK_KEYS: usize = 64;
+/// Keys per segment: a segment has one residual width per component.
+pub const SEGMENT_KEYS: usize = 16;
+/// Bits of a width field.
+const WIDTH_BITS: u32 = 5;
+/// The largest integer magnitude (f32 holds every integer below 2^24).
+pub const MAX_INT: i32 = 1 << 24;
+
+/// A clip in integers: one even grid of `keys` key times from `start`,
+/// `interval` apart, and per track a step and the integers of each stored
+/// component.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackSource {
+    /// The clip's name.
+    pub name: String,
+    /// The first key time.
+    pub start: f64,
+    /// Seconds between keys (> 0).
+    pub interval: f64,
+    /// Keys per track (>= 2).
+    pub keys: usize,
+    /// The tracks.
+    pub tracks: Vec<PackTrack>,
+}
+
+/// One track of a [`PackSource`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackTrack {
+    /// Its name.
+    pub name: String,
+    /// Its kind.
+    pub kind: TrackKind,
+    /// Its settings: rotations `hermite`, no `match_speed`; `pre` and `post`
+    /// the same for every track of the clip.
+    pub settings: TrackSettings,
+    /// Tension, continuity and bias of every key.
+    pub tcb: Tcb,
+    /// Quantization step (finite, > 0): a value is `x as f32 * step`.
+    pub step: f32,
+    /// Rotations: `x y z` stored, `w >= 0` rebuilt
+    /// ([`tcb_core::quat::rebuild_w`]); else every component is stored.
+    pub rebuild_w: bool,
+    /// Per stored component, one integer per key (`|x| < 2^24`).
+    pub values: Vec<Vec<i32>>,
+}
+
+impl PackTrack {
+    /// Components stored.
+    pub fn stored(&self) -> usize {
+        self.kind.dim() - usize::from(self.rebuild_w)
+    }
+
+    /// Key `k`'s components as the reference clip is given them (rotations
+    /// before the track normalizes them).
+    pub fn value(&self, k: usize) -> [f32; 4] {
+        let mut v = [0.0f32; 4];
+        for (c, x) in self.values.iter().enumerate() {
+            v[c] = dequantize(x[k], self.step);
+        }
+        if self.rebuild_w {
+            v[3] = tcb_core::quat::rebuild_w(v[0], v[1], v[2]);
+        }
+        v
+    }
+}
+
+/// `x as f32 * step`: the one dequantization (the kernel's is this on 8 lanes).
+#[inline(always)]
+pub fn dequantize(x: i32, step: f32) -> f32 {
+    x as f32 * step
+}
+
+/// Why a packed clip cannot be built or read: one line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PackError(pub String);
+
+impl fmt::Display for PackError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for PackError {}
+
+fn err<T>(msg: impl Into<String>) -> Result<T, PackError> {
+    Err(PackError(msg.into()))
+}
+
+impl PackSource {
+    /// The key times.
+    pub fn times(&self) -> Vec<f64> {
+        (0..self.keys)
+            .map(|k| self.start + k as f64 * self.interval)
+            .collect()
+    }
+
+    /// Quantize `clip`'s keys: every track on one even grid (to 1e-6 of the
+    /// interval), track `i` with step `steps[i]`; rotations `hermite`,
+    /// storing `x y z` where every key's `w` has one sign (the keys negated
+    /// where it is negative) and all four otherwise. Key parameters are
+    /// not read: the packed tracks have the default tension, continuity and
+    /// bias and the clip's settings (a measurement against the source says
+    /// how close that is).
+    pub fn quantize(clip: &SourceClip, steps: &[f32]) -> Result<PackSource, PackError> {
+        let times = clip.key_times();
+        let n = times.len();
+        if n < 2 {
+            return err("a packed clip needs 2 keys or more");
+        }
+        let (start, interval) = (times[0], (times[n - 1] - times[0]) / (n - 1) as f64);
+        for (k, t) in times.iter().enumerate() {
+            if (t - (start + k as f64 * interval)).abs() > 1e-6 * interval {
+                return err(format!(
+                    "key {k} at {t} s is not on an even grid of {interval} s from {start} s"
+                ));
+            }
+        }
+        if steps.len() != clip.tracks().len() {
+            return err(format!(
+                "{} steps for {} tracks",
+                steps.len(),
+                clip.tracks().len()
+            ));
+        }
+        let mut tracks = Vec::with_capacity(steps.len());
+        for (t, &step) in clip.tracks().iter().zip(steps) {
+            if t.data.times().len() != n {
+                return err(format!(
+                    "track {} has {} keys, the clip {n}",
+                    t.name,
+                    t.data.times().len()
+                ));
+            }
+            let kind = t.data.kind();
+            let mut values: Vec<[f32; 4]> = (0..n)
+                .map(|k| {
+                    let mut v = [0.0f32; 4];
+                    t.data.sample_into(times[k], &mut v[..kind.dim()], None);
+                    v
+                })
+                .collect();
+            let mut settings = *t.data.settings();
+            settings.match_speed = false;
+            let mut rebuild_w = false;
+            if kind == TrackKind::Quat {
+                settings.rotation = RotationMode::Hermite;
+                // Keys on one hemisphere, as the track plays them.
+                for k in 1..n {
+                    let d: f32 = (0..4).map(|c| values[k][c] * values[k - 1][c]).sum();
+                    if d < 0.0 {
+                        values[k] = values[k].map(|x| -x);
+                    }
+                }
+                let pos = values.iter().all(|v| v[3] > 0.0);
+                let neg = values.iter().all(|v| v[3] < 0.0);
+                if neg {
+                    values.iter_mut().for_each(|v| *v = v.map(|x| -x));
+                }
+                rebuild_w = pos || neg;
+            }
+            let stored = kind.dim() - usize::from(rebuild_w);
+            let q = |x: f32| {
+                let v = (f64::from(x) / f64::from(step)).round();
+                if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
+                    Err(PackError(format!(
+                        "track {}: step {step} is too fine for {x}",
+                        t.name
+                    )))
+                } else {
+                    Ok(v as i32)
+                }
+            };
+            let values = (0..stored)
+                .map(|c| {
+                    values
+                        .iter()
+                        .map(|v| q(v[c]))
+                        .collect::<Result<Vec<i32>, _>>()
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            tracks.push(PackTrack {
+                name: t.name.clone(),
+                kind,
+                settings,
+                tcb: Tcb::DEFAULT,
+                step,
+                rebuild_w,
+                values,
+            });
+        }
+        Ok(PackSource {
+            name: clip.name().to_string(),
+            start,
+            interval,
+            keys: n,
+            tracks,
+        })
+    }
+
+    /// Stored components over all tracks (the stream's lanes).
+    pub fn lanes(&self) -> usize {
+        self.tracks.iter().map(PackTrack::stored).sum()
+    }
+
+    /// Check what the format and the runtime need (see the field docs).
+    pub fn validate(&self) -> Result<(), PackError> {
+        if self.keys < 2 {
+            return err(format!(
+                "a packed clip needs 2 keys or more, not {}",
+                self.keys
+            ));
+        }
+        if !(self.start.is_finite() && self.interval.is_finite() && self.interval > 0.0) {
+            return err(format!(
+                "key times start {} interval {}: need finite times and a positive interval",
+                self.start, self.interval
+            ));
+        }
+        let last = self.start + (self.keys - 1) as f64 * self.interval;
+        if !last.is_finite() {
+            return err("the last key time is not finite");
+        }
+        let first = self
+            .tracks
+            .first()
+            .map(|t| (t.settings.pre, t.settings.post));
+        for t in &self.tracks {
+            let at = |m: String| err(format!("track {}: {m}", t.name));
+            if t.kind == TrackKind::Quat {
+                if t.settings.rotation != RotationMode::Hermite {
+                    return at("packed rotations are `hermite`".into());
+                }
+            } else if t.rebuild_w {
+                return at("only rotations rebuild w".into());
+            }
+            if t.settings.match_speed {
+                return at("packed tracks have no `match_speed`".into());
+            }
+            if Some((t.settings.pre, t.settings.post)) != first {
+                return at("every packed track has the same pre and post".into());
+            }
+            if !(t.step.is_finite() && t.step > 0.0) {
+                return at(format!("step {} is not a positive number", t.step));
+            }
+            if !t.tcb.is_finite() {
+                return at("tension, continuity and bias must be finite".into());
+            }
+            if t.values.len() != t.stored() {
+                return at(format!(
+                    "{} components given, {} stored",
+                    t.values.len(),
+                    t.stored()
+                ));
+            }
+            for v in &t.values {
+                if v.len() != self.keys {
+                    return at(format!("{} values, not {}", v.len(), self.keys));
+                }
+                if let Some(x) = v.iter().find(|x| x.unsigned_abs() >= MAX_INT as u32) {
+                    return at(format!("integer {x} is outside +-2^24"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The reference: an ordinary clip whose keys are the dequantized
+    /// values (what `tcb sample --scalar` plays, and what the runtime's
+    /// decoded keys are checked against).
+    pub fn to_clip(&self) -> Result<SourceClip, PackError> {
+        self.validate()?;
+        let times = self.times();
+        let mut tracks = Vec::with_capacity(self.tracks.len());
+        for t in &self.tracks {
+            let vals: Vec<[f32; 4]> = (0..self.keys).map(|k| t.value(k)).collect();
+            let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", t.name));
+            let (s, n) = (&t.settings, self.keys);
+            let data = match t.kind {
+                TrackKind::Scalar => {
+                    let v = vals.iter().map(|v| v[0]).collect();
+                    TrackData::Scalar(
+                        Track::new(times.clone(), v, key_params(t.tcb, n), s).map_err(e)?,
+                    )
+                }
+                TrackKind::Vec2 => {
+                    let v = vals.iter().map(|v| glam::Vec2::new(v[0], v[1])).collect();
+                    TrackData::Vec2(
+                        Track::new(times.clone(), v, key_params(t.tcb, n), s).map_err(e)?,
+                    )
+                }
+                TrackKind::Vec3 => {
+                    let v = vals
+                        .iter()
+                        .map(|v| glam::Vec3::new(v[0], v[1], v[2]))
+                        .collect();
+                    TrackData::Vec3(
+                        Track::new(times.clone(), v, key_params(t.tcb, n), s).map_err(e)?,
+                    )
+                }
+                TrackKind::Vec4 => {
+                    let v = vals.iter().map(|v| glam::Vec4::from_array(*v)).collect();
+                    TrackData::Vec4(
+                        Track::new(times.clone(), v, key_params(t.tcb, n), s).map_err(e)?,
+                    )
+                }
+                TrackKind::Quat => {
+                    let v = vals.iter().map(|v| glam::Quat::from_array(*v)).collect();
+                    let r = RotationTrack::new(times.clone(), v, key_params(t.tcb, n), s);
+                    TrackData::Quat(r.map_err(e)?)
+                }
+            };
+            tracks.push(NamedTrack {
+                name: t.name.clone(),
+                data,
+            });
+        }
+        SourceClip::new(self.name.clone(), tracks)
+            .map_err(|d| PackError(format!("track {} appears twice", d.0)))
+    }
+}
+
+/// `n` keys with `tcb` (none: the defaults).
+fn key_params<V: Copy>(tcb: Tcb, n: usize) -> Vec<KeyParams<V>> {
+    if tcb == Tcb::DEFAULT {
+        return Vec::new();
+    }
+    let key = KeyParams {
+        tcb,
+        ..KeyParams::default()
+    };
+    vec![key; n]
+}
+
+/// Bits a zigzag-coded value takes.
+fn bits_of(z: u32) -> u32 {
+    32 - z.leading_zeros()
+}
+
+fn zigzag(x: i32) -> u32 {
+    ((x << 1) ^ (x >> 31)) as u32
+}
+
+#[inline(always)]
+pub(crate) fn unzigzag(z: u32) -> i32 {
+    ((z >> 1) as i32) ^ -((z & 1) as i32)
+}
+
+/// Bits written least significant first.
+struct BitWriter {
+    bytes: Vec<u8>,
+    bits: usize,
+}
+
+impl BitWriter {
+    fn put(&mut self, v: u32, w: u32) {
+        debug_assert!(w <= 32 && (w == 32 || v >> w == 0));
+        for i in 0..w {
+            if self.bits.is_multiple_of(8) {
+                self.bytes.push(0);
+            }
+            let bit = (v >> i) & 1;
+            *self.bytes.last_mut().expect("pushed above") |= (bit as u8) << (self.bits % 8);
+            self.bits += 1;
+        }
+    }
+}
+
+/// `w` bits (at most 32) at bit `pos` of `stream`, which has 8 bytes of
+/// padding after its last bit (so the word read is in bounds).
+#[inline(always)]
+pub(crate) fn read_bits(stream: &[u8], pos: usize, w: u32) -> u32 {
+    let at = pos >> 3;
+    let word = u64::from_le_bytes(stream[at..at + 8].try_into().expect("8 bytes"));
+    ((word >> (pos & 7)) & ((1u64 << w) - 1)) as u32
+}
+
+/// The encoded clip (see the module docs): the description without its
+/// integers, per lane the widths of block starts, per segment its first
+/// bit, and the stream.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Packed {
+    pub(crate) head: PackSource,
+    /// Per lane: bits of the zigzag absolute value and delta at block starts.
+    pub(crate) abs_bits: Vec<u8>,
+    pub(crate) delta_bits: Vec<u8>,
+    /// Per segment its first bit, then the stream's length in bits.
+    pub(crate) seg_at: Vec<u32>,
+    /// The bits, then 8 bytes of zeros.
+    pub(crate) stream: Vec<u8>,
+    /// What made it (`tcb compress`'s options and measured error), for
+    /// `tcb info`: free text, kept in the file.
+    pub note: String,
+}
+
+/// Per key of a block, the integer a lane codes.
+#[inline(always)]
+fn code(x: &[i32], k: usize) -> i32 {
+    match k % BLOCK_KEYS {
+        0 => x[k],
+        1 => x[k].wrapping_sub(x[k - 1]),
+        _ => x[k]
+            .wrapping_sub(x[k - 1].wrapping_mul(2))
+            .wrapping_add(x[k - 2]),
+    }
+}
+
+impl Packed {
+    /// Encode `source` (validated first).
+    pub fn encode(source: &PackSource) -> Result<Packed, PackError> {
+        source.validate()?;
+        let n = source.keys;
+        let lanes: Vec<&Vec<i32>> = source.tracks.iter().flat_map(|t| t.values.iter()).collect();
+        let mut abs_bits = vec![0u8; lanes.len()];
+        let mut delta_bits = vec![0u8; lanes.len()];
+        for (l, x) in lanes.iter().enumerate() {
+            for b in (0..n).step_by(BLOCK_KEYS) {
+                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b))) as u8);
+                if b + 1 < n {
+                    delta_bits[l] = delta_bits[l].max(bits_of(zigzag(code(x, b + 1))) as u8);
+                }
+            }
+        }
+        let mut w = BitWriter {
+            bytes: Vec::new(),
+            bits: 0,
+        };
+        let mut seg_at = Vec::with_capacity(n.div_ceil(SEGMENT_KEYS) + 1);
+        let bit_offset = |bits: usize| {
+            u32::try_from(bits).map_err(|_| PackError("the packed stream exceeds 2^32 bits".into()))
+        };
+        for s in (0..n).step_by(SEGMENT_KEYS) {
+            seg_at.push(bit_offset(w.bits)?);
+            let end = (s + SEGMENT_KEYS).min(n);
+            let rows = || (s..end).filter(|k| k % BLOCK_KEYS >= 2);
+            let widths: Vec<u32> = lanes
+                .iter()
+                .map(|x| {
+                    rows()
+                        .map(|k| bits_of(zigzag(code(x, k))))
+                        .max()
+                        .unwrap_or(0)
+                })
+                .collect();
+            for &wd in &widths {
+                if wd >= 1 << WIDTH_BITS {
+                    return err("a residual needs more than 31 bits");
+                }
+                w.put(wd, WIDTH_BITS);
+            }
+            if s % BLOCK_KEYS == 0 {
+                for (l, x) in lanes.iter().enumerate() {
+                    w.put(zigzag(code(x, s)), u32::from(abs_bits[l]));
+                }
+                for (l, x) in lanes.iter().enumerate() {
+                    let d = if s + 1 < n { zigzag(code(x, s + 1)) } else { 0 };
+                    w.put(d, u32::from(delta_bits[l]));
+                }
+            }
+            for k in rows() {
+                for (l, x) in lanes.iter().enumerate() {
+                    w.put(zigzag(code(x, k)), widths[l]);
+                }
+            }
+        }
+        seg_at.push(bit_offset(w.bits)?);
+        let mut stream = w.bytes;
+        stream.extend_from_slice(&[0; 8]);
+        let mut head = source.clone();
+        for t in &mut head.tracks {
+            t.values = Vec::new();
+        }
+        Ok(Packed {
+            head,
+            abs_bits,
+            delta_bits,
+            seg_at,
+            stream,
+            note: String::new(),
+        })
+    }
+
+    /// Decode every key: the description in integers (also the check of a
+    /// file read: every width, length and integer is validated).
+    pub fn decode(&self) -> Result<PackSource, PackError> {
+        let n = self.head.keys;
+        let lanes = self.abs_bits.len();
+        let mut x: Vec<Vec<i32>> = (0..lanes).map(|_| Vec::with_capacity(n)).collect();
+        let mut widths = vec![0u32; lanes];
+        let bits = self.stream.len().saturating_sub(8) * 8;
+        let mut pos = 0usize;
+        let take = |pos: &mut usize, w: u32| -> Result<u32, PackError> {
+            if *pos + w as usize > bits {
+                return err("the packed stream ends early");
+            }
+            let v = read_bits(&self.stream, *pos, w);
+            *pos += w as usize;
+            Ok(v)
+        };
+        for (j, s) in (0..n).step_by(SEGMENT_KEYS).enumerate() {
+            if pos != self.seg_at[j] as usize {
+                return err(format!(
+                    "segment {j} starts at bit {pos}, the table says {}",
+                    self.seg_at[j]
+                ));
+            }
+            for wd in widths.iter_mut() {
+                *wd = take(&mut pos, WIDTH_BITS)?;
+            }
+            let end = (s + SEGMENT_KEYS).min(n);
+            if s % BLOCK_KEYS == 0 {
+                for (l, xl) in x.iter_mut().enumerate() {
+                    xl.push(unzigzag(take(&mut pos, u32::from(self.abs_bits[l]))?));
+                }
+                for (l, xl) in x.iter_mut().enumerate() {
+                    let d = unzigzag(take(&mut pos, u32::from(self.delta_bits[l]))?);
+                    if s + 1 < n {
+                        let v = xl[s].wrapping_add(d);
+                        xl.push(v);
+                    }
+                }
+            }
+            for k in s..end {
+                if k % BLOCK_KEYS < 2 {
+                    continue;
+                }
+                for (l, xl) in x.iter_mut().enumerate() {
+                    let r = unzigzag(take(&mut pos, widths[l])?);
+                    let v = xl[k - 1]
+                        .wrapping_mul(2)
+                        .wrapping_sub(xl[k - 2])
+                        .wrapping_add(r);
+                    xl.push(v);
+                }
+            }
+        }
+        if pos != *self.seg_at.last().expect("segments + 1 entries") as usize {
+            return err("the packed stream's length disagrees with its table");
+        }
+        let mut source = self.head.clone();
+        let mut lanes = x.into_iter();
+        for t in &mut source.tracks {
+            t.values = lanes.by_ref().take(t.stored()).collect();
+        }
+        source.validate()?;
+        Ok(source)
+    }
+
+    /// The description (integers not included).
+    pub fn head(&self) -> &PackSource {
+        &self.head
+    }
+
+    /// Bytes of the encoded stream and its tables (what a runtime keeps).
+    pub fn stream_bytes(&self) -> usize {
+        self.stream.len() + 4 * self.seg_at.len() + self.abs_bits.len() + self.delta_bits.len()
+    }
+
+    /// Bits of the residuals, widths and block starts.
+    pub fn stream_bits(&self) -> usize {
+        *self.seg_at.last().unwrap_or(&0) as usize
+    }
+}
+
+mod compile;
+mod file;
+pub(crate) mod store;

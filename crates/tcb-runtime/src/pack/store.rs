@@ -1,0 +1,276 @@
+//! A group's controls from a [`Packed`] stream: keys decoded as playback
+//! reaches them, tangents derived from their neighbours.
+//!
+//! An instance keeps the last four decoded keys (`P`, in the group's planes)
+//! and the predictor's state; a segment from key `a` to `a + 1` needs keys
+//! `a - 1 ..= a + 2`, so forward playback decodes one key per key it
+//! crosses. Interior tangents are the tangent rule on the two chords,
+//!
+//! ```text
+//! TO_a = (P_a - P_{a-1}) out_a + (P_{a+1} - P_a) out_b       TI_b likewise with in_a, in_b
+//! ```
+//!
+//! in f32 with the weights rounded to f32, as `tcb_core::Track` computes
+//! them; keys 0 and n-1 (whose tangents follow the `ends` rule) and the
+//! sentinel pseudo-keys are kept in f32. Rotations are decoded as the
+//! reference builds them: `w` rebuilt where the track stores three
+//! components, then made unit length in f64 ([`tcb_core::quat::unit_key`]).
+
+use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, WIDTH_BITS, read_bits, unzigzag};
+use crate::store::Segment;
+use std::sync::Arc;
+use wide::{f32x8, f64x4, i32x8};
+
+/// Sections of a key: `P`, `TO`, `TI`.
+const P: usize = 0;
+const TO: usize = 1;
+const TI: usize = 2;
+
+/// The packed controls of one group (see the module docs).
+#[derive(Clone, Debug)]
+pub(crate) struct PackedKeys {
+    pub packed: Arc<Packed>,
+    /// Keys (n).
+    pub keys: usize,
+    pub planes: usize,
+    /// Per stream lane, its plane and lane in the group (`8 plane + lane`).
+    pub lane_slot: Vec<u32>,
+    /// Per plane: the quantization step of each lane (0 where not stored).
+    pub step: Vec<f32x8>,
+    /// Per plane: `in_a, in_b, out_a, out_b` of each lane.
+    pub weights: Vec<[f32x8; 4]>,
+    /// The first rotation plane; rotation blocks of 4 planes follow.
+    pub rot_from: usize,
+    /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes).
+    pub rebuild: Vec<[bool; 8]>,
+    /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
+    /// (`n ..= n+3`), `planes` vectors each.
+    pub table: Vec<f32x8>,
+}
+
+impl PackedKeys {
+    /// Section `j` of table key `e` (0: key 0, 1: key n-1, 2..: sentinels).
+    #[inline(always)]
+    fn table(&self, e: usize, j: usize) -> &[f32x8] {
+        let at = (3 * e + j) * self.planes;
+        &self.table[at..at + self.planes]
+    }
+
+    /// Heap bytes: the stream and its tables (once per clip) and the rest.
+    pub fn heap_bytes(&self) -> usize {
+        self.packed.stream_bytes()
+            + 4 * self.lane_slot.len()
+            + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
+            + 8 * self.rebuild.len()
+    }
+
+    /// A cache for [`segment`](Self::segment), per instance.
+    pub fn cache(&self) -> PackCache {
+        let lanes = self.lane_slot.len();
+        PackCache {
+            seg: usize::MAX,
+            next: 0,
+            first: 0,
+            pos: 0,
+            widths: vec![0; lanes],
+            abs: vec![0; lanes],
+            delta: vec![0; lanes],
+            flat: vec![0; 8 * self.planes],
+            x0: vec![i32x8::ZERO; self.planes],
+            x1: vec![i32x8::ZERO; self.planes],
+            p: vec![f32x8::ZERO; 4 * self.planes],
+            m: vec![f32x8::ZERO; 2 * self.planes],
+        }
+    }
+
+    /// The controls of the segment from key `a` to key `b`: a real segment
+    /// (`b = a + 1 < n`) from decoded keys, a sentinel from the table.
+    #[inline(always)]
+    pub fn segment<'a>(&'a self, a: usize, b: usize, c: &'a mut PackCache) -> Segment<'a> {
+        let n = self.keys;
+        if a >= n {
+            let (ea, eb) = (a - n + 2, b - n + 2);
+            return Segment {
+                p0: self.table(ea, P),
+                m0: self.table(ea, TO),
+                p1: self.table(eb, P),
+                m1: self.table(eb, TI),
+            };
+        }
+        debug_assert_eq!(b, a + 1, "packed groups have no step segments");
+        if c.seg != a {
+            let (lo, hi) = (a.saturating_sub(1), (b + 1).min(n - 1));
+            c.ensure(self, lo, hi);
+            self.tangents(a, b, c);
+            c.seg = a;
+        }
+        let np = self.planes;
+        let (m0, m1) = c.m.split_at(np);
+        Segment {
+            p0: c.ring(a, np),
+            m0: if a == 0 { self.table(0, TO) } else { m0 },
+            p1: c.ring(b, np),
+            m1: if b == n - 1 { self.table(1, TI) } else { m1 },
+        }
+    }
+
+    /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
+    fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
+        let (np, n) = (self.planes, self.keys);
+        for p in 0..np {
+            let [ia, ib, oa, ob] = self.weights[p];
+            let at = |k: usize| c.p[(k & 3) * np + p];
+            if a > 0 {
+                let (x, y, z) = (at(a - 1), at(a), at(b));
+                c.m[p] = (y - x) * oa + (z - y) * ob;
+            }
+            if b < n - 1 {
+                let (x, y, z) = (at(a), at(b), at(b + 1));
+                c.m[np + p] = (y - x) * ia + (z - y) * ib;
+            }
+        }
+    }
+}
+
+/// One instance's decoding state for a [`PackedKeys`] group.
+#[derive(Clone, Debug)]
+pub(crate) struct PackCache {
+    /// The first key of the segment whose tangents `m` holds.
+    seg: usize,
+    /// The next key to decode, the first decoded since the last seek, and
+    /// the stream position of the next key's residuals.
+    next: usize,
+    first: usize,
+    pos: usize,
+    /// Per stream lane: this segment's widths, this block's start and delta.
+    widths: Vec<u8>,
+    abs: Vec<i32>,
+    delta: Vec<i32>,
+    /// Integers of one key in the group's planes (scratch).
+    flat: Vec<i32>,
+    /// The predictor: the last two keys' integers, per plane.
+    x0: Vec<i32x8>,
+    x1: Vec<i32x8>,
+    /// The last four decoded keys (key k in slot k & 3), `planes` each.
+    p: Vec<f32x8>,
+    /// `TO_a` then `TI_b` of the segment `seg`.
+    m: Vec<f32x8>,
+}
+
+impl PackCache {
+    #[inline(always)]
+    fn ring(&self, k: usize, np: usize) -> &[f32x8] {
+        let at = (k & 3) * np;
+        &self.p[at..at + np]
+    }
+
+    /// Decode until keys `lo ..= hi` (at most 4) are in the ring: forward
+    /// from the last key decoded, or from the start of `lo`'s block.
+    fn ensure(&mut self, g: &PackedKeys, lo: usize, hi: usize) {
+        let start = lo - lo % BLOCK_KEYS;
+        let ok = if lo >= self.next {
+            self.next >= start
+        } else {
+            lo >= self.first.max(self.next.saturating_sub(4))
+        };
+        if !ok {
+            self.next = start;
+            self.first = start;
+        }
+        while self.next <= hi {
+            self.decode_next(g);
+        }
+    }
+
+    /// Decode key `next` into the ring.
+    fn decode_next(&mut self, g: &PackedKeys) {
+        let (k, np) = (self.next, g.planes);
+        let s = &g.packed.stream;
+        let in_block = k % BLOCK_KEYS;
+        if k.is_multiple_of(SEGMENT_KEYS) {
+            self.pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
+            for w in self.widths.iter_mut() {
+                *w = read_bits(s, self.pos, WIDTH_BITS) as u8;
+                self.pos += WIDTH_BITS as usize;
+            }
+            if in_block == 0 {
+                for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
+                    *x = unzigzag(read_bits(s, self.pos, u32::from(w)));
+                    self.pos += usize::from(w);
+                }
+                for (x, &w) in self.delta.iter_mut().zip(&g.packed.delta_bits) {
+                    *x = unzigzag(read_bits(s, self.pos, u32::from(w)));
+                    self.pos += usize::from(w);
+                }
+            }
+        }
+        // This key's integers (block start, delta, or residual) per plane.
+        let flat = &mut self.flat;
+        match in_block {
+            0 => scatter(&g.lane_slot, &self.abs, flat),
+            1 => scatter(&g.lane_slot, &self.delta, flat),
+            _ => {
+                let mut pos = self.pos;
+                for (&slot, &w) in g.lane_slot.iter().zip(&self.widths) {
+                    flat[slot as usize] = unzigzag(read_bits(s, pos, u32::from(w)));
+                    pos += usize::from(w);
+                }
+                self.pos = pos;
+            }
+        }
+        let ring = (k & 3) * np;
+        for p in 0..np {
+            let r = i32x8::new(flat[8 * p..8 * p + 8].try_into().expect("8 lanes"));
+            let x = match in_block {
+                0 => r,
+                1 => self.x1[p] + r,
+                _ => self.x1[p] + self.x1[p] - self.x0[p] + r,
+            };
+            self.x0[p] = self.x1[p];
+            self.x1[p] = x;
+            self.p[ring + p] = x.round_float() * g.step[p];
+        }
+        for (b, rebuild) in g.rebuild.iter().enumerate() {
+            let at = ring + g.rot_from + 4 * b;
+            unit_block(&mut self.p[at..at + 4], rebuild);
+        }
+        self.next = k + 1;
+    }
+}
+
+/// Stream lanes' integers into their plane lanes.
+#[inline(always)]
+fn scatter(slots: &[u32], x: &[i32], flat: &mut [i32]) {
+    for (&s, &v) in slots.iter().zip(x) {
+        flat[s as usize] = v;
+    }
+}
+
+/// One block of 8 rotation keys as the reference builds them: `w` rebuilt
+/// in the lanes of `rebuild`, then unit length in f64.
+fn unit_block(planes: &mut [f32x8], rebuild: &[bool; 8]) {
+    let c: [[f32; 8]; 4] = std::array::from_fn(|i| planes[i].to_array());
+    let mut out = [[0.0f32; 8]; 4];
+    for h in 0..2 {
+        let lanes = |i: usize| f64x4::new(std::array::from_fn(|l| f64::from(c[i][4 * h + l])));
+        let (x, y, z, w) = (lanes(0), lanes(1), lanes(2), lanes(3));
+        let rebuilt = tcb_core::quat::rebuild_w_lanes(x, y, z).to_array();
+        let w = w.to_array();
+        let w = f64x4::new(std::array::from_fn(|l| {
+            if rebuild[4 * h + l] {
+                f64::from(rebuilt[l] as f32)
+            } else {
+                w[l]
+            }
+        }));
+        let q = tcb_core::quat::unit_key([x, y, z, w]);
+        for (i, qi) in q.iter().enumerate() {
+            for (l, v) in qi.to_array().iter().enumerate() {
+                out[i][4 * h + l] = *v as f32;
+            }
+        }
+    }
+    for (p, o) in planes.iter_mut().zip(out) {
+        *p = f32x8::new(o);
+    }
+}

@@ -1,0 +1,164 @@
+//! Packed clips (`tcb_runtime::pack`): the runtime's decoded keys against
+//! the reference, forward and with seeks; the file round trip; bad files.
+
+use std::sync::Arc;
+use tcb_core::RotationMode;
+use tcb_runtime::{Clip, Instance, PackSource, Packed};
+
+/// The bundled CMU capture (hermite), quantized with steps of 2^-14
+/// (rotations) and 2^-8 (the root translation, in the clip's units).
+fn cmu() -> (tcb_core::Clip, PackSource) {
+    let bvh = include_str!("../../../data/cmu-01_01.bvh");
+    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
+    let clip = bvh
+        .to_clip_doc("cmu", RotationMode::Hermite)
+        .unwrap()
+        .build()
+        .unwrap();
+    let steps: Vec<f32> = clip
+        .tracks()
+        .iter()
+        .map(|t| {
+            if t.name.ends_with("translation") {
+                1.0 / 256.0
+            } else {
+                1.0 / 16384.0
+            }
+        })
+        .collect();
+    let source = PackSource::quantize(&clip, &steps).unwrap();
+    (clip, source)
+}
+
+fn rows(inst: &mut Instance, t: f64, n: usize) -> Vec<f32> {
+    let mut row = vec![0.0; n];
+    inst.sample(t).write_row(&mut row, None);
+    row
+}
+
+#[test]
+fn packed_cmu_plays_its_reference() {
+    let (_, source) = cmu();
+    // The root turns past w = 0: it keeps 4 components; the rest rebuild w.
+    let rebuilt = source.tracks.iter().filter(|t| t.rebuild_w).count();
+    assert!(rebuilt > 25, "{rebuilt}");
+    let packed = Arc::new(Packed::encode(&source).unwrap());
+    let clip = Arc::new(Clip::from_packed(packed.clone()).unwrap());
+    let reference = Arc::new(Clip::compile(&source.to_clip().unwrap()));
+    let n = clip.channel_count();
+    let (mut a, mut b) = (
+        Instance::new(clip.clone()),
+        Instance::new(reference.clone()),
+    );
+    // Forward at 60 fps, then random access (seeks back and across blocks),
+    // then past both ends: the same bits as the f32 clip of the reference.
+    let (t0, t1) = clip.time_range().unwrap();
+    let mut times: Vec<f64> = (0..)
+        .map(|f| t0 + f as f64 / 60.0)
+        .take_while(|t| *t <= t1)
+        .collect();
+    let mut x = 12345u64;
+    for _ in 0..500 {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        times.push(t0 - 0.5 + (x >> 11) as f64 / (1u64 << 53) as f64 * (t1 - t0 + 1.0));
+    }
+    times.extend([t1, t0, t1 + 1.0, f64::NAN, f64::INFINITY, t0 + 0.3]);
+    for t in times {
+        let (ra, rb) = (rows(&mut a, t, n), rows(&mut b, t, n));
+        let same = ra.iter().zip(&rb).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "at {t}: {:?} vs {:?}", &ra[..8], &rb[..8]);
+    }
+    // Several times smaller than the f32 clip.
+    assert!(
+        packed.to_bytes().len() * 4 < reference.memory_bytes(),
+        "{}",
+        packed.to_bytes().len()
+    );
+}
+
+#[test]
+fn file_round_trip() {
+    let (_, source) = cmu();
+    let mut packed = Packed::encode(&source).unwrap();
+    packed.note = "tolerance 1e-3".into();
+    let bytes = packed.to_bytes();
+    let back = Packed::from_bytes(&bytes).unwrap();
+    assert_eq!(back, packed);
+    assert_eq!(back.decode().unwrap(), source);
+    let clip = Clip::from_bytes(&bytes).unwrap();
+    assert_eq!(clip.to_bytes().unwrap(), bytes);
+    assert!(
+        Clip::compile(&source.to_clip().unwrap())
+            .to_bytes()
+            .is_none()
+    );
+}
+
+#[test]
+fn bad_files_are_one_line_errors() {
+    let (_, source) = cmu();
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    let e = |b: &[u8]| Packed::from_bytes(b).unwrap_err().to_string();
+    assert!(e(b"").contains("not a .tcbc file"), "{}", e(b""));
+    assert!(e(b"{\"format\": \"tcb-clip/1\"}").contains("not a .tcbc file"));
+    // Every truncation is refused, none panics.
+    for cut in (0..bytes.len()).step_by(997) {
+        let msg = e(&bytes[..cut]);
+        assert!(!msg.contains('\n'), "{msg}");
+    }
+    // A flipped bit anywhere is caught by the checksum (or the header).
+    for at in (0..bytes.len()).step_by(1009) {
+        let mut b = bytes.clone();
+        b[at] ^= 0x10;
+        let msg = e(&b);
+        assert!(!msg.contains('\n'), "{msg}");
+    }
+    let mut b = bytes.clone();
+    b[8] = 9;
+    assert!(e(&b).contains("version 9"), "{}", e(&b));
+}
+
+/// A file whose checksum is right but whose contents lie: the counts and
+/// widths are checked against the bytes there are.
+#[test]
+fn lying_files_are_refused() {
+    let (_, source) = cmu();
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    let reseal = |mut b: Vec<u8>| {
+        let crc = crc32(&b[24..]);
+        b[20..24].copy_from_slice(&crc.to_le_bytes());
+        b
+    };
+    // The key count (after the name "cmu", the empty note and two f64s).
+    let at = 24 + 4 + 3 + 4 + 16;
+    for keys in [0u32, 1, 2753, 100_000, u32::MAX] {
+        let mut b = bytes.clone();
+        b[at..at + 4].copy_from_slice(&keys.to_le_bytes());
+        let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
+        assert!(msg.contains("keys"), "{keys}: {msg}");
+    }
+    // Every byte after the header, changed and resealed: an error or a
+    // clip, never a panic.
+    for at in (24..bytes.len()).step_by(211) {
+        let mut b = bytes.clone();
+        b[at] = b[at].wrapping_add(77);
+        let _ = Packed::from_bytes(&reseal(b));
+    }
+}
+
+fn crc32(b: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &x in b {
+        crc ^= u32::from(x);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
