@@ -68,6 +68,8 @@ enum Command {
     Export(ExportArgs),
     /// Fit dense animation with far fewer Hermite keys within a stated error.
     Reduce(ReduceArgs),
+    /// Quantize and pack a clip within a stated error: a binary .tcbc clip.
+    Compress(CompressArgs),
     /// Print a clip's tracks, key grids, runtime layout and bytes.
     Info(InfoArgs),
     /// Time the runtime on a clip: ns per joint and per channel, bytes, flags.
@@ -218,6 +220,38 @@ struct ReduceArgs {
 }
 
 #[derive(Args)]
+struct CompressArgs {
+    /// The input: clip JSON, BVH, glTF or GLB, every track on one even grid
+    /// of key times (motion capture, baked animation).
+    input: PathBuf,
+    /// The packed clip to write (written only once its error is measured
+    /// within the tolerance).
+    #[arg(short, long, value_name = "OUT.tcbc")]
+    output: PathBuf,
+    /// Largest error allowed (as `tcb reduce`: shell, default 6e-5 x the
+    /// rest-pose height; value: per component, default 1e-4).
+    #[arg(long, value_name = "E", allow_hyphen_values = true)]
+    tolerance: Option<f64>,
+    /// Shell radius (default 0.018 x height).
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
+    shell: Option<f64>,
+    /// Error metric (default: shell when the input has a skeleton, else value).
+    #[arg(long, value_name = "shell|value")]
+    metric: Option<tcb_fit::Metric>,
+    /// Value metric: largest rotation error in degrees (default 0.01).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    rotation_tolerance: Option<f64>,
+    /// BVH input: rotation mode of the reference (default hermite, which
+    /// the packed clip plays; squad is measured against, and capture's
+    /// first frames, a jump from the calibration pose, are far apart there).
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF input: the animation, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
+}
+
+#[derive(Args)]
 struct ExportArgs {
     /// The clip (tcb-clip/1 JSON, or anything `sample` reads).
     clip: PathBuf,
@@ -287,6 +321,7 @@ fn main() -> ExitCode {
         Command::Import(args) => import(&args),
         Command::Export(args) => export(&args),
         Command::Reduce(args) => reduce(&args),
+        Command::Compress(args) => compress(&args),
         Command::Info(args) => info(&args),
         Command::Bench(args) => bench(&args),
         Command::Plot(args) => plot(&args),
@@ -445,6 +480,77 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
     Ok(())
 }
 
+fn compress(args: &CompressArgs) -> Result<(), BoxError> {
+    if extension(&args.output) != "tcbc" {
+        return Err(format!("{}: the output must end in .tcbc", args.output.display()).into());
+    }
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(format!("{}: no such directory", dir.display()).into());
+    }
+    let started = std::time::Instant::now();
+    // A BVH's rotations are samples: played as `hermite`, the way a packed
+    // clip plays them, unless asked otherwise.
+    let rotation = args
+        .rotation
+        .or((extension(&args.input) == "bvh").then_some(tcb_core::RotationMode::Hermite));
+    let import = import_options(&args.input, rotation, args.animation.as_ref())?;
+    let loaded = tcb_io::load_with(&args.input, &import)?;
+    warn(&loaded.warnings);
+    let options = tcb_fit::CompressOptions {
+        tolerance: args.tolerance,
+        shell: args.shell,
+        metric: args.metric,
+        rotation_tolerance: args.rotation_tolerance,
+    };
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("tcb: measuring {bar:30} {pos}/{len} clips")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, &progress);
+    bar.finish_and_clear();
+    let c = result?;
+    let s = &c.settings;
+    match s.metric {
+        tcb_fit::Metric::Shell => eprintln!(
+            "tcb: metric shell, tolerance {:e}, shell {:e} (rest-pose height {})",
+            s.tolerance, s.shell, s.height
+        ),
+        tcb_fit::Metric::Value => eprintln!(
+            "tcb: metric value, tolerance {:e}, rotation tolerance {} degrees",
+            s.tolerance, s.rotation_tolerance
+        ),
+    }
+    let bytes = c.packed.to_bytes();
+    tcb_io::write_atomically(&args.output, &bytes)?;
+    eprintln!(
+        "tcb: wrote {} in {:.1} s ({} clips measured)",
+        args.output.display(),
+        started.elapsed().as_secs_f64(),
+        c.evaluations
+    );
+    println!("{}", c.summary_line());
+    Ok(())
+}
+
+/// A `.tcbc` file: its reference clip (the dequantized keys, for
+/// `--scalar` and the track list) and its runtime clip.
+fn load_tcbc(
+    path: &std::path::Path,
+) -> Result<(tcb_core::Clip, std::sync::Arc<tcb_runtime::Clip>), BoxError> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let in_file = |e: tcb_runtime::PackError| format!("{}: {e}", path.display());
+    let packed = std::sync::Arc::new(tcb_runtime::Packed::from_bytes(&bytes).map_err(in_file)?);
+    let reference = packed.decode().and_then(|s| s.to_clip()).map_err(in_file)?;
+    let runtime = tcb_runtime::Clip::from_packed(packed).map_err(in_file)?;
+    Ok((reference, std::sync::Arc::new(runtime)))
+}
+
 fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     if extension(&args.output) != "json" {
         return Err(format!("{}: the output must end in .json", args.output.display()).into());
@@ -543,6 +649,9 @@ fn mb(bytes: usize) -> String {
 }
 
 fn info(args: &InfoArgs) -> Result<(), BoxError> {
+    if extension(&args.clip) == "tcbc" {
+        return info_tcbc(args);
+    }
     let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
     let loaded = tcb_io::load_with(&args.clip, &options)?;
     warn(&loaded.warnings);
@@ -626,6 +735,74 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
         "bytes: {} compiled (no copy of the source kept), {} read per frame inside the keys",
         mb(stats.bytes),
         stats.bytes_per_frame
+    )?;
+    io::stdout().lock().write_all(out.as_bytes())?;
+    Ok(())
+}
+
+/// `tcb info` of a `.tcbc` file: what is stored and how it was made.
+fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
+    let file = std::fs::metadata(&args.clip)?.len();
+    let (clip, runtime) = load_tcbc(&args.clip)?;
+    let packed = runtime.packed().expect("compiled from a packed clip");
+    let head = packed.head();
+    let values = head.keys * head.lanes();
+    let mut out = String::new();
+    use std::fmt::Write as _;
+    writeln!(
+        out,
+        "file: {} ({file} bytes, .tcbc version {})",
+        args.clip.display(),
+        tcb_runtime::pack::VERSION
+    )?;
+    writeln!(
+        out,
+        "clip: {:?}, {} tracks, {} channels, {} keys each, {} to {} s ({} s apart)",
+        head.name,
+        head.tracks.len(),
+        clip.channel_count(),
+        head.keys,
+        head.start,
+        head.start + (head.keys - 1) as f64 * head.interval,
+        head.interval
+    )?;
+    writeln!(
+        out,
+        "made by: {}",
+        if packed.note.is_empty() {
+            "-"
+        } else {
+            &packed.note
+        }
+    )?;
+    writeln!(out, "tracks:")?;
+    writeln!(
+        out,
+        "  {:<32} {:<6} {:>7} {:>14}",
+        "name", "kind", "stored", "step"
+    )?;
+    for t in &head.tracks {
+        writeln!(
+            out,
+            "  {:<32} {:<6} {:>7} {:>14e}",
+            t.name,
+            t.kind.name(),
+            t.stored(),
+            t.step
+        )?;
+    }
+    writeln!(
+        out,
+        "stored: {values} values in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",
+        packed.stream_bits(),
+        packed.stream_bits() as f64 / values.max(1) as f64,
+        8.0 * file as f64 / values.max(1) as f64
+    )?;
+    writeln!(
+        out,
+        "bytes: {} compiled ({} of them the packed stream and its tables)",
+        mb(runtime.memory_bytes()),
+        packed.stream_bytes()
     )?;
     io::stdout().lock().write_all(out.as_bytes())?;
     Ok(())
@@ -786,9 +963,14 @@ fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
 }
 
 fn sample(args: &SampleArgs) -> Result<(), BoxError> {
-    let loaded = load(&args.clip)?;
-    warn(&loaded.warnings);
-    let clip = loaded.clip;
+    let (clip, packed) = if extension(&args.clip) == "tcbc" {
+        let (clip, runtime) = load_tcbc(&args.clip)?;
+        (clip, Some(runtime))
+    } else {
+        let loaded = load(&args.clip)?;
+        warn(&loaded.warnings);
+        (loaded.clip, None)
+    };
     let times = sample_times(args, &clip)?;
     // Everything that can fail has been checked: from here on only writing can.
     let stdout = io::stdout().lock();
@@ -804,7 +986,10 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
             exact_velocities: args.velocity,
             ..Default::default()
         };
-        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile_with(&clip, &options));
+        // A packed clip plays its own stream (its reference is `clip`).
+        let runtime = packed.unwrap_or_else(|| {
+            std::sync::Arc::new(tcb_runtime::Clip::compile_with(&clip, &options))
+        });
         let mut instance = tcb_runtime::Instance::new(runtime);
         if args.velocity {
             instance = instance.with_velocities();

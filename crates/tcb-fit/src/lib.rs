@@ -37,9 +37,11 @@
 #![forbid(unsafe_code)]
 
 mod band;
+pub mod compress;
 pub mod fit;
 pub mod metric;
 pub mod reduce;
 
+pub use compress::{CompressOptions, Compressed, compress};
 pub use fit::{Norm, Tangents};
 pub use reduce::{Knots, Metric, ReduceError, ReduceOptions, Reduced, reduce};

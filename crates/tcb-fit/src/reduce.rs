@@ -268,6 +268,57 @@ impl fmt::Display for ReduceError {
 
 impl std::error::Error for ReduceError {}
 
+/// The metric, tolerance, shell radius and rotation tolerance `options`
+/// ask for, with the contract's defaults (`docs/reduce.md`): what `tcb
+/// reduce` and `tcb compress` measure by.
+pub fn resolve(
+    options: &ReduceOptions,
+    skeleton: Option<&Skeleton>,
+) -> Result<Settings, ReduceError> {
+    let input_skeleton = skeleton;
+    let metric = match (options.metric, input_skeleton) {
+        (Some(Metric::Shell), None) => return Err(ReduceError::NoSkeleton),
+        (Some(m), _) => m,
+        (None, Some(_)) => Metric::Shell,
+        (None, None) => Metric::Value,
+    };
+    let height = input_skeleton.map_or(0.0, metric::rest_height);
+    let tolerance = match options.tolerance {
+        Some(e) => positive("--tolerance", e)?,
+        None if metric == Metric::Shell => {
+            if height.is_nan() || height <= 0.0 {
+                return Err(ReduceError::Option(
+                    "the skeleton's rest-pose height is zero: give --tolerance".into(),
+                ));
+            }
+            6e-5 * height
+        }
+        None => 1e-4,
+    };
+    let shell = match options.shell {
+        Some(r) if r >= 0.0 && r.is_finite() => r,
+        Some(r) => {
+            return Err(ReduceError::Option(format!(
+                "--shell must be a number >= 0, got {r}"
+            )));
+        }
+        None => 0.018 * height,
+    };
+    let rotation_tolerance = positive(
+        "--rotation-tolerance",
+        options.rotation_tolerance.unwrap_or(0.01),
+    )?;
+    Ok(Settings {
+        metric,
+        tolerance,
+        shell,
+        rotation_tolerance,
+        height,
+        knots: options.knots,
+        tangents: options.tangents,
+    })
+}
+
 /// Numbers stored by a track: each key's value and explicit tangents.
 pub fn stored_values(track: &TrackDoc) -> usize {
     let dim = track.kind.dim();
@@ -326,47 +377,14 @@ pub fn reduce(
     options: &ReduceOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Reduced, ReduceError> {
-    let metric = match (options.metric, input.skeleton) {
-        (Some(Metric::Shell), None) => return Err(ReduceError::NoSkeleton),
-        (Some(m), _) => m,
-        (None, Some(_)) => Metric::Shell,
-        (None, None) => Metric::Value,
-    };
-    let height = input.skeleton.map_or(0.0, metric::rest_height);
-    let tolerance = match options.tolerance {
-        Some(e) => positive("--tolerance", e)?,
-        None if metric == Metric::Shell => {
-            if height.is_nan() || height <= 0.0 {
-                return Err(ReduceError::Option(
-                    "the skeleton's rest-pose height is zero: give --tolerance".into(),
-                ));
-            }
-            6e-5 * height
-        }
-        None => 1e-4,
-    };
-    let shell = match options.shell {
-        Some(r) if r >= 0.0 && r.is_finite() => r,
-        Some(r) => {
-            return Err(ReduceError::Option(format!(
-                "--shell must be a number >= 0, got {r}"
-            )));
-        }
-        None => 0.018 * height,
-    };
-    let rotation_tolerance = positive(
-        "--rotation-tolerance",
-        options.rotation_tolerance.unwrap_or(0.01),
-    )?;
-    let settings = Settings {
+    let settings = resolve(options, input.skeleton)?;
+    let Settings {
         metric,
         tolerance,
         shell,
         rotation_tolerance,
-        height,
-        knots: options.knots,
-        tangents: options.tangents,
-    };
+        ..
+    } = settings;
     let times = metric::check_times(input.clip);
     if times.len() < 2 {
         return Err(ReduceError::Empty);
@@ -874,7 +892,7 @@ fn only_different(full: &SettingsDoc, defaults: &SettingsDoc) -> SettingsDoc {
 }
 
 /// Whether joint `d` is `a` or below it.
-fn descends(skeleton: &Skeleton, mut d: usize, a: usize) -> bool {
+pub(crate) fn descends(skeleton: &Skeleton, mut d: usize, a: usize) -> bool {
     loop {
         if d == a {
             return true;
@@ -893,7 +911,11 @@ fn joint_name(track: &str) -> &str {
 
 /// The joint and part a track animates: `<joint>.translation` (vec3),
 /// `.rotation` (quat), `.scale` (vec3).
-fn bound_joint(skeleton: &Skeleton, name: &str, kind: TrackKind) -> Option<(usize, usize)> {
+pub(crate) fn bound_joint(
+    skeleton: &Skeleton,
+    name: &str,
+    kind: TrackKind,
+) -> Option<(usize, usize)> {
     let (joint, part) = name.rsplit_once('.')?;
     let part = match (part, kind) {
         ("translation", TrackKind::Vec3) => 0,

@@ -240,7 +240,6 @@ impl KeyStore {
         self.at = Vec::new();
         self.data = Data::Packed(Box::new(packed));
     }
-
 }
 
 /// Two expanded keys of a quantized group (forward playback reuses the

@@ -601,4 +601,5 @@ impl Packed {
 
 mod compile;
 mod file;
+pub use file::{MAGIC, VERSION};
 pub(crate) mod store;

@@ -1,0 +1,302 @@
+//! `tcb compress`: a packed clip ([`tcb_runtime::pack`]) whose quantization
+//! steps are the coarsest this search finds within the tolerance of
+//! `docs/reduce.md`'s metric, measured on the runtime that plays it.
+//!
+//! 1. Every track gets a step from a budget: the tolerance shared by the
+//!    tracks on the longest chain through its joint and, for rotations,
+//!    divided by the lever `L` (the longest rest chain below the joint plus
+//!    the shell radius), as `tcb reduce` budgets its fits:
+//!    `step = kappa e / (sqrt(3) L)` for a rotation (three components off by
+//!    `step / 2` turn it by at most `sqrt(3) step`), `2 kappa e / sqrt(3)`
+//!    for a translation.
+//! 2. `kappa` is bisected on the measured error (every check time of the
+//!    contract, every joint and End Site, FK in f64).
+//! 3. Rounds of rebalancing: each track's step is scaled by the slack of
+//!    the joints it moves (`(1 / r)^0.5`, r the largest error ratio in its
+//!    subtree), and `kappa` bisected again; the smallest file that holds is
+//!    kept.
+//!
+//! Nothing is returned that was not measured within the tolerance.
+
+use crate::metric::{self, Measured, Worst};
+use crate::reduce::{Metric, ReduceError, ReduceOptions, Settings, bound_joint, descends, resolve};
+use std::sync::Arc;
+use tcb_core::skeleton::Skeleton;
+use tcb_core::{Clip, TrackKind};
+use tcb_runtime::{PackSource, Packed};
+
+/// Options of [`compress`]; `None` takes the contract's default.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CompressOptions {
+    /// `--tolerance E`.
+    pub tolerance: Option<f64>,
+    /// `--shell R`.
+    pub shell: Option<f64>,
+    /// `--metric shell|value`.
+    pub metric: Option<Metric>,
+    /// `--rotation-tolerance DEG` (`value`).
+    pub rotation_tolerance: Option<f64>,
+}
+
+/// The packed clip and what was measured.
+#[derive(Clone, Debug)]
+pub struct Compressed {
+    /// The clip (its `note` says how it was made).
+    pub packed: Packed,
+    /// The values used.
+    pub settings: Settings,
+    /// The measured error, by the metric, on the runtime.
+    pub worst: Worst,
+    /// The file's bytes.
+    pub bytes: usize,
+    /// Values stored (keys times stored components).
+    pub values: usize,
+    /// Clips built and measured by the search.
+    pub evaluations: usize,
+}
+
+impl Compressed {
+    /// Bits of the file per stored value.
+    pub fn bits_per_value(&self) -> f64 {
+        8.0 * self.bytes as f64 / self.values.max(1) as f64
+    }
+
+    /// The last line `tcb compress` prints.
+    pub fn summary_line(&self) -> String {
+        format!(
+            "compressed: tracks {}, keys {}, values {}, bytes {}, {:.2} bits per value, max error {:e} ({}, joint {}, time {})",
+            self.packed.head().tracks.len(),
+            self.packed.head().keys,
+            self.values,
+            self.bytes,
+            self.bits_per_value(),
+            self.worst.error,
+            self.settings.metric.name(),
+            self.worst.at,
+            self.worst.time
+        )
+    }
+}
+
+/// Compress `clip` (with its `skeleton` for the shell metric). `progress`
+/// is called with (clips measured, of about how many).
+pub fn compress(
+    clip: &Clip,
+    skeleton: Option<&Skeleton>,
+    options: &CompressOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Compressed, ReduceError> {
+    let settings = resolve(
+        &ReduceOptions {
+            tolerance: options.tolerance,
+            shell: options.shell,
+            metric: options.metric,
+            rotation_tolerance: options.rotation_tolerance,
+            ..Default::default()
+        },
+        skeleton,
+    )?;
+    let times = metric::check_times(clip);
+    if times.len() < 2 {
+        return Err(ReduceError::Empty);
+    }
+    // Refuse what cannot be packed before searching.
+    let unit_steps = vec![1.0f32; clip.tracks().len()];
+    PackSource::quantize(clip, &unit_steps).map_err(|e| ReduceError::Option(e.to_string()))?;
+    let reference = Arc::new(tcb_runtime::Clip::compile(clip));
+    let rows = metric::play(&reference, &times);
+    let budget = Budget::new(clip, skeleton, &settings);
+    let total = 40;
+    let mut evaluations = 0usize;
+    let mut measure = |steps: &[f32]| -> Result<(Measured, Packed), ReduceError> {
+        evaluations += 1;
+        progress(evaluations.min(total - 1), total);
+        let source =
+            PackSource::quantize(clip, steps).map_err(|e| ReduceError::Option(e.to_string()))?;
+        let packed = Packed::encode(&source).map_err(|e| ReduceError::Build(e.to_string()))?;
+        let compiled = tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
+            .map_err(|e| ReduceError::Build(e.to_string()))?;
+        let compiled = Arc::new(compiled);
+        let m = match settings.metric {
+            Metric::Shell => metric::shell_error(
+                skeleton.expect("shell has a skeleton"),
+                &reference,
+                &compiled,
+                &times,
+                settings.shell,
+                settings.tolerance,
+            ),
+            Metric::Value => metric::value_error(
+                clip,
+                &rows,
+                &compiled,
+                &times,
+                settings.tolerance,
+                settings.rotation_tolerance,
+            ),
+        };
+        Ok((m, packed))
+    };
+
+    // Per track a relative weight (rebalanced below) times kappa.
+    let mut weight = vec![1.0f64; clip.tracks().len()];
+    let mut best: Option<(usize, Measured, Packed)> = None;
+    for round in 0..4 {
+        // Bisect kappa (log scale) between one that holds and one that does not.
+        let (mut lo, mut hi) = (0.25f64, 64.0f64);
+        let mut last_ok: Option<(Measured, Packed)> = None;
+        let steps_at = |k: f64| budget.steps(k, &weight);
+        let iterations = if round == 0 { 9 } else { 6 };
+        // The first round searches the whole range; later rounds near kappa.
+        for _ in 0..iterations {
+            let mid = (lo * hi).sqrt();
+            let (m, p) = measure(&steps_at(mid))?;
+            if m.worst.ratio <= 1.0 {
+                lo = mid;
+                last_ok = Some((m, p));
+            } else {
+                hi = mid;
+            }
+        }
+        let (m, p) = match last_ok {
+            Some(x) => x,
+            None => {
+                let (m, p) = measure(&steps_at(lo))?;
+                if m.worst.ratio > 1.0 {
+                    // Nothing at this round's weights holds: keep the best.
+                    if best.is_some() {
+                        break;
+                    }
+                    return Err(ReduceError::CannotMeet {
+                        ratio: m.worst.ratio,
+                        worst: m.worst,
+                    });
+                }
+                (m, p)
+            }
+        };
+        let bytes = p.to_bytes().len();
+        if best.as_ref().is_none_or(|b| bytes < b.0) {
+            best = Some((bytes, m.clone(), p));
+        }
+        // Rebalance: tracks whose joints have slack get coarser.
+        for (t, w) in weight.iter_mut().enumerate() {
+            let r = budget.slack(t, &m.each);
+            *w *= (1.0 / r.max(0.05)).sqrt().min(4.0);
+        }
+    }
+    progress(total, total);
+    let (bytes, measured, mut packed) = best.expect("a round that holds, or an error above");
+    packed.note = format!(
+        "tcb compress: metric {}, tolerance {:e}, shell {:e}, max error {:e} at {} time {}",
+        settings.metric.name(),
+        settings.tolerance,
+        settings.shell,
+        measured.worst.error,
+        measured.worst.at,
+        measured.worst.time
+    );
+    let bytes = bytes + packed.note.len();
+    let values = packed.head().keys * packed.head().lanes();
+    Ok(Compressed {
+        packed,
+        settings,
+        worst: measured.worst,
+        bytes,
+        values,
+        evaluations,
+    })
+}
+
+/// Per track: its share of the tolerance in its own units.
+struct Budget {
+    /// Per track: the step at kappa = 1.
+    unit: Vec<f64>,
+    /// Per track: the joints (shell) or the track itself (value) its error reaches.
+    reaches: Vec<Vec<usize>>,
+}
+
+impl Budget {
+    fn new(clip: &Clip, skeleton: Option<&Skeleton>, s: &Settings) -> Self {
+        let sqrt3 = 3f64.sqrt();
+        let tracks = clip.tracks();
+        match (s.metric, skeleton) {
+            (Metric::Shell, Some(sk)) => {
+                let n = sk.joints.len();
+                let joint: Vec<Option<usize>> = tracks
+                    .iter()
+                    .map(|t| bound_joint(sk, &t.name, t.data.kind()).map(|(j, _)| j))
+                    .collect();
+                // Longest rest chain below each joint, and tracks per chain.
+                let mut reach = vec![0.0f64; n];
+                let mut count = vec![0usize; n];
+                for j in joint.iter().flatten() {
+                    count[*j] += 1;
+                }
+                let mut down = count.clone();
+                for j in (0..n).rev() {
+                    if let Some(p) = sk.joints[j].parent.filter(|&p| p < j) {
+                        let off = f64::from(sk.joints[j].rest.translation.length());
+                        reach[p] = reach[p].max(reach[j] + off);
+                        down[p] = down[p].max(count[p] + down[j]);
+                    }
+                }
+                let mut up = count.clone();
+                for j in 0..n {
+                    if let Some(p) = sk.joints[j].parent.filter(|&p| p < j) {
+                        up[j] += up[p];
+                    }
+                }
+                let unit = tracks
+                    .iter()
+                    .zip(&joint)
+                    .map(|(t, j)| {
+                        let Some(j) = *j else {
+                            return 1e-6; // moves no joint: fine steps cost little
+                        };
+                        let e = s.tolerance / (up[j] + down[j] - count[j]).max(1) as f64;
+                        match t.data.kind() {
+                            TrackKind::Quat => e / (sqrt3 * (reach[j] + s.shell)),
+                            _ => 2.0 * e / sqrt3,
+                        }
+                    })
+                    .collect();
+                let reaches = joint
+                    .iter()
+                    .map(|j| match j {
+                        Some(a) => (0..n).filter(|&d| descends(sk, d, *a)).collect(),
+                        None => Vec::new(),
+                    })
+                    .collect();
+                Budget { unit, reaches }
+            }
+            _ => Budget {
+                unit: tracks
+                    .iter()
+                    .map(|t| match t.data.kind() {
+                        TrackKind::Quat => (s.rotation_tolerance.to_radians() / 2.0).sin() / sqrt3,
+                        _ => 2.0 * s.tolerance / sqrt3,
+                    })
+                    .collect(),
+                reaches: (0..tracks.len()).map(|i| vec![i]).collect(),
+            },
+        }
+    }
+
+    fn steps(&self, kappa: f64, weight: &[f64]) -> Vec<f32> {
+        self.unit
+            .iter()
+            .zip(weight)
+            .map(|(u, w)| (u * w * kappa).clamp(1e-9, 1e3) as f32)
+            .collect()
+    }
+
+    /// The largest error ratio among what track `t` moves (1 if nothing).
+    fn slack(&self, t: usize, each: &[f64]) -> f64 {
+        self.reaches[t]
+            .iter()
+            .map(|&j| each[j])
+            .fold(0.0, f64::max)
+            .max(if self.reaches[t].is_empty() { 1.0 } else { 0.0 })
+    }
+}
