@@ -11,11 +11,12 @@
 
 use arbitrary::{Arbitrary, Unstructured};
 use std::sync::Arc;
+use tcb_core::params::Tcb;
 use tcb_core::{
     Ends, Extrapolation, Hemisphere, Interp, RotationMode, TangentRule, TrackData, TrackKind,
 };
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
-use tcb_runtime::{BlendMask, Instance};
+use tcb_runtime::{BlendMask, Instance, PackSource, Packed, Playback};
 
 /// `tcb-clip/1` JSON: parse, build, then play what builds.
 pub fn clip_json(data: &[u8]) {
@@ -197,6 +198,117 @@ pub fn reduce(data: &[u8]) {
         );
         let back = ClipDoc::parse(&r.doc.to_json()).expect("the reduced clip reads back");
         back.build().expect("the reduced clip builds");
+    }
+}
+
+/// `.tcbc` bytes, then (past the length their header gives) bytes that
+/// choose the playback. Read as given and, if refused, resealed (magic,
+/// version, length and checksum rewritten) so that mutations reach past
+/// the checksum. What reads back writes the same bytes; what compiles plays
+/// as its reference (the decoded integers' `to_clip`, compiled) does.
+pub fn tcbc(data: &[u8]) {
+    let claimed = data
+        .get(12..20)
+        .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")));
+    let len = match claimed {
+        Some(n) if (24..=data.len() as u64).contains(&n) => n as usize,
+        _ => data.len(),
+    };
+    let (file, rest) = data.split_at(len);
+    let (packed, read) = match Packed::from_bytes(file) {
+        Ok(p) => (p, file.to_vec()),
+        Err(_) if file.len() >= 24 => {
+            let sealed = reseal(file);
+            match Packed::from_bytes(&sealed) {
+                Ok(p) => (p, sealed),
+                Err(_) => return,
+            }
+        }
+        Err(_) => return,
+    };
+    let bytes = packed.to_bytes();
+    assert!(bytes == read, "a file read back writes other bytes");
+    assert_eq!(
+        Packed::from_bytes(&bytes).as_ref(),
+        Ok(&packed),
+        "the written bytes read back to another clip"
+    );
+    let packed = Arc::new(packed);
+    let Ok(clip) = tcb_runtime::Clip::from_packed(packed.clone()) else {
+        return;
+    };
+    let reference = packed
+        .decode()
+        .and_then(|s| s.to_clip())
+        .expect("from_packed built the reference");
+    play_packed(clip, &reference, &mut Unstructured::new(rest));
+}
+
+/// A structured clip on one even grid (1 to 12 tracks of every kind, 2 to
+/// 200 keys, values from gentle to huge, rotations through w = 0 and
+/// across hemispheres, every rule and end, tension, continuity and bias per
+/// track, pre and post shared) and quantization steps: quantized, encoded,
+/// compiled from the packed stream and played against its reference.
+/// Refusals must be clean errors, except a compile whose decoded keys miss
+/// the reference's controls: quantize and encode accepted the clip, so the
+/// runtime's tangents or decoding disagree with the reference.
+pub fn pack(data: &[u8]) {
+    let mut u = Unstructured::new(data);
+    let Ok(input) = arbitrary_pack(&mut u) else {
+        return;
+    };
+    let Ok(clip) = input.doc.build() else {
+        return;
+    };
+    let Ok(mut source) = PackSource::quantize(&clip, &input.steps) else {
+        return;
+    };
+    for (t, tcb) in source.tracks.iter_mut().zip(&input.tcb) {
+        t.tcb = *tcb;
+    }
+    // Settings the format does not hold are refused when encoding.
+    if let Some(i) = input.tamper {
+        let n = source.tracks.len();
+        let t = &mut source.tracks[i % n];
+        match t.kind {
+            TrackKind::Quat => t.settings.rotation = RotationMode::Squad,
+            _ => t.settings.match_speed = true,
+        }
+        assert!(
+            Packed::encode(&source).is_err(),
+            "encoded a track the format cannot hold"
+        );
+        return;
+    }
+    let Ok(packed) = Packed::encode(&source) else {
+        return;
+    };
+    assert_eq!(
+        packed.decode().as_ref(),
+        Ok(&source),
+        "the stream decodes to other integers"
+    );
+    let bytes = packed.to_bytes();
+    assert_eq!(
+        Packed::from_bytes(&bytes).as_ref(),
+        Ok(&packed),
+        "the written bytes read back to another clip"
+    );
+    match tcb_runtime::Clip::from_packed(Arc::new(packed)) {
+        Ok(compiled) => {
+            assert_eq!(
+                compiled.to_bytes(),
+                Some(bytes),
+                "the compiled clip's bytes"
+            );
+            let reference = source.to_clip().expect("from_packed built the reference");
+            play_packed(compiled, &reference, &mut u);
+        }
+        Err(e) => assert!(
+            !e.0.starts_with("packed keys miss their reference"),
+            "{e}; quantize and encode accepted {}",
+            describe(&source)
+        ),
     }
 }
 
@@ -407,4 +519,330 @@ pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
         tracks,
         skeleton: None,
     })
+}
+
+/// `.tcbc` bytes with the magic, version, length and checksum of a good
+/// file: the header as `Packed::to_bytes` writes it over the body given.
+fn reseal(file: &[u8]) -> Vec<u8> {
+    let mut b = file.to_vec();
+    b[..8].copy_from_slice(&tcb_runtime::pack::MAGIC);
+    b[8..12].copy_from_slice(&tcb_runtime::pack::VERSION.to_le_bytes());
+    b[12..20].copy_from_slice(&(file.len() as u64).to_le_bytes());
+    let crc = crc32(&b[24..]);
+    b[20..24].copy_from_slice(&crc.to_le_bytes());
+    b
+}
+
+/// CRC-32 (IEEE, reflected), bit by bit: the fuzz crate and the replay
+/// test share no checksum crate, and inputs are small.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &x in bytes {
+        crc ^= u32::from(x);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// The `pack` target's input: a clip document on one even grid, a
+/// quantization step and a tension, continuity and bias per track, and
+/// perhaps a track to give settings the format refuses.
+struct PackInput {
+    doc: ClipDoc,
+    steps: Vec<f32>,
+    tcb: Vec<Tcb>,
+    tamper: Option<usize>,
+}
+
+fn arbitrary_pack(u: &mut Unstructured) -> arbitrary::Result<PackInput> {
+    let keys = u.int_in_range(2..=200usize)?;
+    let start = match u.int_in_range(0..=7u8)? {
+        0 => f64::arbitrary(u)?,
+        1 => f64::from(i32::arbitrary(u)?) * 1e3 + 0.1,
+        2 => *u.choose(&[1e6 + 0.1, 1e9 / 3.0, -1e7, 3.15e7, 1e-300])?,
+        _ => f64::from(i16::arbitrary(u)?) / 64.0,
+    };
+    let interval = match u.int_in_range(0..=7u8)? {
+        0 => f64::arbitrary(u)?.abs(),
+        1 => *u.choose(&[1e-9, 1e-6, 1.0 / 3.0, 0.1, 1e3, 1e6, 1e12, 1e300])?,
+        2 | 3 => 1.0 / f64::from(u.int_in_range(1..=240u16)?),
+        _ => f64::from(u.int_in_range(1..=u16::MAX)?) / 4096.0,
+    };
+    let times: Vec<f64> = (0..keys).map(|k| start + k as f64 * interval).collect();
+    let kinds: Vec<TrackKind> = (0..u.int_in_range(1..=12u8)?)
+        .map(|_| u.choose(&TrackKind::ALL).copied())
+        .collect::<arbitrary::Result<_>>()?;
+    // One pre and one post for every track; rotations have neither
+    // `linear` nor `offset-repeat`.
+    let ends_modes: Vec<Extrapolation> = Extrapolation::ALL
+        .iter()
+        .copied()
+        .filter(|e| {
+            !kinds.contains(&TrackKind::Quat)
+                || !matches!(e, Extrapolation::Linear | Extrapolation::OffsetRepeat)
+        })
+        .collect();
+    let pre = *u.choose(&ends_modes)?;
+    let post = *u.choose(&ends_modes)?;
+    let mut tracks = Vec::with_capacity(kinds.len());
+    let (mut steps, mut tcbs) = (Vec::new(), Vec::new());
+    for (i, &kind) in kinds.iter().enumerate() {
+        let ends = *u.choose(Ends::ALL)?;
+        let mut values = if kind == TrackKind::Quat && u.ratio(3, 4)? {
+            rotations(u, keys)?
+        } else {
+            vectors(u, keys)?
+        };
+        if ends == Ends::Cyclic {
+            values[keys - 1] = values[0];
+        }
+        let rotation = match ends {
+            Ends::Natural => RotationMode::Hermite,
+            _ => *u.choose(RotationMode::ALL)?,
+        };
+        tracks.push(TrackDoc {
+            name: format!("t{i}"),
+            kind,
+            times: times.clone(),
+            values,
+            keys: Vec::new(),
+            settings: SettingsDoc {
+                tangent_rule: Some(*u.choose(TangentRule::ALL)?),
+                ends: Some(ends),
+                match_speed: Some(bool::arbitrary(u)?),
+                continuity_fade: Some(bool::arbitrary(u)?),
+                tcb: None,
+                pre: Some(pre),
+                post: Some(post),
+                rotation: Some(rotation),
+                hemisphere: Some(*u.choose(Hemisphere::ALL)?),
+            },
+        });
+        tcbs.push(match u.int_in_range(0..=3u8)? {
+            0 => Tcb::DEFAULT,
+            _ => Tcb::from_array(tcb3(u)?),
+        });
+        steps.push(match u.int_in_range(0..=15u8)? {
+            0 => f32::arbitrary(u)?,
+            1 => *u.choose(&[1e-45, f32::MIN_POSITIVE, 1e-30, 1e-12, 1e20, f32::MAX])?,
+            _ => {
+                let fine = 0.5f32.powi(u.int_in_range(0..=24i32)?);
+                fine * (1.0 + f32::from(u8::arbitrary(u)?) / 256.0)
+            }
+        });
+    }
+    let tamper = if u.ratio(1, 32)? {
+        Some(usize::from(u8::arbitrary(u)?))
+    } else {
+        None
+    };
+    Ok(PackInput {
+        doc: ClipDoc {
+            name: "fuzz".into(),
+            defaults: SettingsDoc::default(),
+            tracks,
+            skeleton: None,
+        },
+        steps,
+        tcb: tcbs,
+        tamper,
+    })
+}
+
+/// `keys` values of one track: each key arbitrary, a random walk, or a
+/// quadratic, at a magnitude from 1 to 1e30.
+fn vectors(u: &mut Unstructured, keys: usize) -> arbitrary::Result<Vec<[f32; 4]>> {
+    let scale = *u.choose(&[1.0f32, 1.0, 1.0, 1e-3, 1e3, 1e6, 1e20, 1e30])?;
+    Ok(match u.int_in_range(0..=3u8)? {
+        0 => (0..keys)
+            .map(|_| Ok(value(u)?.map(|x| x * scale)))
+            .collect::<arbitrary::Result<_>>()?,
+        1 => {
+            let mut v = value(u)?;
+            (0..keys)
+                .map(|_| {
+                    let d = value(u)?;
+                    v = std::array::from_fn(|c| v[c] + d[c] * scale);
+                    Ok(v)
+                })
+                .collect::<arbitrary::Result<_>>()?
+        }
+        _ => {
+            let (a, b, c) = (value(u)?, value(u)?, value(u)?);
+            (0..keys)
+                .map(|k| {
+                    let k = k as f32;
+                    std::array::from_fn(|i| scale * (a[i] + b[i] * k + c[i] * k * k / 16.0))
+                })
+                .collect()
+        }
+    })
+}
+
+/// `keys` rotations about one axis, turning a constant angle per key (up
+/// to and past a half turn, so `w` passes 0 and neighbours leave each
+/// other's hemisphere), some keys negated.
+fn rotations(u: &mut Unstructured, keys: usize) -> arbitrary::Result<Vec<[f32; 4]>> {
+    use std::f64::consts::PI;
+    let [x, y, z, _] = value(u)?.map(f64::from);
+    let norm = (x * x + y * y + z * z).sqrt();
+    let axis = if norm > 1e-6 {
+        [x / norm, y / norm, z / norm]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let first = f64::from(i16::arbitrary(u)?) / 32768.0 * 2.0 * PI;
+    let turn = match u.int_in_range(0..=5u8)? {
+        0 => *u.choose(&[PI, PI / 2.0, PI - 1e-4, PI + 1e-4, 2.0 * PI - 1e-3])?,
+        1 => f64::from(i16::arbitrary(u)?) / 32768.0 * 2.0 * PI,
+        _ => f64::from(i8::arbitrary(u)?) / 128.0 * 0.3,
+    };
+    let negate = u8::arbitrary(u)?;
+    Ok((0..keys)
+        .map(|k| {
+            let a = first + turn * k as f64;
+            let (s, c) = (0.5 * a).sin_cos();
+            let q = [axis[0] * s, axis[1] * s, axis[2] * s, c].map(|v| v as f32);
+            if negate != 0 && k % usize::from(negate) == 0 {
+                q.map(|v| -v)
+            } else {
+                q
+            }
+        })
+        .collect())
+}
+
+/// A packed clip against its reference, compiled as usual: one instance
+/// played forward over the keys, then at times the input chooses (seeks
+/// back, across blocks, past the ends, NaN and infinities), then at block
+/// boundaries; each row equal as numbers (values and velocities, rotations
+/// included) to the reference instance's and to a fresh instance's (a
+/// seek from nothing).
+fn play_packed(clip: tcb_runtime::Clip, reference: &tcb_core::Clip, u: &mut Unstructured) {
+    let head = clip.packed().expect("compiled from a packed clip").head();
+    let (start, interval, keys) = (head.start, head.interval, head.keys);
+    let at = |k: f64| start + k * interval;
+    let mut times: Vec<f64> = (0..keys.min(150))
+        .flat_map(|k| [at(k as f64), at(k as f64 + 0.37)])
+        .collect();
+    while times.len() < 400 {
+        let Ok(t) = packed_time(u, start, interval, keys) else {
+            break;
+        };
+        times.push(t);
+    }
+    for b in [63, 64, 65, 127, 128, 129, keys - 2, keys - 1, keys, 1, 0] {
+        times.extend([at(b as f64 + 0.5), at(b as f64 - 0.25)]);
+    }
+    times.extend([f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -1e300, 1e300]);
+    let mode = *u
+        .choose(&[
+            Playback::Clip,
+            Playback::Loop,
+            Playback::Clamp,
+            Playback::PingPong,
+        ])
+        .unwrap_or(&Playback::Clip);
+    let speed = match u.int_in_range(0..=3u8).unwrap_or(0) {
+        0 => 1.0,
+        1 => *u.choose(&[-1.0, 0.5, 2.0, 1e-3, 1e3]).unwrap_or(&1.0),
+        _ => f64::from(i16::arbitrary(u).unwrap_or(1)) / 256.0,
+    };
+    let clip = Arc::new(clip);
+    let reference = Arc::new(tcb_runtime::Clip::compile(reference));
+    let make = |c: &Arc<tcb_runtime::Clip>| {
+        let mut i = Instance::new(c.clone()).with_velocities();
+        i.set_playback(mode, speed).expect("a finite speed");
+        i
+    };
+    let (mut playing, mut against) = (make(&clip), make(&reference));
+    let n = clip.channel_count();
+    let row = |i: &mut Instance, t: f64| {
+        let (mut v, mut d) = (vec![0.0f32; n], vec![0.0f32; n]);
+        i.sample(t).write_row(&mut v, Some(&mut d));
+        (v, d)
+    };
+    for &t in &times {
+        let got = row(&mut playing, t);
+        let seek = row(&mut make(&clip), t);
+        assert!(
+            same(&got.0, &seek.0) && same(&got.1, &seek.1),
+            "packed: forward playback differs from a seek at {t}"
+        );
+        let want = row(&mut against, t);
+        let mut c = 0;
+        for slot in clip.tracks() {
+            let r = c..c + slot.kind().dim();
+            c = r.end;
+            for (what, g, w) in [("value", &got.0, &want.0), ("velocity", &got.1, &want.1)] {
+                let (g, w) = (&g[r.clone()], &w[r.clone()]);
+                assert!(
+                    same(g, w),
+                    "packed {} {:?} {what} at {t} ({mode:?} x{speed}): packed {g:?}, reference {w:?}",
+                    slot.name(),
+                    slot.kind()
+                );
+            }
+        }
+    }
+}
+
+/// Mostly times on and between the keys, sometimes far past them or
+/// anything at all.
+fn packed_time(
+    u: &mut Unstructured,
+    start: f64,
+    interval: f64,
+    keys: usize,
+) -> arbitrary::Result<f64> {
+    if u.is_empty() {
+        return Err(arbitrary::Error::NotEnoughData);
+    }
+    let last = u32::try_from(keys).unwrap_or(u32::MAX).saturating_add(1);
+    Ok(match u.int_in_range(0..=7u8)? {
+        0 => f64::arbitrary(u)?,
+        1 => *u.choose(&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 0.0, -0.0])?,
+        2 => start + interval * f64::from(i16::arbitrary(u)?) / 16.0,
+        _ => {
+            let k = f64::from(u.int_in_range(0..=last)?);
+            start + interval * (k + f64::from(u8::arbitrary(u)?) / 256.0)
+        }
+    })
+}
+
+/// A packed clip's grid and each track's settings, in one line.
+fn describe(s: &PackSource) -> String {
+    let tracks: Vec<String> = s
+        .tracks
+        .iter()
+        .map(|t| {
+            let e = &t.settings;
+            format!(
+                "{} {} {} {} fade={} tcb={:?} pre={} post={} step={} rebuild_w={}",
+                t.name,
+                t.kind.name(),
+                e.tangent_rule,
+                e.ends,
+                e.continuity_fade,
+                t.tcb.to_array(),
+                e.pre,
+                e.post,
+                t.step,
+                t.rebuild_w
+            )
+        })
+        .collect();
+    format!(
+        "{} keys from {} every {}: {}",
+        s.keys,
+        s.start,
+        s.interval,
+        tracks.join("; ")
+    )
 }

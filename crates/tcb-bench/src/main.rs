@@ -155,6 +155,14 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
                 let path = scratch.join("character-reduced.json");
                 tcb_io::write_clip_doc(&doc, &path)?;
                 Some(path)
+            } else if n.starts_with("character-compressed") {
+                // Compressed here too (a search of clips measured); counted
+                // from the written .tcbc, which the counted process loads.
+                let packed = scenarios::compress_cmu(&args.bvh, n.ends_with("acl"))?;
+                std::fs::create_dir_all(&scratch)?;
+                let path = scratch.join(format!("{n}.tcbc"));
+                tcb_io::write_atomically(&path, &packed.to_bytes())?;
+                Some(path)
             } else {
                 None
             };

@@ -192,6 +192,8 @@ pub struct Row {
     /// `character-reduced`: the dense `character-hermite` runtime time over
     /// this one (both measured in this run, so it holds across machines).
     pub speedup_vs_dense: Option<f64>,
+    /// A packed clip's `.tcbc` bytes.
+    pub file_bytes: Option<usize>,
 }
 
 impl Row {
@@ -207,6 +209,7 @@ pub fn measure(s: &Scenario, timing: &Timing) -> Row {
         name: s.name.to_string(),
         channels: s.channels(),
         bytes: s.clip.memory_bytes(),
+        file_bytes: s.file_bytes,
         ..Row::default()
     };
     if let Some(peer) = &s.peer {
@@ -286,7 +289,11 @@ pub fn relate(rows: &mut [Row]) {
         .iter()
         .find(|r| r.name == "character-hermite")
         .and_then(|r| r.ns_of("runtime"));
-    for r in rows.iter_mut().filter(|r| r.name == "character-reduced") {
+    let compressed = |n: &str| n.starts_with("character-compressed");
+    for r in rows
+        .iter_mut()
+        .filter(|r| r.name == "character-reduced" || compressed(&r.name))
+    {
         r.speedup_vs_dense = dense.zip(r.ns_of("runtime")).map(|(d, x)| d / x);
     }
 }
@@ -306,6 +313,9 @@ pub fn to_json(rows: &[Row], here: &Fingerprint, timing: &Timing) -> Value {
             m.insert("ns_per_channel".into(), Value::Object(ns));
             m.insert("speedup_vs_baseline".into(), json!(r.speedup_vs_baseline));
             m.insert("bytes".into(), json!(r.bytes));
+            if let Some(f) = r.file_bytes {
+                m.insert("file_bytes".into(), json!(f));
+            }
             let optional = [
                 ("speedup_vs_splines", r.speedup_vs_splines),
                 ("read_limit_fraction", r.read_limit_fraction),
@@ -492,6 +502,34 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
             ),
             j <= 1.5,
         ));
+    }
+    for (n, what) in [
+        ("character-compressed", "the default tolerance"),
+        ("character-compressed-acl", "ACL's target"),
+    ] {
+        let Some(r) = get(n) else { continue };
+        let f = r.file_bytes.unwrap_or(r.bytes);
+        if n.ends_with("acl") {
+            let x = f as f64 / crate::scenarios::ACL_CMU_BYTES as f64;
+            out.push((
+                format!(
+                    "{n}: {f} bytes at {what}, {x:.3}x ACL's {} (goal: at most 1x; aim 0.65x)",
+                    crate::scenarios::ACL_CMU_BYTES
+                ),
+                x <= 1.0,
+            ));
+        }
+        if let Some(d) = r.speedup_vs_dense {
+            let j = r.ns_per_joint.unwrap_or(f64::NAN);
+            out.push((
+                format!(
+                    "{n}: {j:.2} ns per joint per frame, {:.2}x character-hermite's time in this run (goal: at most 1.5x); {f} bytes at {what}, {:.3} MB compiled",
+                    1.0 / d,
+                    r.bytes as f64 / 1e6
+                ),
+                1.0 / d <= 1.5,
+            ));
+        }
     }
     if let (Some(s), Some(c)) = (get("seek"), get("character-hermite")) {
         let (a, b) = (

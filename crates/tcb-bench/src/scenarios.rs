@@ -11,6 +11,8 @@
 //! | `seek` | the CMU clip (hermite) at random times, as many as `character` |
 //! | `sparse-seek` | `sparse` at random times, as many as `sparse` (every frame a seek of every lane) |
 //! | `character-reduced` | the CMU clip (hermite) reduced by `tcb reduce` at the default shell tolerance, as `character` |
+//! | `character-compressed` | the CMU clip packed by `tcb compress` at the default shell tolerance (a `.tcbc`), as `character` |
+//! | `character-compressed-acl` | the same at ACL's default error target ([`ACL_TARGET`]) |
 
 use crate::Rng;
 use crate::baseline::Baseline;
@@ -49,6 +51,8 @@ pub struct Scenario {
     pub read_limit: bool,
     /// Whether to time instances in parallel with rayon.
     pub parallel: bool,
+    /// A packed clip's `.tcbc` bytes.
+    pub file_bytes: Option<usize>,
 }
 
 impl Scenario {
@@ -64,6 +68,7 @@ impl Scenario {
             joints: None,
             read_limit: false,
             parallel: false,
+            file_bytes: None,
         }
     }
 
@@ -291,6 +296,79 @@ pub fn character_reduced(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     Ok(s)
 }
 
+/// ACL's default error target (0.01 cm at a 3 cm shell) in the CMU clip's
+/// units, with 1 unit = 6.627 cm (its rest pose spans 25.65 units, a 1.7 m
+/// figure): `(tolerance, shell)`.
+pub const ACL_TARGET: (f64, f64) = (1.509e-3, 0.4527);
+
+/// ACL 2.1's bytes for the CMU clip at [`ACL_TARGET`] (120 fps, its
+/// defaults; `../shared/peers/acl/run.sh`, docs/benchmarks.md).
+pub const ACL_CMU_BYTES: usize = 270_987;
+
+/// `character-compressed` (`acl` false) or `character-compressed-acl`:
+/// the hermite character packed by `tcb compress`, played like
+/// `character-hermite` from the packed stream.
+pub fn character_compressed(bvh: &Path, acl: bool) -> Result<Scenario, tcb_io::Error> {
+    let packed = compress_cmu(bvh, acl)?;
+    let name = if acl {
+        "character-compressed-acl"
+    } else {
+        "character-compressed"
+    };
+    packed_scenario(name, packed, bvh)
+}
+
+/// The hermite character compressed by `tcb compress` (at ACL's target
+/// with `acl`), what the compressed scenarios play and `--icount` hands to
+/// the counted process as a file.
+pub fn compress_cmu(bvh: &Path, acl: bool) -> Result<tcb_runtime::Packed, tcb_io::Error> {
+    let options = tcb_io::ImportOptions {
+        rotation: RotationMode::Hermite,
+        ..Default::default()
+    };
+    let loaded = tcb_io::load_with(bvh, &options)?;
+    let options = tcb_fit::CompressOptions {
+        tolerance: acl.then_some(ACL_TARGET.0),
+        shell: acl.then_some(ACL_TARGET.1),
+        ..Default::default()
+    };
+    let c = tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, &|_, _| {})
+        .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(bvh))?;
+    Ok(c.packed)
+}
+
+/// A packed clip played at 60 fps forward over its keys; its baseline plays
+/// the packed clip's reference (the dequantized keys).
+fn packed_scenario(
+    name: &str,
+    packed: tcb_runtime::Packed,
+    path: &Path,
+) -> Result<Scenario, tcb_io::Error> {
+    let err = |e: tcb_runtime::PackError| tcb_io::Error::import(e.to_string()).in_file(path);
+    let file_bytes = packed.to_bytes().len();
+    let packed = Arc::new(packed);
+    let source = packed.decode().and_then(|s| s.to_clip()).map_err(err)?;
+    let clip = tcb_runtime::Clip::from_packed(packed).map_err(err)?;
+    let mut joints: Vec<&str> = source
+        .tracks()
+        .iter()
+        .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
+        .collect();
+    joints.sort_unstable();
+    joints.dedup();
+    let joints = joints.len();
+    let (start, end) = source.time_range().unwrap_or((0.0, 0.0));
+    let times = frames(end - start, 60.0)
+        .into_iter()
+        .map(|t| t + start)
+        .collect();
+    let mut s = Scenario::new(name, source, times);
+    s.clip = Arc::new(clip);
+    s.joints = Some(joints);
+    s.file_bytes = Some(file_bytes);
+    Ok(s)
+}
+
 /// The clip `character-reduced` plays, as a document (what `--icount`
 /// hands to the counted process).
 pub fn reduced_doc(bvh: &Path) -> Result<tcb_io::ClipDoc, tcb_io::Error> {
@@ -347,6 +425,19 @@ pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
 /// several instances, each plays from its own random phase within the clip,
 /// one second (or the whole clip, if shorter) per pass.
 pub fn file_with(path: &Path, options: &FileOptions) -> Result<Scenario, tcb_io::Error> {
+    let stem = path
+        .file_stem()
+        .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("tcbc"))
+    {
+        let bytes =
+            std::fs::read(path).map_err(|e| tcb_io::Error::import(e.to_string()).in_file(path))?;
+        let packed = tcb_runtime::Packed::from_bytes(&bytes)
+            .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(path))?;
+        return packed_scenario(&stem, packed, path);
+    }
     let loaded = tcb_io::load_with(path, &options.import)?;
     let joints = animated_joints(&loaded);
     let (start, end) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
@@ -531,7 +622,7 @@ pub fn all(bvh: &Path) -> Result<Vec<Scenario>, tcb_io::Error> {
 }
 
 /// The scenario names, in report order.
-pub const NAMES: [&str; 10] = [
+pub const NAMES: [&str; 12] = [
     "character-hermite",
     "character-squad",
     "character-quantized",
@@ -542,6 +633,8 @@ pub const NAMES: [&str; 10] = [
     "seek",
     "sparse-seek",
     "character-reduced",
+    "character-compressed",
+    "character-compressed-acl",
 ];
 
 /// The scenarios whose name `want` accepts, built only if wanted (the
@@ -559,6 +652,8 @@ pub fn named(bvh: &Path, want: impl Fn(&str) -> bool) -> Result<Vec<Scenario>, t
             "sparse-rotations" => sparse_rotations(),
             "seek" => seek(bvh)?,
             "sparse-seek" => sparse_seek(),
+            "character-compressed" => character_compressed(bvh, false)?,
+            "character-compressed-acl" => character_compressed(bvh, true)?,
             _ => character_reduced(bvh)?,
         });
     }

@@ -54,3 +54,13 @@ fn blend_corpus() {
 fn reduce_corpus() {
     replay("reduce", bodies::reduce);
 }
+
+#[test]
+fn tcbc_corpus() {
+    replay("tcbc", bodies::tcbc);
+}
+
+#[test]
+fn pack_corpus() {
+    replay("pack", bodies::pack);
+}

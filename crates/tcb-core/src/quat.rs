@@ -58,20 +58,14 @@ pub fn unit_key<L: Lane>(p: [L; 4]) -> [L; 4] {
 
 /// The `w` of a unit quaternion from its `x y z` (`w >= 0`), as a packed
 /// clip stores three components of a rotation: `sqrt(max(0, 1 - |xyz|^2))`
-/// in `f64`, rounded to `f32`. The one copy the encoder and the decoder use.
+/// in `f32`, summed `x x + y y + z z` in that order. The one copy the
+/// encoder (`f32`) and the decoder (`f32x8`) use.
 ///
 /// ```
-/// assert_eq!(tcb_core::quat::rebuild_w(0.6, 0.0, 0.0), 0.8);
+/// assert_eq!(tcb_core::quat::rebuild_w(0.6f32, 0.0, 0.0), 0.8);
 /// ```
-#[inline]
-pub fn rebuild_w(x: f32, y: f32, z: f32) -> f32 {
-    rebuild_w_lanes(f64::from(x), f64::from(y), f64::from(z)) as f32
-}
-
-/// [`rebuild_w`] before its rounding to `f32`, on any lane type (the
-/// decoder runs it on `f64x4`).
 #[inline(always)]
-pub fn rebuild_w_lanes<L: Lane>(x: L, y: L, z: L) -> L {
+pub fn rebuild_w<L: Lane>(x: L, y: L, z: L) -> L {
     let s = L::of(1.0) - (x * x + y * y + z * z);
     L::select(s.lt(L::of(0.0)), L::of(0.0), s).sqrt()
 }

@@ -32,6 +32,7 @@ impl Clip {
         let mut step = vec![[0.0f32; 8]; np];
         let mut weights = vec![[[0.0f32; 8]; 4]; np];
         let mut rebuild = vec![[true; 8]; g.hq_blocks];
+
         let rot_from = g.vec_blocks;
         let times = source.times();
         for (t, slot) in source.tracks.iter().zip(clip.layout.tracks()) {
@@ -78,7 +79,11 @@ impl Clip {
             step: step.into_iter().map(f32x8::new).collect(),
             weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
             rot_from,
-            rebuild,
+            rebuild: rebuild
+                .into_iter()
+                .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))
+                .collect(),
+
             table,
         };
         // Every stored segment, forward: the packed controls are the

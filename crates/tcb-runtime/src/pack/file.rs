@@ -106,7 +106,7 @@ impl Packed {
     /// The `.tcbc` bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
         let h = &self.head;
-        let mut w = Writer(Vec::with_capacity(HEADER + self.stream.len() + 4096));
+        let mut w = Writer(Vec::with_capacity(HEADER + self.stream_len + 4096));
         w.0.extend_from_slice(&[0; HEADER]);
         w.str(&h.name);
         w.str(&self.note);
@@ -144,9 +144,9 @@ impl Packed {
         for s in &self.seg_at {
             w.u32(*s);
         }
-        let stream = &self.stream[..self.stream.len() - 8];
-        w.len(stream.len());
-        w.0.extend_from_slice(stream);
+        let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
+        w.len(self.stream_len);
+        w.0.extend_from_slice(&bytes[..self.stream_len]);
         let total = w.0.len() as u64;
         let crc = crc32fast::hash(&w.0[HEADER..]);
         let head = &mut w.0[..HEADER];
@@ -264,7 +264,7 @@ impl Packed {
             .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
             .collect();
         let len = r.u32("the stream length")? as usize;
-        let mut stream = r.take(len, "the stream")?.to_vec();
+        let stream = super::to_words(r.take(len, "the stream")?);
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
         }
@@ -275,7 +275,6 @@ impl Packed {
                 "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
             ));
         }
-        stream.extend_from_slice(&[0; 8]);
         let packed = Packed {
             head: PackSource {
                 name,
@@ -288,6 +287,7 @@ impl Packed {
             delta_bits,
             seg_at,
             stream,
+            stream_len: len,
             note,
         };
         packed.decode()?;

@@ -196,7 +196,6 @@ impl PackSource {
                 }
                 rebuild_w = pos || neg;
             }
-            let stored = kind.dim() - usize::from(rebuild_w);
             let q = |x: f32| {
                 let v = (f64::from(x) / f64::from(step)).round();
                 if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
@@ -208,14 +207,29 @@ impl PackSource {
                     Ok(v as i32)
                 }
             };
-            let values = (0..stored)
-                .map(|c| {
-                    values
-                        .iter()
-                        .map(|v| q(v[c]))
-                        .collect::<Result<Vec<i32>, _>>()
-                })
-                .collect::<Result<Vec<_>, _>>()?;
+            let ints = |stored: usize| {
+                (0..stored)
+                    .map(|c| {
+                        values
+                            .iter()
+                            .map(|v| q(v[c]))
+                            .collect::<Result<Vec<i32>, _>>()
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            };
+            let mut ints4 = None;
+            if rebuild_w {
+                let xyz = ints(3)?;
+                if one_hemisphere(&xyz, step) {
+                    ints4 = Some(xyz);
+                } else {
+                    rebuild_w = false;
+                }
+            }
+            let values = match ints4 {
+                Some(v) => v,
+                None => ints(kind.dim())?,
+            };
             tracks.push(PackTrack {
                 name: t.name.clone(),
                 kind,
@@ -357,6 +371,27 @@ impl PackSource {
     }
 }
 
+/// Whether a rotation stored as `x y z` (integers per component, `w`
+/// rebuilt) keeps one hemisphere from key to key once its keys are made
+/// unit length as the track makes them (f64, [`tcb_core::quat::unit_key`]):
+/// else the track would flip a key, and it stores all four components.
+fn one_hemisphere(xyz: &[Vec<i32>], step: f32) -> bool {
+    let key = |k: usize| {
+        let [x, y, z] = [0, 1, 2].map(|c| dequantize(xyz[c][k], step));
+        let w = tcb_core::quat::rebuild_w(x, y, z);
+        tcb_core::quat::unit_key([x, y, z, w].map(f64::from))
+    };
+    let mut prev = key(0);
+    for k in 1..xyz[0].len() {
+        let q = key(k);
+        if (0..4).map(|c| prev[c] * q[c]).sum::<f64>() < 0.0 {
+            return false;
+        }
+        prev = q;
+    }
+    true
+}
+
 /// `n` keys with `tcb` (none: the defaults).
 fn key_params<V: Copy>(tcb: Tcb, n: usize) -> Vec<KeyParams<V>> {
     if tcb == Tcb::DEFAULT {
@@ -403,13 +438,33 @@ impl BitWriter {
     }
 }
 
-/// `w` bits (at most 32) at bit `pos` of `stream`, which has 8 bytes of
-/// padding after its last bit (so the word read is in bounds).
+/// `w` bits (at most 32) at bit `pos` of `words` (bit `p` is bit `p % 64`
+/// of word `p / 64`), which end with two words of padding.
 #[inline(always)]
-pub(crate) fn read_bits(stream: &[u8], pos: usize, w: u32) -> u32 {
-    let at = pos >> 3;
-    let word = u64::from_le_bytes(stream[at..at + 8].try_into().expect("8 bytes"));
-    ((word >> (pos & 7)) & ((1u64 << w) - 1)) as u32
+pub(crate) fn read_bits(words: &[u64], pos: usize, w: u32) -> u32 {
+    (window(words, pos) & ((1u64 << w) - 1)) as u32
+}
+
+/// The 64 bits from bit `pos` on.
+#[inline(always)]
+pub(crate) fn window(words: &[u64], pos: usize) -> u64 {
+    let (i, o) = (pos >> 6, (pos & 63) as u32);
+    (words[i] >> o) | ((words[i + 1] << 1) << (63 - o))
+}
+
+/// Bytes (little-endian, padded with zeros) as words, plus two words of
+/// padding.
+pub(crate) fn to_words(bytes: &[u8]) -> Vec<u64> {
+    let mut words: Vec<u64> = bytes
+        .chunks(8)
+        .map(|c| {
+            let mut b = [0u8; 8];
+            b[..c.len()].copy_from_slice(c);
+            u64::from_le_bytes(b)
+        })
+        .collect();
+    words.extend([0, 0]);
+    words
 }
 
 /// The encoded clip (see the module docs): the description without its
@@ -423,8 +478,9 @@ pub struct Packed {
     pub(crate) delta_bits: Vec<u8>,
     /// Per segment its first bit, then the stream's length in bits.
     pub(crate) seg_at: Vec<u32>,
-    /// The bits, then 8 bytes of zeros.
-    pub(crate) stream: Vec<u8>,
+    /// The bits as words, then two words of zeros; its length in bytes.
+    pub(crate) stream: Vec<u64>,
+    pub(crate) stream_len: usize,
     /// What made it (`tcb compress`'s options and measured error), for
     /// `tcb info`: free text, kept in the file.
     pub note: String,
@@ -501,8 +557,8 @@ impl Packed {
             }
         }
         seg_at.push(bit_offset(w.bits)?);
-        let mut stream = w.bytes;
-        stream.extend_from_slice(&[0; 8]);
+        let stream_len = w.bytes.len();
+        let stream = to_words(&w.bytes);
         let mut head = source.clone();
         for t in &mut head.tracks {
             t.values = Vec::new();
@@ -513,6 +569,7 @@ impl Packed {
             delta_bits,
             seg_at,
             stream,
+            stream_len,
             note: String::new(),
         })
     }
@@ -524,7 +581,7 @@ impl Packed {
         let lanes = self.abs_bits.len();
         let mut x: Vec<Vec<i32>> = (0..lanes).map(|_| Vec::with_capacity(n)).collect();
         let mut widths = vec![0u32; lanes];
-        let bits = self.stream.len().saturating_sub(8) * 8;
+        let bits = self.stream_len * 8;
         let mut pos = 0usize;
         let take = |pos: &mut usize, w: u32| -> Result<u32, PackError> {
             if *pos + w as usize > bits {
@@ -590,7 +647,7 @@ impl Packed {
 
     /// Bytes of the encoded stream and its tables (what a runtime keeps).
     pub fn stream_bytes(&self) -> usize {
-        self.stream.len() + 4 * self.seg_at.len() + self.abs_bits.len() + self.delta_bits.len()
+        8 * self.stream.len() + 4 * self.seg_at.len() + self.abs_bits.len() + self.delta_bits.len()
     }
 
     /// Bits of the residuals, widths and block starts.

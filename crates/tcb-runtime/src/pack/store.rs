@@ -16,9 +16,10 @@
 //! reference builds them: `w` rebuilt where the track stores three
 //! components, then made unit length in f64 ([`tcb_core::quat::unit_key`]).
 
-use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, WIDTH_BITS, read_bits, unzigzag};
+use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, WIDTH_BITS, read_bits, unzigzag, window};
 use crate::store::Segment;
 use std::sync::Arc;
+use tcb_core::lane::Lane;
 use wide::{f32x8, f64x4, i32x8};
 
 /// Sections of a key: `P`, `TO`, `TI`.
@@ -41,8 +42,9 @@ pub(crate) struct PackedKeys {
     pub weights: Vec<[f32x8; 4]>,
     /// The first rotation plane; rotation blocks of 4 planes follow.
     pub rot_from: usize,
-    /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes).
-    pub rebuild: Vec<[bool; 8]>,
+    /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
+    /// as a mask.
+    pub rebuild: Vec<f32x8>,
     /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
     /// (`n ..= n+3`), `planes` vectors each.
     pub table: Vec<f32x8>,
@@ -72,7 +74,8 @@ impl PackedKeys {
             next: 0,
             first: 0,
             pos: 0,
-            widths: vec![0; lanes],
+            reads: vec![LaneRead::default(); lanes],
+            row_bits: 0,
             abs: vec![0; lanes],
             delta: vec![0; lanes],
             flat: vec![0; 8 * self.planes],
@@ -117,19 +120,33 @@ impl PackedKeys {
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
     fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
         let (np, n) = (self.planes, self.keys);
-        for p in 0..np {
-            let [ia, ib, oa, ob] = self.weights[p];
-            let at = |k: usize| c.p[(k & 3) * np + p];
-            if a > 0 {
-                let (x, y, z) = (at(a - 1), at(a), at(b));
-                c.m[p] = (y - x) * oa + (z - y) * ob;
+        let ring = |k: usize| (k & 3) * np;
+        let (m0, m1) = c.m.split_at_mut(np);
+        let p = &c.p;
+        if a > 0 {
+            let (x, y, z) = (ring(a - 1), ring(a), ring(b));
+            let rows = p[x..x + np].iter().zip(&p[y..y + np]).zip(&p[z..z + np]);
+            for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
+                *m = (*y - *x) * w[2] + (*z - *y) * w[3];
             }
-            if b < n - 1 {
-                let (x, y, z) = (at(a), at(b), at(b + 1));
-                c.m[np + p] = (y - x) * ia + (z - y) * ib;
+        }
+        if b < n - 1 {
+            let (x, y, z) = (ring(a), ring(b), ring(b + 1));
+            let rows = p[x..x + np].iter().zip(&p[y..y + np]).zip(&p[z..z + np]);
+            for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
+                *m = (*y - *x) * w[0] + (*z - *y) * w[1];
             }
         }
     }
+}
+
+/// Where one stream lane's residual is in a key's row of the current
+/// segment, and its width.
+#[derive(Clone, Copy, Debug, Default)]
+struct LaneRead {
+    slot: u32,
+    offset: u32,
+    mask: u32,
 }
 
 /// One instance's decoding state for a [`PackedKeys`] group.
@@ -142,8 +159,11 @@ pub(crate) struct PackCache {
     next: usize,
     first: usize,
     pos: usize,
-    /// Per stream lane: this segment's widths, this block's start and delta.
-    widths: Vec<u8>,
+    /// Per stream lane: where this segment's residuals are in a key's row;
+    /// the bits of a row.
+    reads: Vec<LaneRead>,
+    row_bits: usize,
+    /// Per stream lane: this block's start and delta.
     abs: Vec<i32>,
     delta: Vec<i32>,
     /// Integers of one key in the group's planes (scratch).
@@ -188,21 +208,7 @@ impl PackCache {
         let s = &g.packed.stream;
         let in_block = k % BLOCK_KEYS;
         if k.is_multiple_of(SEGMENT_KEYS) {
-            self.pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
-            for w in self.widths.iter_mut() {
-                *w = read_bits(s, self.pos, WIDTH_BITS) as u8;
-                self.pos += WIDTH_BITS as usize;
-            }
-            if in_block == 0 {
-                for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
-                    *x = unzigzag(read_bits(s, self.pos, u32::from(w)));
-                    self.pos += usize::from(w);
-                }
-                for (x, &w) in self.delta.iter_mut().zip(&g.packed.delta_bits) {
-                    *x = unzigzag(read_bits(s, self.pos, u32::from(w)));
-                    self.pos += usize::from(w);
-                }
-            }
+            self.enter_segment(g, k, in_block == 0);
         }
         // This key's integers (block start, delta, or residual) per plane.
         let flat = &mut self.flat;
@@ -210,31 +216,67 @@ impl PackCache {
             0 => scatter(&g.lane_slot, &self.abs, flat),
             1 => scatter(&g.lane_slot, &self.delta, flat),
             _ => {
-                let mut pos = self.pos;
-                for (&slot, &w) in g.lane_slot.iter().zip(&self.widths) {
-                    flat[slot as usize] = unzigzag(read_bits(s, pos, u32::from(w)));
-                    pos += usize::from(w);
+                let base = self.pos;
+                for r in &self.reads {
+                    let at = base + r.offset as usize;
+                    flat[r.slot as usize] = unzigzag(window(s, at) as u32 & r.mask);
                 }
-                self.pos = pos;
+                self.pos = base + self.row_bits;
             }
         }
         let ring = (k & 3) * np;
-        for p in 0..np {
-            let r = i32x8::new(flat[8 * p..8 * p + 8].try_into().expect("8 lanes"));
+        let (x0, x1) = (&mut self.x0, &mut self.x1);
+        let planes = flat.chunks_exact(8).zip(x0.iter_mut().zip(x1.iter_mut()));
+        for (((r, (x0, x1)), step), out) in planes.zip(&g.step).zip(&mut self.p[ring..ring + np]) {
+            let r = i32x8::new(r.try_into().expect("8 lanes"));
             let x = match in_block {
                 0 => r,
-                1 => self.x1[p] + r,
-                _ => self.x1[p] + self.x1[p] - self.x0[p] + r,
+                1 => *x1 + r,
+                _ => *x1 + *x1 - *x0 + r,
             };
-            self.x0[p] = self.x1[p];
-            self.x1[p] = x;
-            self.p[ring + p] = x.round_float() * g.step[p];
+            *x0 = *x1;
+            *x1 = x;
+            *out = x.round_float() * *step;
         }
-        for (b, rebuild) in g.rebuild.iter().enumerate() {
-            let at = ring + g.rot_from + 4 * b;
-            unit_block(&mut self.p[at..at + 4], rebuild);
+        let rot = &mut self.p[ring + g.rot_from..ring + np];
+        for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
+            let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
+            block[3] = <f32x8 as Lane>::select(*mask, w, block[3]);
+        }
+        for block in rot.chunks_exact_mut(4) {
+            unit_block(block);
         }
         self.next = k + 1;
+    }
+
+    /// At the first key of a segment: its widths (and, starting a block,
+    /// the block's start values and deltas), each lane's place in a row.
+    fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
+        let s = &g.packed.stream;
+        let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
+        let mut offset = 0u32;
+        for (r, &slot) in self.reads.iter_mut().zip(&g.lane_slot) {
+            let w = read_bits(s, pos, WIDTH_BITS);
+            pos += WIDTH_BITS as usize;
+            *r = LaneRead {
+                slot,
+                offset,
+                mask: ((1u64 << w) - 1) as u32,
+            };
+            offset += w;
+        }
+        self.row_bits = offset as usize;
+        if block {
+            for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
+                *x = unzigzag(read_bits(s, pos, u32::from(w)));
+                pos += usize::from(w);
+            }
+            for (x, &w) in self.delta.iter_mut().zip(&g.packed.delta_bits) {
+                *x = unzigzag(read_bits(s, pos, u32::from(w)));
+                pos += usize::from(w);
+            }
+        }
+        self.pos = pos;
     }
 }
 
@@ -246,31 +288,22 @@ fn scatter(slots: &[u32], x: &[i32], flat: &mut [i32]) {
     }
 }
 
-/// One block of 8 rotation keys as the reference builds them: `w` rebuilt
-/// in the lanes of `rebuild`, then unit length in f64.
-fn unit_block(planes: &mut [f32x8], rebuild: &[bool; 8]) {
-    let c: [[f32; 8]; 4] = std::array::from_fn(|i| planes[i].to_array());
+/// One block of 8 rotation keys made unit length as the reference makes
+/// its keys: [`tcb_core::quat::unit_key`] in f64, rounded to f32.
+fn unit_block(block: &mut [f32x8]) {
+    let c: [[f32; 8]; 4] = std::array::from_fn(|i| block[i].to_array());
     let mut out = [[0.0f32; 8]; 4];
     for h in 0..2 {
-        let lanes = |i: usize| f64x4::new(std::array::from_fn(|l| f64::from(c[i][4 * h + l])));
-        let (x, y, z, w) = (lanes(0), lanes(1), lanes(2), lanes(3));
-        let rebuilt = tcb_core::quat::rebuild_w_lanes(x, y, z).to_array();
-        let w = w.to_array();
-        let w = f64x4::new(std::array::from_fn(|l| {
-            if rebuild[4 * h + l] {
-                f64::from(rebuilt[l] as f32)
-            } else {
-                w[l]
-            }
-        }));
-        let q = tcb_core::quat::unit_key([x, y, z, w]);
-        for (i, qi) in q.iter().enumerate() {
-            for (l, v) in qi.to_array().iter().enumerate() {
-                out[i][4 * h + l] = *v as f32;
+        let q: [f64x4; 4] = std::array::from_fn(|i| {
+            f64x4::new(std::array::from_fn(|l| f64::from(c[i][4 * h + l])))
+        });
+        for (o, u) in out.iter_mut().zip(tcb_core::quat::unit_key(q)) {
+            for (l, v) in u.to_array().into_iter().enumerate() {
+                o[4 * h + l] = v as f32;
             }
         }
     }
-    for (p, o) in planes.iter_mut().zip(out) {
-        *p = f32x8::new(o);
+    for (b, o) in block.iter_mut().zip(out) {
+        *b = f32x8::new(o);
     }
 }
