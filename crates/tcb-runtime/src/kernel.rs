@@ -63,7 +63,7 @@ pub(crate) fn offset(delta: &[f32x8], cycles: f32x8, out: &mut [f32x8]) {
 /// Whether `|p|^2` stays well inside f32's range is checked for every lane
 /// but acted on once per call: the rare segment where some lane leaves it
 /// (explicit tangents of 1e36, say) is redone block by block, cold.
-#[inline]
+#[inline(always)]
 pub(crate) fn hermite_quats(
     c: Segment,
     rows: [f32; 4],

@@ -61,8 +61,6 @@ impl<'a> Segment<'a> {
 enum Data {
     F32(Vec<f32x8>),
     Q16(Quantized),
-    /// Values only, decoded per instance (`crate::pack`).
-    Packed(Box<PackedKeys>),
 }
 
 /// One group's controls per key (see the module docs).
@@ -73,6 +71,9 @@ pub(crate) struct KeyStore {
     /// `TI` section starts.
     at: Vec<[u32; 2]>,
     data: Data,
+    /// Values only, decoded per instance (`crate::pack`): when set, `at`
+    /// and `data` are empty.
+    packed: Option<Box<PackedKeys>>,
 }
 
 /// Per control (`P`, `TO`, `TI`), plane and lane: the largest error
@@ -112,6 +113,7 @@ impl KeyStore {
                 planes,
                 at,
                 data: Data::F32(data),
+                packed: None,
             };
             return (store, None);
         }
@@ -120,6 +122,7 @@ impl KeyStore {
             planes,
             at,
             data: Data::Q16(q),
+            packed: None,
         };
         (store, Some(error))
     }
@@ -145,8 +148,8 @@ impl KeyStore {
             + match &self.data {
                 Data::F32(d) => std::mem::size_of_val(d.as_slice()),
                 Data::Q16(q) => q.heap_bytes(),
-                Data::Packed(p) => p.heap_bytes(),
             }
+            + self.packed.as_ref().map_or(0, |p| p.heap_bytes())
     }
 
     /// Whether the numbers are 16-bit.
@@ -173,9 +176,6 @@ impl KeyStore {
                 }
             }
             Data::Q16(q) => self.expanded(q, a, b, cache),
-            Data::Packed(p) => {
-                p.segment(a, b, cache.pack.as_mut().expect("a packed group's cache"))
-            }
         }
     }
 
@@ -217,10 +217,7 @@ impl KeyStore {
             valid: [0; 2],
             planes: n,
             data: vec![f32x8::ZERO; 2 * 3 * n],
-            pack: match &self.data {
-                Data::Packed(p) => Some(Box::new(p.cache())),
-                _ => None,
-            },
+            pack: self.packed.as_ref().map(|p| Box::new(p.cache())),
         }
     }
 
@@ -238,7 +235,23 @@ impl KeyStore {
     /// kept only for sizes).
     pub fn set_packed(&mut self, packed: PackedKeys) {
         self.at = Vec::new();
-        self.data = Data::Packed(Box::new(packed));
+        self.data = Data::F32(Vec::new());
+        self.packed = Some(Box::new(packed));
+    }
+
+    /// A packed group's controls and its cache's decoder state: such a
+    /// group is sampled apart (`instance::sample_packed`), so that the f32
+    /// and 16-bit path stays as it was.
+    #[inline(always)]
+    pub fn packed<'a>(
+        &'a self,
+        cache: &'a mut KeyCache,
+    ) -> Option<(&'a PackedKeys, &'a mut PackCache)> {
+        let p = self.packed.as_deref()?;
+        Some((
+            p,
+            cache.pack.as_deref_mut().expect("a packed group's cache"),
+        ))
     }
 }
 

@@ -65,6 +65,17 @@ fn steady_playback_and_blending_allocate_nothing() {
         };
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
     }
+    // A packed clip (decoded as playback crosses keys, seeks included).
+    let options = tcb_io::ImportOptions {
+        rotation: tcb_core::RotationMode::Hermite,
+        ..Default::default()
+    };
+    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh").as_ref(), &options)
+        .unwrap()
+        .clip;
+    let source = tcb_runtime::PackSource::quantize(&cmu, &vec![1.0 / 4096.0; cmu.tracks().len()]);
+    let packed = tcb_runtime::Packed::encode(&source.unwrap()).unwrap();
+    clips.push(Arc::new(tcb_runtime::Clip::from_packed(Arc::new(packed)).unwrap()));
     for clip in clips {
         let mut a = tcb_runtime::Instance::new(clip.clone()).with_velocities();
         let mut b = tcb_runtime::Instance::new(clip.clone()).with_velocities();

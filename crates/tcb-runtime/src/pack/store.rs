@@ -19,7 +19,6 @@
 use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, WIDTH_BITS, read_bits, unzigzag, window};
 use crate::store::Segment;
 use std::sync::Arc;
-use tcb_core::lane::Lane;
 use wide::{f32x8, f64x4, i32x8};
 
 /// Sections of a key: `P`, `TO`, `TI`.
@@ -241,7 +240,7 @@ impl PackCache {
         let rot = &mut self.p[ring + g.rot_from..ring + np];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
             let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
-            block[3] = <f32x8 as Lane>::select(*mask, w, block[3]);
+            block[3] = (*mask & w) | (!*mask & block[3]);
         }
         for block in rot.chunks_exact_mut(4) {
             unit_block(block);
