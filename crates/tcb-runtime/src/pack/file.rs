@@ -268,9 +268,9 @@ impl Packed {
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
         }
-        // Every segment spends 5 bits per lane on its widths: a file cannot
-        // describe more keys than that.
-        if (segments - 1).saturating_mul(lanes).saturating_mul(5) > 8 * len {
+        // Every segment spends at least 2 bits per lane on its header: a
+        // file cannot describe more keys than that.
+        if (segments - 1).saturating_mul(lanes).saturating_mul(2) > 8 * len {
             return err(format!(
                 "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
             ));

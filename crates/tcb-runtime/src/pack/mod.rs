@@ -486,15 +486,54 @@ pub struct Packed {
     pub note: String,
 }
 
-/// Per key of a block, the integer a lane codes.
+/// Per key of a block, the integer a lane codes: the block's first value,
+/// its delta, then the residual of the prediction of `order` (1: the last
+/// value; 2: the line through the last two).
 #[inline(always)]
-fn code(x: &[i32], k: usize) -> i32 {
-    match k % BLOCK_KEYS {
-        0 => x[k],
-        1 => x[k].wrapping_sub(x[k - 1]),
+fn code(x: &[i32], k: usize, order: u32) -> i32 {
+    match (k % BLOCK_KEYS, order) {
+        (0, _) => x[k],
+        (1, _) | (_, 1) => x[k].wrapping_sub(x[k - 1]),
         _ => x[k]
             .wrapping_sub(x[k - 1].wrapping_mul(2))
             .wrapping_add(x[k - 2]),
+    }
+}
+
+/// A segment's header entry for one lane: the prediction order (1 bit:
+/// 0 for 2, 1 for 1), then its residual width, coded against the lane's
+/// width in the segment before (not across blocks, where a seek starts):
+/// `0` the same, `10s` one more (`s` = 0) or one less, `11wwwww` any.
+fn put_header(w: &mut BitWriter, order: u32, width: u32, before: Option<u32>) {
+    w.put(2 - order, 1);
+    match before {
+        Some(b) if b == width => w.put(0, 1),
+        Some(b) if b + 1 == width || width + 1 == b => {
+            w.put(1, 1);
+            w.put(0, 1);
+            w.put(u32::from(width < b), 1);
+        }
+        _ => {
+            w.put(1, 1);
+            w.put(1, 1);
+            w.put(width, WIDTH_BITS);
+        }
+    }
+}
+
+/// [`put_header`]'s entry at bit `pos` of `words`: `(order, width, bits read)`.
+#[inline(always)]
+pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, usize) {
+    let v = window(words, pos);
+    let order = 2 - (v & 1) as u32;
+    match (v >> 1) & 3 {
+        0 | 2 => (order, before, 2),
+        1 => {
+            let down = (v >> 3) & 1 == 1;
+            let width = if down { before.wrapping_sub(1) } else { before + 1 };
+            (order, width, 4)
+        }
+        _ => (order, ((v >> 3) & 31) as u32, 3 + WIDTH_BITS as usize),
     }
 }
 
@@ -508,9 +547,9 @@ impl Packed {
         let mut delta_bits = vec![0u8; lanes.len()];
         for (l, x) in lanes.iter().enumerate() {
             for b in (0..n).step_by(BLOCK_KEYS) {
-                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b))) as u8);
+                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b, 2))) as u8);
                 if b + 1 < n {
-                    delta_bits[l] = delta_bits[l].max(bits_of(zigzag(code(x, b + 1))) as u8);
+                    delta_bits[l] = delta_bits[l].max(bits_of(zigzag(code(x, b + 1, 2))) as u8);
                 }
             }
         }
@@ -519,6 +558,7 @@ impl Packed {
             bits: 0,
         };
         let mut seg_at = Vec::with_capacity(n.div_ceil(SEGMENT_KEYS) + 1);
+        let mut widths = vec![0u32; lanes.len()];
         let bit_offset = |bits: usize| {
             u32::try_from(bits).map_err(|_| PackError("the packed stream exceeds 2^32 bits".into()))
         };
@@ -526,33 +566,40 @@ impl Packed {
             seg_at.push(bit_offset(w.bits)?);
             let end = (s + SEGMENT_KEYS).min(n);
             let rows = || (s..end).filter(|k| k % BLOCK_KEYS >= 2);
-            let widths: Vec<u32> = lanes
+            // Per lane the order whose residuals take fewer bits (2 on a tie).
+            let width = |x: &[i32], order| {
+                rows()
+                    .map(|k| bits_of(zigzag(code(x, k, order))))
+                    .max()
+                    .unwrap_or(0)
+            };
+            let chosen: Vec<(u32, u32)> = lanes
                 .iter()
                 .map(|x| {
-                    rows()
-                        .map(|k| bits_of(zigzag(code(x, k))))
-                        .max()
-                        .unwrap_or(0)
+                    let (w2, w1) = (width(x, 2), width(x, 1));
+                    if w1 < w2 { (1, w1) } else { (2, w2) }
                 })
                 .collect();
-            for &wd in &widths {
+            for (l, &(order, wd)) in chosen.iter().enumerate() {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
                 }
-                w.put(wd, WIDTH_BITS);
+                let before = (s % BLOCK_KEYS != 0).then(|| widths[l]);
+                put_header(&mut w, order, wd, before);
+                widths[l] = wd;
             }
             if s % BLOCK_KEYS == 0 {
                 for (l, x) in lanes.iter().enumerate() {
-                    w.put(zigzag(code(x, s)), u32::from(abs_bits[l]));
+                    w.put(zigzag(code(x, s, 2)), u32::from(abs_bits[l]));
                 }
                 for (l, x) in lanes.iter().enumerate() {
-                    let d = if s + 1 < n { zigzag(code(x, s + 1)) } else { 0 };
+                    let d = if s + 1 < n { zigzag(code(x, s + 1, 2)) } else { 0 };
                     w.put(d, u32::from(delta_bits[l]));
                 }
             }
             for k in rows() {
-                for (l, x) in lanes.iter().enumerate() {
-                    w.put(zigzag(code(x, k)), widths[l]);
+                for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
+                    w.put(zigzag(code(x, k, order)), wd);
                 }
             }
         }
@@ -581,6 +628,7 @@ impl Packed {
         let lanes = self.abs_bits.len();
         let mut x: Vec<Vec<i32>> = (0..lanes).map(|_| Vec::with_capacity(n)).collect();
         let mut widths = vec![0u32; lanes];
+        let mut orders = vec![2u32; lanes];
         let bits = self.stream_len * 8;
         let mut pos = 0usize;
         let take = |pos: &mut usize, w: u32| -> Result<u32, PackError> {
@@ -598,8 +646,23 @@ impl Packed {
                     self.seg_at[j]
                 ));
             }
-            for wd in widths.iter_mut() {
-                *wd = take(&mut pos, WIDTH_BITS)?;
+            for (wd, order) in widths.iter_mut().zip(orders.iter_mut()) {
+                if pos > bits {
+                    return err("the packed stream ends early");
+                }
+                let before = if s % BLOCK_KEYS == 0 { 0 } else { *wd };
+                let (o, w, used) = read_header(&self.stream, pos, before);
+                if s % BLOCK_KEYS == 0 && used != 3 + WIDTH_BITS as usize {
+                    return err(format!("segment {j} starts a block with a relative width"));
+                }
+                if w >= 1 << WIDTH_BITS {
+                    return err(format!("segment {j}: a width out of range"));
+                }
+                (*order, *wd) = (o, w);
+                pos += used;
+                if pos > bits {
+                    return err("the packed stream ends early");
+                }
             }
             let end = (s + SEGMENT_KEYS).min(n);
             if s % BLOCK_KEYS == 0 {
@@ -620,10 +683,12 @@ impl Packed {
                 }
                 for (l, xl) in x.iter_mut().enumerate() {
                     let r = unzigzag(take(&mut pos, widths[l])?);
-                    let v = xl[k - 1]
-                        .wrapping_mul(2)
-                        .wrapping_sub(xl[k - 2])
-                        .wrapping_add(r);
+                    let trend = if orders[l] == 2 {
+                        xl[k - 1].wrapping_sub(xl[k - 2])
+                    } else {
+                        0
+                    };
+                    let v = xl[k - 1].wrapping_add(trend).wrapping_add(r);
                     xl.push(v);
                 }
             }

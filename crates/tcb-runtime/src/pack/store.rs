@@ -16,7 +16,7 @@
 //! reference builds them: `w` rebuilt where the track stores three
 //! components, then made unit length in f64 ([`tcb_core::quat::unit_key`]).
 
-use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, WIDTH_BITS, read_bits, unzigzag, window};
+use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
 use crate::store::Segment;
 use std::sync::Arc;
 use wide::{f32x8, f64x4, i32x8};
@@ -75,6 +75,7 @@ impl PackedKeys {
             pos: 0,
             reads: vec![LaneRead::default(); lanes],
             row_bits: 0,
+            trend: vec![i32x8::ZERO; self.planes],
             abs: vec![0; lanes],
             delta: vec![0; lanes],
             flat: vec![0; 8 * self.planes],
@@ -146,6 +147,7 @@ struct LaneRead {
     slot: u32,
     offset: u32,
     mask: u32,
+    width: u32,
 }
 
 /// One instance's decoding state for a [`PackedKeys`] group.
@@ -162,6 +164,9 @@ pub(crate) struct PackCache {
     /// the bits of a row.
     reads: Vec<LaneRead>,
     row_bits: usize,
+    /// Per plane: all ones in lanes predicted by the line through their
+    /// last two values (order 2), zeros in lanes predicted by the last.
+    trend: Vec<i32x8>,
     /// Per stream lane: this block's start and delta.
     abs: Vec<i32>,
     delta: Vec<i32>,
@@ -226,12 +231,13 @@ impl PackCache {
         let ring = (k & 3) * np;
         let (x0, x1) = (&mut self.x0, &mut self.x1);
         let planes = flat.chunks_exact(8).zip(x0.iter_mut().zip(x1.iter_mut()));
-        for (((r, (x0, x1)), step), out) in planes.zip(&g.step).zip(&mut self.p[ring..ring + np]) {
+        let lanes = planes.zip(&g.step).zip(&self.trend);
+        for ((((r, (x0, x1)), step), trend), out) in lanes.zip(&mut self.p[ring..ring + np]) {
             let r = i32x8::new(r.try_into().expect("8 lanes"));
             let x = match in_block {
                 0 => r,
                 1 => *x1 + r,
-                _ => *x1 + *x1 - *x0 + r,
+                _ => *x1 + ((*x1 - *x0) & *trend) + r,
             };
             *x0 = *x1;
             *x1 = x;
@@ -248,21 +254,29 @@ impl PackCache {
         self.next = k + 1;
     }
 
-    /// At the first key of a segment: its widths (and, starting a block,
-    /// the block's start values and deltas), each lane's place in a row.
+    /// At the first key of a segment: its headers (and, starting a block,
+    /// the block's start values and deltas), each lane's place in a row and
+    /// its prediction order.
     fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
         let s = &g.packed.stream;
         let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
         let mut offset = 0u32;
+        let flat = &mut self.flat;
         for (r, &slot) in self.reads.iter_mut().zip(&g.lane_slot) {
-            let w = read_bits(s, pos, WIDTH_BITS);
-            pos += WIDTH_BITS as usize;
+            let before = if block { 0 } else { r.width };
+            let (order, w, used) = read_header(s, pos, before);
+            pos += used;
             *r = LaneRead {
                 slot,
                 offset,
                 mask: ((1u64 << w) - 1) as u32,
+                width: w,
             };
             offset += w;
+            flat[slot as usize] = if order == 2 { -1 } else { 0 };
+        }
+        for (m, f) in self.trend.iter_mut().zip(flat.chunks_exact(8)) {
+            *m = i32x8::new(f.try_into().expect("8 lanes"));
         }
         self.row_bits = offset as usize;
         if block {
