@@ -43,9 +43,8 @@ pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 
 
 /// A rotation key made unit length as a track stores it: `p / |p|` with
 /// `|p| = sqrt(x x + y y + z z + w w)` summed in that order and each
-/// component divided (not multiplied by a reciprocal). [`crate::RotationTrack`]
-/// normalizes its keys with it in `f64`, and a packed clip's decoder
-/// (`tcb_runtime::pack`) with it in `f64x4`, so both give the same bits.
+/// component divided (not multiplied by a reciprocal), as
+/// [`crate::RotationTrack::new`] normalizes its keys (in `f64`).
 ///
 /// ```
 /// assert_eq!(tcb_core::quat::unit_key([0.0f64, 0.0, 3.0, 4.0]), [0.0, 0.0, 0.6, 0.8]);

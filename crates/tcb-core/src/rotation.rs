@@ -171,6 +171,39 @@ impl RotationTrack {
         keys: Vec<KeyParams<Quat>>,
         settings: &TrackSettings,
     ) -> Result<Self, TrackError> {
+        Self::build(times, values, keys, settings, true)
+    }
+
+    /// [`RotationTrack::new`] with the keys used as given, not normalized
+    /// (still refused if zero or not finite): for keys that are unit length
+    /// to the precision they were stored at, such as a packed clip's
+    /// dequantized keys (`tcb_runtime::pack`), whose decoder then need not
+    /// normalize them. `hermite` playback normalizes the curve, as always.
+    ///
+    /// ```
+    /// use glam::Quat;
+    /// use tcb_core::{RotationMode, RotationTrack, TrackSettings};
+    /// let settings = TrackSettings { rotation: RotationMode::Hermite, ..Default::default() };
+    /// let q = Quat::from_xyzw(0.0, 0.0, 0.6, 0.8001);
+    /// let t = RotationTrack::new_as_given(vec![0.0, 1.0], vec![q, q], vec![], &settings).unwrap();
+    /// assert_eq!(t.values()[0], q);
+    /// ```
+    pub fn new_as_given(
+        times: Vec<f64>,
+        values: Vec<Quat>,
+        keys: Vec<KeyParams<Quat>>,
+        settings: &TrackSettings,
+    ) -> Result<Self, TrackError> {
+        Self::build(times, values, keys, settings, false)
+    }
+
+    fn build(
+        times: Vec<f64>,
+        values: Vec<Quat>,
+        keys: Vec<KeyParams<Quat>>,
+        settings: &TrackSettings,
+        normalize: bool,
+    ) -> Result<Self, TrackError> {
         check_keys(&times, values.len(), &keys, settings.ends, Quat::is_finite)?;
         for (side, mode) in [("pre", settings.pre), ("post", settings.post)] {
             if matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat) {
@@ -200,7 +233,11 @@ impl RotationTrack {
             if len == 0.0 || !len.is_finite() {
                 return Err(TrackError::ZeroQuaternion { key });
             }
-            let mut v = DVec4::from_array(crate::quat::unit_key(v.to_array()));
+            let mut v = if normalize {
+                DVec4::from_array(crate::quat::unit_key(v.to_array()))
+            } else {
+                v
+            };
             if settings.hemisphere == Hemisphere::Nearest
                 && let Some(prev) = qs.last()
                 && DVec4::from(*prev).dot(v) < 0.0

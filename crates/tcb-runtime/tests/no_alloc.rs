@@ -75,7 +75,9 @@ fn steady_playback_and_blending_allocate_nothing() {
         .clip;
     let source = tcb_runtime::PackSource::quantize(&cmu, &vec![1.0 / 4096.0; cmu.tracks().len()]);
     let packed = tcb_runtime::Packed::encode(&source.unwrap()).unwrap();
-    clips.push(Arc::new(tcb_runtime::Clip::from_packed(Arc::new(packed)).unwrap()));
+    clips.push(Arc::new(
+        tcb_runtime::Clip::from_packed(Arc::new(packed)).unwrap(),
+    ));
     for clip in clips {
         let mut a = tcb_runtime::Instance::new(clip.clone()).with_velocities();
         let mut b = tcb_runtime::Instance::new(clip.clone()).with_velocities();

@@ -89,7 +89,7 @@ impl PackTrack {
     }
 
     /// Key `k`'s components as the reference clip is given them (rotations
-    /// before the track normalizes them).
+    /// as given, not normalized: `RotationTrack::new_as_given`).
     pub fn value(&self, k: usize) -> [f32; 4] {
         let mut v = [0.0f32; 4];
         for (c, x) in self.values.iter().enumerate() {
@@ -357,7 +357,8 @@ impl PackSource {
                 }
                 TrackKind::Quat => {
                     let v = vals.iter().map(|v| glam::Quat::from_array(*v)).collect();
-                    let r = RotationTrack::new(times.clone(), v, key_params(t.tcb, n), s);
+                    // As given: the decoder's keys are these, not normalized.
+                    let r = RotationTrack::new_as_given(times.clone(), v, key_params(t.tcb, n), s);
                     TrackData::Quat(r.map_err(e)?)
                 }
             };
@@ -372,14 +373,13 @@ impl PackSource {
 }
 
 /// Whether a rotation stored as `x y z` (integers per component, `w`
-/// rebuilt) keeps one hemisphere from key to key once its keys are made
-/// unit length as the track makes them (f64, [`tcb_core::quat::unit_key`]):
-/// else the track would flip a key, and it stores all four components.
+/// rebuilt) keeps one hemisphere from key to key, as the track keeps its
+/// keys (dot products in f64): else the track would flip a key, and it
+/// stores all four components.
 fn one_hemisphere(xyz: &[Vec<i32>], step: f32) -> bool {
     let key = |k: usize| {
         let [x, y, z] = [0, 1, 2].map(|c| dequantize(xyz[c][k], step));
-        let w = tcb_core::quat::rebuild_w(x, y, z);
-        tcb_core::quat::unit_key([x, y, z, w].map(f64::from))
+        [x, y, z, tcb_core::quat::rebuild_w(x, y, z)].map(f64::from)
     };
     let mut prev = key(0);
     for k in 1..xyz[0].len() {
@@ -449,7 +449,8 @@ pub(crate) fn read_bits(words: &[u64], pos: usize, w: u32) -> u32 {
 #[inline(always)]
 pub(crate) fn window(words: &[u64], pos: usize) -> u64 {
     let (i, o) = (pos >> 6, (pos & 63) as u32);
-    (words[i] >> o) | ((words[i + 1] << 1) << (63 - o))
+    let pair = &words[i..i + 2];
+    (pair[0] >> o) | ((pair[1] << 1) << (63 - o))
 }
 
 /// Bytes (little-endian, padded with zeros) as words, plus two words of
@@ -530,7 +531,11 @@ pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, 
         0 | 2 => (order, before, 2),
         1 => {
             let down = (v >> 3) & 1 == 1;
-            let width = if down { before.wrapping_sub(1) } else { before + 1 };
+            let width = if down {
+                before.wrapping_sub(1)
+            } else {
+                before + 1
+            };
             (order, width, 4)
         }
         _ => (order, ((v >> 3) & 31) as u32, 3 + WIDTH_BITS as usize),
@@ -593,7 +598,11 @@ impl Packed {
                     w.put(zigzag(code(x, s, 2)), u32::from(abs_bits[l]));
                 }
                 for (l, x) in lanes.iter().enumerate() {
-                    let d = if s + 1 < n { zigzag(code(x, s + 1, 2)) } else { 0 };
+                    let d = if s + 1 < n {
+                        zigzag(code(x, s + 1, 2))
+                    } else {
+                        0
+                    };
                     w.put(d, u32::from(delta_bits[l]));
                 }
             }

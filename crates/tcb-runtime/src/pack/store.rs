@@ -13,13 +13,14 @@
 //! in f32 with the weights rounded to f32, as `tcb_core::Track` computes
 //! them; keys 0 and n-1 (whose tangents follow the `ends` rule) and the
 //! sentinel pseudo-keys are kept in f32. Rotations are decoded as the
-//! reference builds them: `w` rebuilt where the track stores three
-//! components, then made unit length in f64 ([`tcb_core::quat::unit_key`]).
+//! reference is given them (`tcb_core::RotationTrack::new_as_given`): `w`
+//! rebuilt where the track stores three components, not normalized (the
+//! kernel normalizes the curve it plays).
 
 use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
 use crate::store::Segment;
 use std::sync::Arc;
-use wide::{f32x8, f64x4, i32x8};
+use wide::{f32x8, i32x8};
 
 /// Sections of a key: `P`, `TO`, `TI`.
 const P: usize = 0;
@@ -145,7 +146,6 @@ impl PackedKeys {
 #[derive(Clone, Copy, Debug, Default)]
 struct LaneRead {
     slot: u32,
-    offset: u32,
     mask: u32,
     width: u32,
 }
@@ -209,7 +209,7 @@ impl PackCache {
     /// Decode key `next` into the ring.
     fn decode_next(&mut self, g: &PackedKeys) {
         let (k, np) = (self.next, g.planes);
-        let s = &g.packed.stream;
+        let s: &[u64] = &g.packed.stream;
         let in_block = k % BLOCK_KEYS;
         if k.is_multiple_of(SEGMENT_KEYS) {
             self.enter_segment(g, k, in_block == 0);
@@ -219,14 +219,7 @@ impl PackCache {
         match in_block {
             0 => scatter(&g.lane_slot, &self.abs, flat),
             1 => scatter(&g.lane_slot, &self.delta, flat),
-            _ => {
-                let base = self.pos;
-                for r in &self.reads {
-                    let at = base + r.offset as usize;
-                    flat[r.slot as usize] = unzigzag(window(s, at) as u32 & r.mask);
-                }
-                self.pos = base + self.row_bits;
-            }
+            _ => self.pos = read_row(s, self.pos, &self.reads, flat),
         }
         let ring = (k & 3) * np;
         let (x0, x1) = (&mut self.x0, &mut self.x1);
@@ -248,9 +241,6 @@ impl PackCache {
             let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
             block[3] = (*mask & w) | (!*mask & block[3]);
         }
-        for block in rot.chunks_exact_mut(4) {
-            unit_block(block);
-        }
         self.next = k + 1;
     }
 
@@ -258,7 +248,7 @@ impl PackCache {
     /// the block's start values and deltas), each lane's place in a row and
     /// its prediction order.
     fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
-        let s = &g.packed.stream;
+        let s: &[u64] = &g.packed.stream;
         let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
         let mut offset = 0u32;
         let flat = &mut self.flat;
@@ -268,7 +258,6 @@ impl PackCache {
             pos += used;
             *r = LaneRead {
                 slot,
-                offset,
                 mask: ((1u64 << w) - 1) as u32,
                 width: w,
             };
@@ -293,30 +282,26 @@ impl PackCache {
     }
 }
 
+/// One key's residuals from bit `pos` of `words` into their plane lanes;
+/// the position after them. (A function of slices alone, so that the loop
+/// keeps its pointers in registers; out of line, so that it has the
+/// registers to itself.)
+#[inline(never)]
+fn read_row(words: &[u64], mut pos: usize, reads: &[LaneRead], flat: &mut [i32]) -> usize {
+    for r in reads {
+        let v = window(words, pos) as u32 & r.mask;
+        pos += r.width as usize;
+        if let Some(x) = flat.get_mut(r.slot as usize) {
+            *x = unzigzag(v);
+        }
+    }
+    pos
+}
+
 /// Stream lanes' integers into their plane lanes.
 #[inline(always)]
 fn scatter(slots: &[u32], x: &[i32], flat: &mut [i32]) {
     for (&s, &v) in slots.iter().zip(x) {
         flat[s as usize] = v;
-    }
-}
-
-/// One block of 8 rotation keys made unit length as the reference makes
-/// its keys: [`tcb_core::quat::unit_key`] in f64, rounded to f32.
-fn unit_block(block: &mut [f32x8]) {
-    let c: [[f32; 8]; 4] = std::array::from_fn(|i| block[i].to_array());
-    let mut out = [[0.0f32; 8]; 4];
-    for h in 0..2 {
-        let q: [f64x4; 4] = std::array::from_fn(|i| {
-            f64x4::new(std::array::from_fn(|l| f64::from(c[i][4 * h + l])))
-        });
-        for (o, u) in out.iter_mut().zip(tcb_core::quat::unit_key(q)) {
-            for (l, v) in u.to_array().into_iter().enumerate() {
-                o[4 * h + l] = v as f32;
-            }
-        }
-    }
-    for (b, o) in block.iter_mut().zip(out) {
-        *b = f32x8::new(o);
     }
 }
