@@ -241,6 +241,10 @@ struct CompressArgs {
     /// Value metric: largest rotation error in degrees (default 0.01).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     rotation_tolerance: Option<f64>,
+    /// Keys between seek points: a seek decodes up to N - 1 keys (smaller
+    /// seeks faster and takes more bytes); a multiple of 16 up to 1024.
+    #[arg(long, value_name = "N", default_value_t = 64)]
+    seek_keys: usize,
     /// BVH input: rotation mode of the reference (default hermite, which
     /// the packed clip plays; squad is measured against, and capture's
     /// first frames, a jump from the calibration pose, are far apart there).
@@ -503,6 +507,7 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
         shell: args.shell,
         metric: args.metric,
         rotation_tolerance: args.rotation_tolerance,
+        seek_keys: Some(args.seek_keys),
     };
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("tcb: measuring {bar:30} {pos}/{len} clips")

@@ -36,6 +36,9 @@ pub struct CompressOptions {
     pub metric: Option<Metric>,
     /// `--rotation-tolerance DEG` (`value`).
     pub rotation_tolerance: Option<f64>,
+    /// `--seek-keys N`: keys per block (a seek decodes up to N - 1 keys);
+    /// default [`tcb_runtime::pack::BLOCK_KEYS`].
+    pub seek_keys: Option<usize>,
 }
 
 /// The packed clip and what was measured.
@@ -100,6 +103,7 @@ pub fn compress(
     if times.len() < 2 {
         return Err(ReduceError::Empty);
     }
+    let block = options.seek_keys.unwrap_or(tcb_runtime::pack::BLOCK_KEYS);
     // Refuse what cannot be packed before searching.
     let unit_steps = vec![1.0f32; clip.tracks().len()];
     PackSource::quantize(clip, &unit_steps).map_err(|e| ReduceError::Option(e.to_string()))?;
@@ -113,7 +117,8 @@ pub fn compress(
         progress(evaluations.min(total - 1), total);
         let source =
             PackSource::quantize(clip, steps).map_err(|e| ReduceError::Option(e.to_string()))?;
-        let packed = Packed::encode(&source).map_err(|e| ReduceError::Build(e.to_string()))?;
+        let packed = Packed::encode_with(&source, block)
+            .map_err(|e| ReduceError::Option(format!("--seek-keys: {e}")))?;
         let compiled = tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
             .map_err(|e| ReduceError::Build(e.to_string()))?;
         let compiled = Arc::new(compiled);
@@ -188,7 +193,7 @@ pub fn compress(
     progress(total, total);
     let (bytes, measured, mut packed) = best.expect("a round that holds, or an error above");
     packed.note = format!(
-        "tcb compress: metric {}, tolerance {:e}, shell {:e}, max error {:e} at {} time {}",
+        "tcb compress: metric {}, tolerance {:e}, shell {:e}, seek keys {block}, max error {:e} at {} time {}",
         settings.metric.name(),
         settings.tolerance,
         settings.shell,

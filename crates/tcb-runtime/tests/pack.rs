@@ -42,7 +42,17 @@ fn packed_cmu_plays_its_reference() {
     // The root turns past w = 0: it keeps 4 components; the rest rebuild w.
     let rebuilt = source.tracks.iter().filter(|t| t.rebuild_w).count();
     assert!(rebuilt > 25, "{rebuilt}");
-    let packed = Arc::new(Packed::encode(&source).unwrap());
+    for block in [16, 64, 1024] {
+        plays_its_reference(&source, block);
+    }
+    assert!(Packed::encode_with(&source, 24).is_err());
+    assert!(Packed::encode_with(&source, 2048).is_err());
+}
+
+/// The packed clip in blocks of `block` keys against its reference, bit for bit.
+fn plays_its_reference(source: &PackSource, block: usize) {
+    let packed = Arc::new(Packed::encode_with(source, block).unwrap());
+    assert_eq!(packed.block_keys(), block);
     let clip = Arc::new(Clip::from_packed(packed.clone()).unwrap());
     let reference = Arc::new(Clip::compile(&source.to_clip().unwrap()));
     let n = clip.channel_count();

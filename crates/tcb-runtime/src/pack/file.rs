@@ -8,7 +8,7 @@
 //! fields can describe (so what it allocates grows with the file, not with
 //! what the file claims).
 
-use super::{BLOCK_KEYS, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, err};
+use super::{PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, check_block, err};
 use tcb_core::TrackKind;
 use tcb_core::TrackSettings;
 use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
@@ -113,7 +113,7 @@ impl Packed {
         w.f64(h.start);
         w.f64(h.interval);
         w.len(h.keys);
-        w.len(BLOCK_KEYS);
+        w.len(self.block);
         w.len(SEGMENT_KEYS);
         w.len(h.tracks.len());
         for t in &h.tracks {
@@ -189,11 +189,13 @@ impl Packed {
         let interval = r.f64("the key interval")?;
         let keys = r.u32("the key count")? as usize;
         let (block, seg) = (r.u32("keys per block")?, r.u32("keys per segment")?);
-        if (block as usize, seg as usize) != (BLOCK_KEYS, SEGMENT_KEYS) {
+        if seg as usize != SEGMENT_KEYS {
             return err(format!(
-                "blocks of {block} and segments of {seg} keys; this build reads {BLOCK_KEYS} and {SEGMENT_KEYS}"
+                "segments of {seg} keys; this build reads {SEGMENT_KEYS}"
             ));
         }
+        let block = block as usize;
+        check_block(block)?;
         let count = r.u32("the track count")? as usize;
         // A track takes at least 55 bytes: refuse counts the file cannot hold.
         if count > body.len() / 55 {
@@ -276,6 +278,7 @@ impl Packed {
             ));
         }
         let packed = Packed {
+            block,
             head: PackSource {
                 name,
                 start,

@@ -34,9 +34,12 @@ use tcb_core::{
     TrackSettings,
 };
 
-/// Keys per block: a block starts from absolute values (a seek decodes
-/// from the start of its block).
+/// Keys per block by default: a block starts from absolute values (a seek
+/// decodes from the start of its block); [`Packed::encode_with`] takes
+/// another multiple of [`SEGMENT_KEYS`].
 pub const BLOCK_KEYS: usize = 64;
+/// The largest block.
+pub const MAX_BLOCK_KEYS: usize = 1024;
 /// Keys per segment: a segment has one residual width per component.
 pub const SEGMENT_KEYS: usize = 16;
 /// Bits of a width field.
@@ -392,6 +395,16 @@ fn one_hemisphere(xyz: &[Vec<i32>], step: f32) -> bool {
     true
 }
 
+/// A block size the format takes.
+pub(crate) fn check_block(block: usize) -> Result<(), PackError> {
+    if block < SEGMENT_KEYS || block > MAX_BLOCK_KEYS || !block.is_multiple_of(SEGMENT_KEYS) {
+        return err(format!(
+            "blocks of {block} keys: a multiple of {SEGMENT_KEYS} up to {MAX_BLOCK_KEYS}"
+        ));
+    }
+    Ok(())
+}
+
 /// `n` keys with `tcb` (none: the defaults).
 fn key_params<V: Copy>(tcb: Tcb, n: usize) -> Vec<KeyParams<V>> {
     if tcb == Tcb::DEFAULT {
@@ -474,6 +487,8 @@ pub(crate) fn to_words(bytes: &[u8]) -> Vec<u64> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Packed {
     pub(crate) head: PackSource,
+    /// Keys per block.
+    pub(crate) block: usize,
     /// Per lane: bits of the zigzag absolute value and delta at block starts.
     pub(crate) abs_bits: Vec<u8>,
     pub(crate) delta_bits: Vec<u8>,
@@ -491,8 +506,8 @@ pub struct Packed {
 /// its delta, then the residual of the prediction of `order` (1: the last
 /// value; 2: the line through the last two).
 #[inline(always)]
-fn code(x: &[i32], k: usize, order: u32) -> i32 {
-    match (k % BLOCK_KEYS, order) {
+fn code(x: &[i32], k: usize, order: u32, block: usize) -> i32 {
+    match (k % block, order) {
         (0, _) => x[k],
         (1, _) | (_, 1) => x[k].wrapping_sub(x[k - 1]),
         _ => x[k]
@@ -543,18 +558,27 @@ pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, 
 }
 
 impl Packed {
-    /// Encode `source` (validated first).
+    /// Encode `source` (validated first) in blocks of [`BLOCK_KEYS`].
     pub fn encode(source: &PackSource) -> Result<Packed, PackError> {
+        Packed::encode_with(source, BLOCK_KEYS)
+    }
+
+    /// Encode `source` in blocks of `block` keys (a multiple of
+    /// [`SEGMENT_KEYS`], at most [`MAX_BLOCK_KEYS`]): a seek decodes up to
+    /// `block - 1` keys; smaller blocks seek faster and take more bytes.
+    pub fn encode_with(source: &PackSource, block: usize) -> Result<Packed, PackError> {
+        check_block(block)?;
         source.validate()?;
         let n = source.keys;
         let lanes: Vec<&Vec<i32>> = source.tracks.iter().flat_map(|t| t.values.iter()).collect();
         let mut abs_bits = vec![0u8; lanes.len()];
         let mut delta_bits = vec![0u8; lanes.len()];
         for (l, x) in lanes.iter().enumerate() {
-            for b in (0..n).step_by(BLOCK_KEYS) {
-                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b, 2))) as u8);
+            for b in (0..n).step_by(block) {
+                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b, 2, block))) as u8);
                 if b + 1 < n {
-                    delta_bits[l] = delta_bits[l].max(bits_of(zigzag(code(x, b + 1, 2))) as u8);
+                    delta_bits[l] =
+                        delta_bits[l].max(bits_of(zigzag(code(x, b + 1, 2, block))) as u8);
                 }
             }
         }
@@ -570,11 +594,11 @@ impl Packed {
         for s in (0..n).step_by(SEGMENT_KEYS) {
             seg_at.push(bit_offset(w.bits)?);
             let end = (s + SEGMENT_KEYS).min(n);
-            let rows = || (s..end).filter(|k| k % BLOCK_KEYS >= 2);
+            let rows = || (s..end).filter(|k| k % block >= 2);
             // Per lane the order whose residuals take fewer bits (2 on a tie).
             let width = |x: &[i32], order| {
                 rows()
-                    .map(|k| bits_of(zigzag(code(x, k, order))))
+                    .map(|k| bits_of(zigzag(code(x, k, order, block))))
                     .max()
                     .unwrap_or(0)
             };
@@ -589,17 +613,17 @@ impl Packed {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
                 }
-                let before = (s % BLOCK_KEYS != 0).then(|| widths[l]);
+                let before = (s % block != 0).then(|| widths[l]);
                 put_header(&mut w, order, wd, before);
                 widths[l] = wd;
             }
-            if s % BLOCK_KEYS == 0 {
+            if s % block == 0 {
                 for (l, x) in lanes.iter().enumerate() {
-                    w.put(zigzag(code(x, s, 2)), u32::from(abs_bits[l]));
+                    w.put(zigzag(code(x, s, 2, block)), u32::from(abs_bits[l]));
                 }
                 for (l, x) in lanes.iter().enumerate() {
                     let d = if s + 1 < n {
-                        zigzag(code(x, s + 1, 2))
+                        zigzag(code(x, s + 1, 2, block))
                     } else {
                         0
                     };
@@ -608,7 +632,7 @@ impl Packed {
             }
             for k in rows() {
                 for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
-                    w.put(zigzag(code(x, k, order)), wd);
+                    w.put(zigzag(code(x, k, order, block)), wd);
                 }
             }
         }
@@ -621,6 +645,7 @@ impl Packed {
         }
         Ok(Packed {
             head,
+            block,
             abs_bits,
             delta_bits,
             seg_at,
@@ -659,9 +684,9 @@ impl Packed {
                 if pos > bits {
                     return err("the packed stream ends early");
                 }
-                let before = if s % BLOCK_KEYS == 0 { 0 } else { *wd };
+                let before = if s % self.block == 0 { 0 } else { *wd };
                 let (o, w, used) = read_header(&self.stream, pos, before);
-                if s % BLOCK_KEYS == 0 && used != 3 + WIDTH_BITS as usize {
+                if s % self.block == 0 && used != 3 + WIDTH_BITS as usize {
                     return err(format!("segment {j} starts a block with a relative width"));
                 }
                 if w >= 1 << WIDTH_BITS {
@@ -674,7 +699,7 @@ impl Packed {
                 }
             }
             let end = (s + SEGMENT_KEYS).min(n);
-            if s % BLOCK_KEYS == 0 {
+            if s % self.block == 0 {
                 for (l, xl) in x.iter_mut().enumerate() {
                     xl.push(unzigzag(take(&mut pos, u32::from(self.abs_bits[l]))?));
                 }
@@ -687,7 +712,7 @@ impl Packed {
                 }
             }
             for k in s..end {
-                if k % BLOCK_KEYS < 2 {
+                if k % self.block < 2 {
                     continue;
                 }
                 for (l, xl) in x.iter_mut().enumerate() {
@@ -712,6 +737,11 @@ impl Packed {
         }
         source.validate()?;
         Ok(source)
+    }
+
+    /// Keys per block (a seek decodes up to this many less one).
+    pub fn block_keys(&self) -> usize {
+        self.block
     }
 
     /// The description (integers not included).

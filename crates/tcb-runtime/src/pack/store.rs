@@ -17,7 +17,7 @@
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
 
-use super::{BLOCK_KEYS, Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
+use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
 use crate::store::Segment;
 use std::sync::Arc;
 use wide::{f32x8, i32x8};
@@ -191,7 +191,7 @@ impl PackCache {
     /// Decode until keys `lo ..= hi` (at most 4) are in the ring: forward
     /// from the last key decoded, or from the start of `lo`'s block.
     fn ensure(&mut self, g: &PackedKeys, lo: usize, hi: usize) {
-        let start = lo - lo % BLOCK_KEYS;
+        let start = lo - lo % g.packed.block;
         let ok = if lo >= self.next {
             self.next >= start
         } else {
@@ -210,7 +210,7 @@ impl PackCache {
     fn decode_next(&mut self, g: &PackedKeys) {
         let (k, np) = (self.next, g.planes);
         let s: &[u64] = &g.packed.stream;
-        let in_block = k % BLOCK_KEYS;
+        let in_block = k % g.packed.block;
         if k.is_multiple_of(SEGMENT_KEYS) {
             self.enter_segment(g, k, in_block == 0);
         }
