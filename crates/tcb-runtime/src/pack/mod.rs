@@ -397,7 +397,7 @@ fn one_hemisphere(xyz: &[Vec<i32>], step: f32) -> bool {
 
 /// A block size the format takes.
 pub(crate) fn check_block(block: usize) -> Result<(), PackError> {
-    if block < SEGMENT_KEYS || block > MAX_BLOCK_KEYS || !block.is_multiple_of(SEGMENT_KEYS) {
+    if !(SEGMENT_KEYS..=MAX_BLOCK_KEYS).contains(&block) || !block.is_multiple_of(SEGMENT_KEYS) {
         return err(format!(
             "blocks of {block} keys: a multiple of {SEGMENT_KEYS} up to {MAX_BLOCK_KEYS}"
         ));
