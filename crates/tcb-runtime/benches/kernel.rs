@@ -191,7 +191,60 @@ fn benches(c: &mut Criterion) {
     ] {
         play(c, name, &sparse_rotations(64, 64, mode), 64);
     }
+    packed(c);
     rig_and_blend(c);
+}
+
+/// A packed clip (`tcb_runtime::pack`, what `tcb compress` writes): the
+/// bundled CMU capture (hermite) in steps of 1/4096, decoded as playback
+/// crosses keys (`packed/forward`, 60 fps), at random times (`packed/seek`:
+/// each a decode from the start of a block), and the same clip in f32
+/// (`packed/f32`).
+fn packed(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    let options = tcb_io::ImportOptions {
+        rotation: RotationMode::Hermite,
+        ..Default::default()
+    };
+    let clip = tcb_io::load_with(path.as_ref(), &options).unwrap().clip;
+    let steps = vec![1.0 / 4096.0; clip.tracks().len()];
+    let source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();
+    let packed = Arc::new(tcb_runtime::Packed::encode(&source).unwrap());
+    let compiled = Arc::new(Clip::from_packed(packed).unwrap());
+    let dense = Arc::new(Clip::compile(&source.to_clip().unwrap()));
+    let (a, b) = clip.time_range().unwrap();
+    let mut g = c.benchmark_group("packed");
+    g.throughput(Throughput::Elements(31));
+    for (name, clip) in [("forward", &compiled), ("f32", &dense)] {
+        let mut inst = Instance::new(clip.clone());
+        let mut frame = 0u64;
+        g.bench_function(name, |bench| {
+            bench.iter(|| {
+                frame += 1;
+                let t = a + (frame as f64 / 60.0) % (b - a);
+                black_box(inst.sample(black_box(t)));
+            })
+        });
+    }
+    let mut x = 7u64;
+    let seeks: Vec<f64> = (0..1024)
+        .map(|_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect();
+    let mut inst = Instance::new(compiled);
+    let mut at = 0usize;
+    g.bench_function("seek", |bench| {
+        bench.iter(|| {
+            at = (at + 1) % seeks.len();
+            let t = a + seeks[at] * (b - a);
+            black_box(inst.sample(black_box(t)));
+        })
+    });
+    g.finish();
 }
 
 /// Sampling through a rig (the copy into rig order), blending two rig
