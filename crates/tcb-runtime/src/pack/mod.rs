@@ -12,8 +12,9 @@
 //! ```text
 //! block of 64 keys:   x_b (absolute), x_{b+1} - x_b (delta), then per key
 //!                     r_k = x_k - (2 x_{k-1} - x_{k-2})          (2nd-order prediction)
-//! segment of 16 keys: a width per component (5 bits), then the residuals
-//!                     key by key, each in its component's width (zigzag)
+//! segment of 16 keys: per component a header (the prediction order, 1 or 2,
+//!                     and a width), then each component's residuals of the
+//!                     segment in its width (zigzag)
 //! ```
 //!
 //! so playback decodes one key per key it crosses (shifts and adds), and a
@@ -630,8 +631,9 @@ impl Packed {
                     w.put(d, u32::from(delta_bits[l]));
                 }
             }
-            for k in rows() {
-                for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
+            // Lane by lane: a lane's residuals of the segment are contiguous.
+            for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
+                for k in rows() {
                     w.put(zigzag(code(x, k, order, block)), wd);
                 }
             }
@@ -711,11 +713,11 @@ impl Packed {
                     }
                 }
             }
-            for k in s..end {
-                if k % self.block < 2 {
-                    continue;
-                }
-                for (l, xl) in x.iter_mut().enumerate() {
+            for (l, xl) in x.iter_mut().enumerate() {
+                for k in s..end {
+                    if k % self.block < 2 {
+                        continue;
+                    }
                     let r = unzigzag(take(&mut pos, widths[l])?);
                     let trend = if orders[l] == 2 {
                         xl[k - 1].wrapping_sub(xl[k - 2])

@@ -73,9 +73,8 @@ impl PackedKeys {
             seg: usize::MAX,
             next: 0,
             first: 0,
-            pos: 0,
             reads: vec![LaneRead::default(); lanes],
-            row_bits: 0,
+            res: vec![0; SEGMENT_KEYS * 8 * self.planes],
             trend: vec![i32x8::ZERO; self.planes],
             abs: vec![0; lanes],
             delta: vec![0; lanes],
@@ -146,7 +145,6 @@ impl PackedKeys {
 #[derive(Clone, Copy, Debug, Default)]
 struct LaneRead {
     slot: u32,
-    mask: u32,
     width: u32,
 }
 
@@ -155,15 +153,13 @@ struct LaneRead {
 pub(crate) struct PackCache {
     /// The first key of the segment whose tangents `m` holds.
     seg: usize,
-    /// The next key to decode, the first decoded since the last seek, and
-    /// the stream position of the next key's residuals.
+    /// The next key to decode, and the first decoded since the last seek.
     next: usize,
     first: usize,
-    pos: usize,
-    /// Per stream lane: where this segment's residuals are in a key's row;
-    /// the bits of a row.
+    /// Per stream lane: its plane slot and this segment's width.
     reads: Vec<LaneRead>,
-    row_bits: usize,
+    /// This segment's residuals: per plane lane, per key of the segment.
+    res: Vec<i32>,
     /// Per plane: all ones in lanes predicted by the line through their
     /// last two values (order 2), zeros in lanes predicted by the last.
     trend: Vec<i32x8>,
@@ -209,21 +205,38 @@ impl PackCache {
     /// Decode key `next` into the ring.
     fn decode_next(&mut self, g: &PackedKeys) {
         let (k, np) = (self.next, g.planes);
-        let s: &[u64] = &g.packed.stream;
         let in_block = k % g.packed.block;
         if k.is_multiple_of(SEGMENT_KEYS) {
             self.enter_segment(g, k, in_block == 0);
         }
         // This key's integers (block start, delta, or residual) per plane.
         let flat = &mut self.flat;
-        match in_block {
-            0 => scatter(&g.lane_slot, &self.abs, flat),
-            1 => scatter(&g.lane_slot, &self.delta, flat),
-            _ => self.pos = read_row(s, self.pos, &self.reads, flat),
-        }
+        let ints: &[i32] = match in_block {
+            0 => {
+                scatter(&g.lane_slot, &self.abs, flat);
+                flat
+            }
+            1 => {
+                scatter(&g.lane_slot, &self.delta, flat);
+                flat
+            }
+            _ => {
+                // The key's residuals, gathered from each lane's 16.
+                let i = k % SEGMENT_KEYS;
+                for (f, lanes) in flat
+                    .chunks_exact_mut(8)
+                    .zip(self.res.chunks_exact(8 * SEGMENT_KEYS))
+                {
+                    for (x, lane) in f.iter_mut().zip(lanes.chunks_exact(SEGMENT_KEYS)) {
+                        *x = lane[i];
+                    }
+                }
+                flat
+            }
+        };
         let ring = (k & 3) * np;
         let (x0, x1) = (&mut self.x0, &mut self.x1);
-        let planes = flat.chunks_exact(8).zip(x0.iter_mut().zip(x1.iter_mut()));
+        let planes = ints.chunks_exact(8).zip(x0.iter_mut().zip(x1.iter_mut()));
         let lanes = planes.zip(&g.step).zip(&self.trend);
         for ((((r, (x0, x1)), step), trend), out) in lanes.zip(&mut self.p[ring..ring + np]) {
             let r = i32x8::new(r.try_into().expect("8 lanes"));
@@ -245,29 +258,23 @@ impl PackCache {
     }
 
     /// At the first key of a segment: its headers (and, starting a block,
-    /// the block's start values and deltas), each lane's place in a row and
-    /// its prediction order.
+    /// the block's start values and deltas) and every lane's residuals of
+    /// the segment, into `res` by key and plane lane; each lane's
+    /// prediction order.
     fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
         let s: &[u64] = &g.packed.stream;
         let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
-        let mut offset = 0u32;
         let flat = &mut self.flat;
         for (r, &slot) in self.reads.iter_mut().zip(&g.lane_slot) {
             let before = if block { 0 } else { r.width };
             let (order, w, used) = read_header(s, pos, before);
             pos += used;
-            *r = LaneRead {
-                slot,
-                mask: ((1u64 << w) - 1) as u32,
-                width: w,
-            };
-            offset += w;
+            *r = LaneRead { slot, width: w };
             flat[slot as usize] = if order == 2 { -1 } else { 0 };
         }
         for (m, f) in self.trend.iter_mut().zip(flat.chunks_exact(8)) {
             *m = i32x8::new(f.try_into().expect("8 lanes"));
         }
-        self.row_bits = offset as usize;
         if block {
             for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
                 *x = unzigzag(read_bits(s, pos, u32::from(w)));
@@ -278,24 +285,48 @@ impl PackCache {
                 pos += usize::from(w);
             }
         }
-        self.pos = pos;
+        // Rows: the segment's keys after the block's first two.
+        let end = (k + SEGMENT_KEYS).min(g.keys);
+        let first = if block { 2.min(end - k) } else { 0 };
+        read_segment(s, pos, &self.reads, first..end - k, &mut self.res);
     }
 }
 
-/// One key's residuals from bit `pos` of `words` into their plane lanes;
-/// the position after them. (A function of slices alone, so that the loop
-/// keeps its pointers in registers; out of line, so that it has the
-/// registers to itself.)
+/// Each lane's residuals of one segment (contiguous, in the lane's width)
+/// from bit `pos` of `words` into `res`, 16 per plane lane (`rows` of
+/// them: the segment's keys after a block's first two): as many values from
+/// each 64-bit window as it holds. (A function of slices alone, out of
+/// line, so that its loop keeps its pointers in registers.)
 #[inline(never)]
-fn read_row(words: &[u64], mut pos: usize, reads: &[LaneRead], flat: &mut [i32]) -> usize {
+fn read_segment(
+    words: &[u64],
+    mut pos: usize,
+    reads: &[LaneRead],
+    rows: std::ops::Range<usize>,
+    res: &mut [i32],
+) {
     for r in reads {
-        let v = window(words, pos) as u32 & r.mask;
-        pos += r.width as usize;
-        if let Some(x) = flat.get_mut(r.slot as usize) {
-            *x = unzigzag(v);
+        let (w, slot) = (r.width as usize, r.slot as usize);
+        let Some(lane) = res.get_mut(slot * SEGMENT_KEYS..(slot + 1) * SEGMENT_KEYS) else {
+            continue;
+        };
+        let Some(dst) = lane.get_mut(rows.clone()) else {
+            continue;
+        };
+        if w == 0 {
+            dst.fill(0);
+            continue;
+        }
+        let (per, mask) = (64 / w, (1u64 << w) - 1);
+        for chunk in dst.chunks_mut(per) {
+            let mut win = window(words, pos);
+            for x in chunk.iter_mut() {
+                *x = unzigzag((win & mask) as u32);
+                win >>= w;
+            }
+            pos += chunk.len() * w;
         }
     }
-    pos
 }
 
 /// Stream lanes' integers into their plane lanes.
