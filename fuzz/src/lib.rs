@@ -824,12 +824,13 @@ fn describe(s: &PackSource) -> String {
         .map(|t| {
             let e = &t.settings;
             format!(
-                "{} {} {} {} fade={} tcb={:?} pre={} post={} step={} rebuild_w={}",
+                "{} {} {} {} fade={} hemisphere={} tcb={:?} pre={} post={} step={} rebuild_w={}",
                 t.name,
                 t.kind.name(),
                 e.tangent_rule,
                 e.ends,
                 e.continuity_fade,
+                e.hemisphere,
                 t.tcb.to_array(),
                 e.pre,
                 e.post,

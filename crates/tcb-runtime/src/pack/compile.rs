@@ -8,7 +8,6 @@ use crate::clip::{Clip, CompileOptions, key_pair};
 use crate::pack::err;
 use std::sync::Arc;
 use tcb_core::TrackKind;
-use tcb_core::tangent::ChordWeights;
 use wide::f32x8;
 
 impl Clip {
@@ -36,17 +35,12 @@ impl Clip {
         let rot_from = g.vec_blocks;
         let times = source.times();
         for (t, slot) in source.tracks.iter().zip(clip.layout.tracks()) {
-            let s = &t.settings;
-            let (d_in, d_out) = (
-                times[1] - times[0],
-                times[n.min(3) - 1] - times[n.min(3) - 2],
-            );
-            let cw = if s.continuity_fade {
-                ChordWeights::with_continuity_fade(s.tangent_rule, t.tcb, d_in, d_out)
+            // Every interior key's weights are key 1's (`PackSource::validate`).
+            let w = if n > 2 {
+                super::key_weights(&times, t, 1)
             } else {
-                ChordWeights::new(s.tangent_rule, t.tcb, d_in, d_out)
+                [0.0; 4]
             };
-            let w = [cw.in_a, cw.in_b, cw.out_a, cw.out_b].map(|x| x as f32);
             for c in 0..t.kind.dim() {
                 let at = slot.index[c];
                 let (p, l) = (at / 8, at % 8);

@@ -29,7 +29,7 @@
 //! the reference compiles to.
 
 use std::fmt;
-use tcb_core::params::{RotationMode, Tcb};
+use tcb_core::params::{Hemisphere, RotationMode, TangentRule, Tcb};
 use tcb_core::{
     Clip as SourceClip, KeyParams, NamedTrack, RotationTrack, Track, TrackData, TrackKind,
     TrackSettings,
@@ -186,6 +186,11 @@ impl PackSource {
             let mut rebuild_w = false;
             if kind == TrackKind::Quat {
                 settings.rotation = RotationMode::Hermite;
+                // The keys are made continuous below, before rounding; kept
+                // as stored, so that the reference flips none the decoder
+                // does not (rounding can leave a dot product just below 0
+                // between keys half a turn apart).
+                settings.hemisphere = Hemisphere::Keep;
                 // Keys on one hemisphere, as the track plays them.
                 for k in 1..n {
                     let d: f32 = (0..4).map(|c| values[k][c] * values[k - 1][c]).sum();
@@ -301,6 +306,12 @@ impl PackSource {
             if !t.tcb.is_finite() {
                 return at("tension, continuity and bias must be finite".into());
             }
+            if let Some(k) = uneven_weights(&self.times(), t) {
+                return at(format!(
+                    "the key times' f64 differences vary (at key {k}: {} s from {}), so the tangent rule's weights would differ from key to key; start nearer 0, or use the uniform rule",
+                    self.interval, self.start
+                ));
+            }
             if t.values.len() != t.stored() {
                 return at(format!(
                     "{} components given, {} stored",
@@ -404,6 +415,32 @@ pub(crate) fn check_block(block: usize) -> Result<(), PackError> {
         ));
     }
     Ok(())
+}
+
+/// The tangent rule's chord weights of `t` at key `k` of `times`, rounded to
+/// f32 as `tcb_core::Vector::scale` rounds them: `[in_a, in_b, out_a, out_b]`.
+pub(crate) fn key_weights(times: &[f64], t: &PackTrack, k: usize) -> [f32; 4] {
+    use tcb_core::tangent::ChordWeights;
+    let (d_in, d_out) = (times[k] - times[k - 1], times[k + 1] - times[k]);
+    let s = &t.settings;
+    let cw = if s.continuity_fade {
+        ChordWeights::with_continuity_fade(s.tangent_rule, t.tcb, d_in, d_out)
+    } else {
+        ChordWeights::new(s.tangent_rule, t.tcb, d_in, d_out)
+    };
+    [cw.in_a, cw.in_b, cw.out_a, cw.out_b].map(|x| x as f32)
+}
+
+/// The first interior key whose weights differ from key 1's (times far
+/// from 0 for their interval make the f64 intervals differ in their last
+/// bits, and every rule but `uniform` weighs by them), or `None`.
+fn uneven_weights(times: &[f64], t: &PackTrack) -> Option<usize> {
+    let n = times.len();
+    if n < 4 || t.settings.tangent_rule == TangentRule::Uniform {
+        return None;
+    }
+    let first = key_weights(times, t, 1);
+    (2..n - 1).find(|&k| key_weights(times, t, k) != first)
 }
 
 /// `n` keys with `tcb` (none: the defaults).
