@@ -809,6 +809,22 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
         mb(runtime.memory_bytes()),
         packed.stream_bytes()
     )?;
+    // What a game pays to load it: `Clip::from_bytes` (checks, one decode,
+    // the reference compiled and compared), fastest of 3.
+    let bytes = std::fs::read(&args.clip)?;
+    let load = (0..3)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            let clip = tcb_runtime::Clip::from_bytes(&bytes);
+            (t.elapsed(), clip.is_ok())
+        })
+        .min()
+        .expect("3 loads");
+    writeln!(
+        out,
+        "load: Clip::from_bytes in {:.2} ms (fastest of 3)",
+        load.0.as_secs_f64() * 1e3
+    )?;
     io::stdout().lock().write_all(out.as_bytes())?;
     Ok(())
 }
