@@ -528,26 +528,9 @@ fn reseal(file: &[u8]) -> Vec<u8> {
     b[..8].copy_from_slice(&tcb_runtime::pack::MAGIC);
     b[8..12].copy_from_slice(&tcb_runtime::pack::VERSION.to_le_bytes());
     b[12..20].copy_from_slice(&(file.len() as u64).to_le_bytes());
-    let crc = crc32(&b[24..]);
+    let crc = crc32fast::hash(&b[24..]);
     b[20..24].copy_from_slice(&crc.to_le_bytes());
     b
-}
-
-/// CRC-32 (IEEE, reflected), bit by bit: the fuzz crate and the replay
-/// test share no checksum crate, and inputs are small.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &x in bytes {
-        crc ^= u32::from(x);
-        for _ in 0..8 {
-            crc = if crc & 1 != 0 {
-                (crc >> 1) ^ 0xEDB8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
 }
 
 /// The `pack` target's input: a clip document on one even grid, a

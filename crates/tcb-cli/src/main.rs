@@ -189,19 +189,8 @@ struct ReduceArgs {
     /// The clip to write (tcb-clip/1 JSON; written only once it is verified).
     #[arg(short, long, value_name = "OUT.json")]
     output: PathBuf,
-    /// Largest error allowed (shell: model-space distance, default 6e-5 x the
-    /// rest-pose height; value: per component, default 1e-4).
-    #[arg(long, value_name = "E", allow_hyphen_values = true)]
-    tolerance: Option<f64>,
-    /// Shell radius: distance of the virtual points from each joint (default 0.018 x height).
-    #[arg(long, value_name = "R", allow_hyphen_values = true)]
-    shell: Option<f64>,
-    /// Error metric (default: shell when the input has a skeleton, else value).
-    #[arg(long, value_name = "shell|value")]
-    metric: Option<tcb_fit::Metric>,
-    /// Value metric: largest rotation error in degrees (default 0.01).
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    rotation_tolerance: Option<f64>,
+    #[command(flatten)]
+    error: ErrorArgs,
     /// Which tracks share key times.
     #[arg(long, value_name = "track|joint|clip", default_value = "track")]
     knots: tcb_fit::Knots,
@@ -219,6 +208,24 @@ struct ReduceArgs {
     animation: Option<String>,
 }
 
+/// The error a result is held to (`reduce` and `compress`, docs/reduce.md).
+#[derive(Args)]
+struct ErrorArgs {
+    /// Largest error allowed (shell: model-space distance, default 6e-5 x the
+    /// rest-pose height; value: per component, default 1e-4).
+    #[arg(long, value_name = "E", allow_hyphen_values = true)]
+    tolerance: Option<f64>,
+    /// Shell radius: distance of the virtual points from each joint (default 0.018 x height).
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
+    shell: Option<f64>,
+    /// Error metric (default: shell when the input has a skeleton, else value).
+    #[arg(long, value_name = "shell|value")]
+    metric: Option<tcb_fit::Metric>,
+    /// Value metric: largest rotation error in degrees (default 0.01).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    rotation_tolerance: Option<f64>,
+}
+
 #[derive(Args)]
 struct CompressArgs {
     /// The input: clip JSON, BVH, glTF or GLB, every track on one even grid
@@ -228,19 +235,8 @@ struct CompressArgs {
     /// within the tolerance).
     #[arg(short, long, value_name = "OUT.tcbc")]
     output: PathBuf,
-    /// Largest error allowed (as `tcb reduce`: shell, default 6e-5 x the
-    /// rest-pose height; value: per component, default 1e-4).
-    #[arg(long, value_name = "E", allow_hyphen_values = true)]
-    tolerance: Option<f64>,
-    /// Shell radius (default 0.018 x height).
-    #[arg(long, value_name = "R", allow_hyphen_values = true)]
-    shell: Option<f64>,
-    /// Error metric (default: shell when the input has a skeleton, else value).
-    #[arg(long, value_name = "shell|value")]
-    metric: Option<tcb_fit::Metric>,
-    /// Value metric: largest rotation error in degrees (default 0.01).
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    rotation_tolerance: Option<f64>,
+    #[command(flatten)]
+    error: ErrorArgs,
     /// Keys between seek points: a seek decodes up to N - 1 keys (smaller
     /// seeks faster and takes more bytes); a multiple of 16 up to 1024.
     #[arg(long, value_name = "N", default_value_t = 64)]
@@ -503,10 +499,10 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     let loaded = tcb_io::load_with(&args.input, &import)?;
     warn(&loaded.warnings);
     let options = tcb_fit::CompressOptions {
-        tolerance: args.tolerance,
-        shell: args.shell,
-        metric: args.metric,
-        rotation_tolerance: args.rotation_tolerance,
+        tolerance: args.error.tolerance,
+        shell: args.error.shell,
+        metric: args.error.metric,
+        rotation_tolerance: args.error.rotation_tolerance,
         seek_keys: Some(args.seek_keys),
     };
     let bar = indicatif::ProgressBar::new(0).with_style(
@@ -571,10 +567,10 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     let loaded = tcb_io::load_with(&args.input, &import)?;
     warn(&loaded.warnings);
     let options = tcb_fit::ReduceOptions {
-        tolerance: args.tolerance,
-        shell: args.shell,
-        metric: args.metric,
-        rotation_tolerance: args.rotation_tolerance,
+        tolerance: args.error.tolerance,
+        shell: args.error.shell,
+        metric: args.error.metric,
+        rotation_tolerance: args.error.rotation_tolerance,
         knots: args.knots,
         tangents: args.tangents,
     };

@@ -156,8 +156,16 @@ fn a_reduction_that_compiles_larger_says_so() {
 
 /// `tcb sample --at` of `clip` at `times`: one row of numbers per time.
 fn sample_at(clip: &Path, times: &[f64]) -> Vec<Vec<f64>> {
+    sample_with(clip, times, &[])
+}
+
+/// `tcb sample CLIP --at TIMES EXTRA...`: the rows without their time.
+fn sample_with(clip: &Path, times: &[f64], extra: &[&str]) -> Vec<Vec<f64>> {
     let at: Vec<String> = times.iter().map(|t| t.to_string()).collect();
-    let o = tcb(&["sample", clip.to_str().unwrap(), "--at", &at.join(",")]);
+    let at = at.join(",");
+    let mut args = vec!["sample", clip.to_str().unwrap(), "--at", &at];
+    args.extend(extra);
+    let o = tcb(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     String::from_utf8(o.stdout)
         .unwrap()
@@ -350,4 +358,112 @@ fn a_constant_track_becomes_two_keys_even_beside_a_kept_grid() {
     let written = tcb_io::read_clip_doc(&out).unwrap();
     let c = written.tracks.iter().find(|t| t.name == "c").unwrap();
     assert_eq!(c.times.len(), 2, "{:?}", c.times);
+}
+
+/// `tcb compress` (docs/tcbc.md): the first 240 frames of the CMU clip
+/// packed within a shell tolerance; the summary line; the `.tcbc` plays
+/// (runtime and `--scalar` agree), `info` and `bench` read it.
+#[test]
+fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
+    let input = short_cmu(240);
+    let out = dir().join("short.tcbc");
+    let o = tcb(&[
+        "compress",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--tolerance",
+        "0.002",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let line = stdout.lines().last().unwrap();
+    let rest = line
+        .strip_prefix("compressed: tracks 32, keys 240, values ")
+        .expect(line);
+    let (_, tail) = rest.split_once(" bits per value, max error ").expect(line);
+    let (error, place) = tail.split_once(" (shell, joint ").expect(line);
+    let error: f64 = error.parse().expect(line);
+    assert!(error > 0.0 && error <= 0.002, "{line}");
+    assert!(place.contains(", time "), "{line}");
+    let bytes = std::fs::metadata(&out).unwrap().len();
+    assert!(line.contains(&format!("bytes {bytes},")), "{line}: {bytes}");
+    // The f32 clip of 240 frames takes far more.
+    assert!(bytes < 32 * 240 * 4, "{bytes}");
+    let times = [0.0, 0.3, 0.51, 1.0, 1.99];
+    let runtime = sample_at(&out, &times);
+    let reference = sample_with(&out, &times, &["--scalar"]);
+    assert_eq!(runtime.len(), times.len());
+    for (a, b) in runtime.iter().zip(&reference) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{a:?} {b:?}");
+        }
+    }
+    let o = tcb(&["info", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        info.contains("bits per value") && info.contains("made by: tcb compress"),
+        "{info}"
+    );
+    let o = tcb(&["bench", out.to_str().unwrap(), "--rounds", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Bad requests and files: one line on stderr, exit 1, nothing written.
+#[test]
+fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
+    let input = short_cmu(40);
+    let input = input.to_str().unwrap();
+    let out = dir().join("never.tcbc");
+    let uneven = repo("examples/clips/bounce.json");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec![input, "-o", "x.json"], "must end in .tcbc"),
+        (
+            vec![input, "-o", out.to_str().unwrap(), "--seek-keys", "17"],
+            "a multiple of 16",
+        ),
+        (
+            vec![input, "-o", out.to_str().unwrap(), "--tolerance", "-1"],
+            "--tolerance",
+        ),
+        (vec![&uneven, "-o", out.to_str().unwrap()], "even grid"),
+        (
+            vec![input, "-o", out.to_str().unwrap(), "--tolerance", "1e-12"],
+            "error:",
+        ),
+    ];
+    for (args, want) in cases {
+        let mut all = vec!["compress"];
+        all.extend(&args);
+        let o = tcb(&all);
+        let e = stderr(&o);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(e.contains(want), "{args:?}: {e}");
+        assert_eq!(e.lines().filter(|l| l.contains("error")).count(), 1, "{e}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
+    // A damaged .tcbc: one line, from sample and info alike.
+    let good = dir().join("good.tcbc");
+    let o = tcb(&[
+        "compress",
+        input,
+        "-o",
+        good.to_str().unwrap(),
+        "--tolerance",
+        "0.01",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut bytes = std::fs::read(&good).unwrap();
+    let n = bytes.len();
+    bytes[n / 2] ^= 1;
+    let bad = dir().join("bad.tcbc");
+    std::fs::write(&bad, &bytes).unwrap();
+    for args in [vec!["sample", "--at", "0"], vec!["info"]] {
+        let mut all = args.clone();
+        all.insert(1, bad.to_str().unwrap());
+        let o = tcb(&all);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains("checksum mismatch"), "{}", stderr(&o));
+    }
 }
