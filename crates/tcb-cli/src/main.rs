@@ -82,7 +82,7 @@ enum Command {
 
 #[derive(Args)]
 struct PlotArgs {
-    /// The clip: clip JSON, BVH, glTF or GLB.
+    /// The clip: clip JSON, BVH, glTF, GLB or a packed .tcbc.
     clip: PathBuf,
     /// The SVG to write.
     #[arg(short, long, value_name = "OUT.svg")]
@@ -134,7 +134,7 @@ struct FiguresArgs {
 
 #[derive(Args)]
 struct InfoArgs {
-    /// The clip: clip JSON, BVH, glTF or GLB.
+    /// The clip: clip JSON, BVH, glTF, GLB or a packed .tcbc.
     clip: PathBuf,
     /// Compile with 16-bit controls (and print each track's error bound).
     #[arg(long)]
@@ -149,7 +149,7 @@ struct InfoArgs {
 
 #[derive(Args)]
 struct BenchArgs {
-    /// The clip: clip JSON, BVH, glTF or GLB.
+    /// The clip: clip JSON, BVH, glTF, GLB or a packed .tcbc.
     clip: PathBuf,
     /// Compile with 16-bit controls.
     #[arg(long)]
@@ -285,7 +285,7 @@ struct ImportArgs {
 #[derive(Args)]
 #[command(group = clap::ArgGroup::new("times").required(true).args(["at", "fps", "inbetweens"]))]
 struct SampleArgs {
-    /// The clip file (tcb-clip/1 JSON; .bvh, .gltf and .glb are imported first).
+    /// The clip file (tcb-clip/1 JSON; .bvh, .gltf and .glb are imported first; a .tcbc plays its packed stream).
     clip: PathBuf,
     /// Sample at these times (seconds, comma separated; may be negative or huge).
     #[arg(long, value_name = "T,T,...", allow_hyphen_values = true)]
@@ -433,18 +433,13 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
                 .ok_or_else(|| format!("--rename {r}: expected FROM=TO"))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let loaded = load(&args.clip)?;
-    warn(&loaded.warnings);
+    let (clip, skeleton) = load_any(&args.clip, &import_options_plain())?;
     let options = tcb_io::gltf_export::ExportOptions {
         max_error: args.max_error,
         rename,
     };
-    let report = tcb_io::gltf_export::export_file(
-        &loaded.clip,
-        loaded.skeleton.as_ref(),
-        &args.output,
-        &options,
-    )?;
+    let report =
+        tcb_io::gltf_export::export_file(&clip, skeleton.as_ref(), &args.output, &options)?;
     warn(&report.notes);
     let resampled: Vec<_> = report
         .tracks
@@ -457,12 +452,9 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         .map_or(String::new(), |(n, e)| {
             format!(" (max error {e:e}, in {n})")
         });
-    let joints = loaded
-        .skeleton
-        .as_ref()
-        .map_or("no skeleton".to_string(), |s| {
-            format!("{} joints as the node hierarchy", s.joints.len())
-        });
+    let joints = skeleton.as_ref().map_or("no skeleton".to_string(), |s| {
+        format!("{} joints as the node hierarchy", s.joints.len())
+    });
     eprintln!(
         "tcb: wrote {}: {} tracks, {} exact, {} resampled{worst}; {joints}",
         args.output.display(),
@@ -537,6 +529,21 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     );
     println!("{}", c.summary_line());
     Ok(())
+}
+
+/// Any clip file as a source clip and its skeleton: a `.tcbc` as its
+/// reference (the dequantized keys; the file keeps no skeleton), the rest
+/// through `tcb_io` (warnings printed).
+fn load_any(
+    path: &std::path::Path,
+    options: &tcb_io::ImportOptions,
+) -> Result<(tcb_core::Clip, Option<tcb_core::skeleton::Skeleton>), BoxError> {
+    if extension(path) == "tcbc" {
+        return Ok((load_tcbc(path)?.0, None));
+    }
+    let loaded = tcb_io::load_with(path, options)?;
+    warn(&loaded.warnings);
+    Ok((loaded.clip, loaded.skeleton))
 }
 
 /// A `.tcbc` file: its reference clip (the dequantized keys, for
@@ -934,17 +941,16 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
         tcb_plot::Mode::Value
     };
     let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
-    let loaded = tcb_io::load_with(&args.clip, &options)?;
-    warn(&loaded.warnings);
+    let (clip, _) = load_any(&args.clip, &options)?;
     let file = args.clip.file_name().map_or_else(
         || args.clip.display().to_string(),
         |f| f.to_string_lossy().into_owned(),
     );
-    if args.track.is_empty() && loaded.clip.channel_count() > 16 {
+    if args.track.is_empty() && clip.channel_count() > 16 {
         eprintln!(
             "tcb: plotting '{}' ({} tracks; choose others with --track)",
-            loaded.clip.tracks()[0].name,
-            loaded.clip.tracks().len()
+            clip.tracks()[0].name,
+            clip.tracks().len()
         );
     }
     let plot = tcb_plot::Plot {
@@ -955,7 +961,7 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
         inbetweens: args.inbetweens,
         ..tcb_plot::Plot::new(file)
     };
-    let svg = tcb_plot::render(&loaded.clip, &plot)?;
+    let svg = tcb_plot::render(&clip, &plot)?;
     tcb_io::write_atomically(&args.output, svg.as_bytes())?;
     eprintln!("tcb: wrote {}", args.output.display());
     Ok(())
