@@ -425,37 +425,41 @@ pub fn file(path: &Path) -> Result<Scenario, tcb_io::Error> {
 /// several instances, each plays from its own random phase within the clip,
 /// one second (or the whole clip, if shorter) per pass.
 pub fn file_with(path: &Path, options: &FileOptions) -> Result<Scenario, tcb_io::Error> {
-    let stem = path
+    let name = path
         .file_stem()
         .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
-    if path
+    let mut s = if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("tcbc"))
     {
-        let bytes =
-            std::fs::read(path).map_err(|e| tcb_io::Error::import(e.to_string()).in_file(path))?;
-        let packed = tcb_runtime::Packed::from_bytes(&bytes)
-            .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(path))?;
-        return packed_scenario(&stem, packed, path);
-    }
-    let loaded = tcb_io::load_with(path, &options.import)?;
-    let joints = animated_joints(&loaded);
-    let (start, end) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
+        // A packed clip plays its own stream: compile options do not apply.
+        let err = |e: String| tcb_io::Error::import(e).in_file(path);
+        if options.compile != tcb_runtime::CompileOptions::default() {
+            return Err(err(
+                "compile options (--quantize) do not apply to a packed clip".into(),
+            ));
+        }
+        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+        let packed = tcb_runtime::Packed::from_bytes(&bytes).map_err(|e| err(e.to_string()))?;
+        packed_scenario(&name, packed, path)?
+    } else {
+        let loaded = tcb_io::load_with(path, &options.import)?;
+        let joints = animated_joints(&loaded);
+        let mut s = Scenario::new(name, loaded.clip, Vec::new());
+        s.clip = Arc::new(tcb_runtime::Clip::compile_with(&s.source, &options.compile));
+        s.joints = Some(joints);
+        s
+    };
+    let (start, end) = s.source.time_range().unwrap_or((0.0, 0.0));
     let span = if options.instances > 1 {
         (end - start).min(1.0)
     } else {
         end - start
     };
-    let times = frames(span, options.fps)
+    s.times = frames(span, options.fps)
         .into_iter()
         .map(|t| t + start)
         .collect();
-    let name = path
-        .file_stem()
-        .map_or("clip".into(), |s| s.to_string_lossy().into_owned());
-    let mut s = Scenario::new(name, loaded.clip, times);
-    s.clip = Arc::new(tcb_runtime::Clip::compile_with(&s.source, &options.compile));
-    s.joints = Some(joints);
     if options.instances > 1 {
         let mut rng = Rng(0xf11e);
         let room = (end - start - span).max(0.0);

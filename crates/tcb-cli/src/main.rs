@@ -211,11 +211,13 @@ struct ReduceArgs {
 /// The error a result is held to (`reduce` and `compress`, docs/reduce.md).
 #[derive(Args)]
 struct ErrorArgs {
-    /// Largest error allowed (shell: model-space distance, default 6e-5 x the
-    /// rest-pose height; value: per component, default 1e-4).
+    /// Largest error allowed, in the clip's units (shell: model-space
+    /// distance, default 6e-5 x the rest-pose height; value: per component,
+    /// default 1e-4).
     #[arg(long, value_name = "E", allow_hyphen_values = true)]
     tolerance: Option<f64>,
-    /// Shell radius: distance of the virtual points from each joint (default 0.018 x height).
+    /// Shell radius: distance of the virtual points from each joint, in the
+    /// clip's units (default 0.018 x height).
     #[arg(long, value_name = "R", allow_hyphen_values = true)]
     shell: Option<f64>,
     /// Error metric (default: shell when the input has a skeleton, else value).
@@ -241,9 +243,9 @@ struct CompressArgs {
     /// seeks faster and takes more bytes); a multiple of 16 up to 1024.
     #[arg(long, value_name = "N", default_value_t = 64)]
     seek_keys: usize,
-    /// BVH input: rotation mode of the reference (default hermite, which
-    /// the packed clip plays; squad is measured against, and capture's
-    /// first frames, a jump from the calibration pose, are far apart there).
+    /// BVH input: how the reference plays its rotations (default hermite,
+    /// as the packed clip plays them; with squad, the difference between
+    /// the two counts in the measured error).
     #[arg(long, value_name = "squad|hermite")]
     rotation: Option<tcb_core::RotationMode>,
     /// glTF input: the animation, by name or index (default: the first).

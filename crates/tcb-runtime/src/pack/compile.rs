@@ -115,6 +115,29 @@ impl Clip {
     }
 
     /// Read a `.tcbc` file's bytes ([`Packed::from_bytes`]) and compile it.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use tcb_runtime::{Clip, Instance, PackSource, Packed};
+    /// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    /// # /*
+    /// let path = "data/cmu-01_01.bvh"; // from the repository's root
+    /// # */
+    /// // What `tcb compress` writes (here in steps of 1/4096, not searched).
+    /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
+    /// let steps = vec![1.0 / 4096.0; source.tracks().len()];
+    /// let packed = Packed::encode(&PackSource::quantize(&source, &steps).unwrap()).unwrap();
+    /// let bytes = packed.to_bytes(); // or std::fs::read("cmu.tcbc")
+    ///
+    /// // In the game: load once, share by Arc, sample every frame.
+    /// let clip = Arc::new(Clip::from_bytes(&bytes).unwrap());
+    /// let hips = clip.track("Hips.rotation").unwrap();
+    /// let mut walk = Instance::new(clip.clone());
+    /// for frame in 0..120 {
+    ///     let q = walk.sample(frame as f64 / 60.0).quat(hips).unwrap();
+    ///     assert!((q.length() - 1.0).abs() < 1e-5);
+    /// }
+    /// ```
     pub fn from_bytes(bytes: &[u8]) -> Result<Clip, PackError> {
         Clip::from_packed(Arc::new(Packed::from_bytes(bytes)?))
     }

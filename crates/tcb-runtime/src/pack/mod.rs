@@ -153,7 +153,7 @@ impl PackSource {
         for (k, t) in times.iter().enumerate() {
             if (t - (start + k as f64 * interval)).abs() > 1e-6 * interval {
                 return err(format!(
-                    "key {k} at {t} s is not on an even grid of {interval} s from {start} s: a packed clip needs every track on one grid of evenly spaced keys (capture, baked animation)"
+                    "key time {t} s (number {k} of the clip's {n}, all tracks together) is not on an even grid of {interval} s from {start} s: a packed clip needs every track on one grid of evenly spaced keys (capture, baked animation); sample it on such a grid first"
                 ));
             }
         }
