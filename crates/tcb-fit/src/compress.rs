@@ -104,12 +104,22 @@ pub fn compress(
         return Err(ReduceError::Empty);
     }
     let block = options.seek_keys.unwrap_or(tcb_runtime::pack::BLOCK_KEYS);
-    // Refuse what cannot be packed before searching.
+    // Refuse what cannot be packed before searching; each track's largest
+    // magnitude (its integers at a step of 1).
     let unit_steps = vec![1.0f32; clip.tracks().len()];
-    PackSource::quantize(clip, &unit_steps).map_err(|e| ReduceError::Option(e.to_string()))?;
+    let unit =
+        PackSource::quantize(clip, &unit_steps).map_err(|e| ReduceError::Option(e.to_string()))?;
+    let largest: Vec<f64> = unit
+        .tracks
+        .iter()
+        .map(|t| {
+            let most = t.values.iter().flatten().map(|x| x.unsigned_abs()).max();
+            f64::from(most.unwrap_or(0)).max(1.0)
+        })
+        .collect();
     let reference = Arc::new(tcb_runtime::Clip::compile(clip));
     let rows = metric::play(&reference, &times);
-    let budget = Budget::new(clip, skeleton, &settings);
+    let budget = Budget::new(clip, skeleton, &settings, &largest);
     let total = 40;
     let mut evaluations = 0usize;
     let mut measure = |steps: &[f32]| -> Result<(Measured, Packed), ReduceError> {
@@ -152,7 +162,8 @@ pub fn compress(
         let mut last_ok: Option<(Measured, Packed)> = None;
         let steps_at = |k: f64| budget.steps(k, &weight);
         let iterations = if round == 0 { 9 } else { 6 };
-        // The first round searches the whole range; later rounds near kappa.
+        // Every round bisects the whole range (later rounds, with weights
+        // rebalanced, fewer times).
         for _ in 0..iterations {
             let mid = (lo * hi).sqrt();
             let (m, p) = measure(&steps_at(mid))?;
@@ -191,7 +202,7 @@ pub fn compress(
         }
     }
     progress(total, total);
-    let (bytes, measured, mut packed) = best.expect("a round that holds, or an error above");
+    let (_, measured, mut packed) = best.expect("a round that holds, or an error above");
     packed.note = format!(
         "tcb compress: metric {}, tolerance {:e}, shell {:e}, seek keys {block}, max error {:e} at {} time {}",
         settings.metric.name(),
@@ -201,7 +212,15 @@ pub fn compress(
         measured.worst.at,
         measured.worst.time
     );
-    let bytes = bytes + packed.note.len();
+    // What is written must read back as it is (the checks of a file read
+    // are not the encoder's).
+    let file = packed.to_bytes();
+    if Packed::from_bytes(&file).as_ref() != Ok(&packed) {
+        return Err(ReduceError::Build(
+            "the packed clip does not read back from its bytes".into(),
+        ));
+    }
+    let bytes = file.len();
     let values = packed.head().keys * packed.head().lanes();
     Ok(Compressed {
         packed,
@@ -217,12 +236,19 @@ pub fn compress(
 struct Budget {
     /// Per track: the step at kappa = 1.
     unit: Vec<f64>,
+    /// Per track: the finest step it may take (its integers stay below
+    /// 2^22), and a fixed step for a track the shell metric does not see:
+    /// 2e-4, so that it is within 1e-4 per component, the `value`
+    /// metric's default (docs/reduce.md), whatever kappa is.
+    finest: Vec<f64>,
+    fixed: Vec<Option<f64>>,
     /// Per track: the joints (shell) or the track itself (value) its error reaches.
     reaches: Vec<Vec<usize>>,
 }
 
 impl Budget {
-    fn new(clip: &Clip, skeleton: Option<&Skeleton>, s: &Settings) -> Self {
+    fn new(clip: &Clip, skeleton: Option<&Skeleton>, s: &Settings, largest: &[f64]) -> Self {
+        let finest: Vec<f64> = largest.iter().map(|m| m / f64::from(1u32 << 22)).collect();
         let sqrt3 = 3f64.sqrt();
         let tracks = clip.tracks();
         match (s.metric, skeleton) {
@@ -252,12 +278,13 @@ impl Budget {
                         up[j] += up[p];
                     }
                 }
+                let fixed = joint.iter().map(|j| j.is_none().then_some(2e-4)).collect();
                 let unit = tracks
                     .iter()
                     .zip(&joint)
                     .map(|(t, j)| {
                         let Some(j) = *j else {
-                            return 1e-6; // moves no joint: fine steps cost little
+                            return 1.0; // moves no joint: `fixed`
                         };
                         let e = s.tolerance / (up[j] + down[j] - count[j]).max(1) as f64;
                         match t.data.kind() {
@@ -273,7 +300,12 @@ impl Budget {
                         None => Vec::new(),
                     })
                     .collect();
-                Budget { unit, reaches }
+                Budget {
+                    unit,
+                    finest,
+                    fixed,
+                    reaches,
+                }
             }
             _ => Budget {
                 unit: tracks
@@ -284,15 +316,18 @@ impl Budget {
                     })
                     .collect(),
                 reaches: (0..tracks.len()).map(|i| vec![i]).collect(),
+                finest,
+                fixed: vec![None; tracks.len()],
             },
         }
     }
 
     fn steps(&self, kappa: f64, weight: &[f64]) -> Vec<f32> {
-        self.unit
-            .iter()
-            .zip(weight)
-            .map(|(u, w)| (u * w * kappa).clamp(1e-9, 1e3) as f32)
+        (0..self.unit.len())
+            .map(|t| {
+                let step = self.fixed[t].unwrap_or(self.unit[t] * weight[t] * kappa);
+                step.clamp(self.finest[t], 1e3) as f32
+            })
             .collect()
     }
 

@@ -157,3 +157,33 @@ fn lying_files_are_refused() {
         let _ = Packed::from_bytes(&reseal(b));
     }
 }
+
+/// Files the encoder writes read back, however small their tracks (a
+/// check once assumed 55 bytes a track; the least is 42); a clip of no
+/// tracks is refused.
+#[test]
+fn small_tracks_read_back_and_no_tracks_is_refused() {
+    use tcb_core::{Tcb, TrackKind, TrackSettings};
+    let track = |i: usize| tcb_runtime::PackTrack {
+        name: format!("{i}"),
+        kind: TrackKind::Scalar,
+        settings: TrackSettings::default(),
+        tcb: Tcb::DEFAULT,
+        step: 0.5,
+        rebuild_w: false,
+        values: vec![vec![1, 1]],
+    };
+    let mut source = PackSource {
+        name: String::new(),
+        start: 0.0,
+        interval: 1.0,
+        keys: 2,
+        tracks: (0..7).map(track).collect(),
+    };
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    Packed::from_bytes(&bytes).unwrap();
+    Clip::from_bytes(&bytes).unwrap();
+    source.tracks.clear();
+    let e = Packed::encode(&source).unwrap_err().to_string();
+    assert!(e.contains("no tracks"), "{e}");
+}

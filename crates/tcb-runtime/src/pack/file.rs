@@ -197,8 +197,10 @@ impl Packed {
         let block = block as usize;
         check_block(block)?;
         let count = r.u32("the track count")? as usize;
-        // A track takes at least 55 bytes: refuse counts the file cannot hold.
-        if count > body.len() / 55 {
+        // A track takes at least 42 bytes (an empty name's length, 10 bytes
+        // of settings, tension, continuity, bias and step): refuse counts
+        // the file cannot hold.
+        if count > body.len() / 42 {
             return err(format!(
                 "{count} tracks claimed in a file of {} bytes",
                 bytes.len()
@@ -243,6 +245,12 @@ impl Packed {
                 rebuild_w,
                 values: Vec::new(),
             });
+        }
+        if tracks.is_empty() || keys.saturating_mul(count) > super::MAX_TRACK_KEYS {
+            return err(format!(
+                "{keys} keys of {count} tracks: a packed clip has 1 to {} track keys",
+                super::MAX_TRACK_KEYS
+            ));
         }
         let lanes = r.u32("the lane count")? as usize;
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();

@@ -47,6 +47,11 @@ pub const SEGMENT_KEYS: usize = 16;
 const WIDTH_BITS: u32 = 5;
 /// The largest integer magnitude (f32 holds every integer below 2^24).
 pub const MAX_INT: i32 = 1 << 24;
+/// The most keys over all tracks a packed clip may hold: loading compiles
+/// the reference in full (about 50 bytes a key and component), so this
+/// bounds what a small file of constant tracks can make a loader allocate
+/// (CMU 01_01 has 88,064).
+pub const MAX_TRACK_KEYS: usize = 1 << 22;
 
 /// A clip in integers: one even grid of `keys` key times from `start`,
 /// `interval` apart, and per track a step and the integers of each stored
@@ -265,6 +270,16 @@ impl PackSource {
 
     /// Check what the format and the runtime need (see the field docs).
     pub fn validate(&self) -> Result<(), PackError> {
+        if self.tracks.is_empty() {
+            return err("a packed clip with no tracks");
+        }
+        if self.keys.saturating_mul(self.tracks.len()) > MAX_TRACK_KEYS {
+            return err(format!(
+                "{} keys of {} tracks: a packed clip holds at most {MAX_TRACK_KEYS} track keys (loading compiles them in full)",
+                self.keys,
+                self.tracks.len()
+            ));
+        }
         if self.keys < 2 {
             return err(format!(
                 "a packed clip needs 2 keys or more, not {}",
@@ -285,11 +300,15 @@ impl PackSource {
             .tracks
             .first()
             .map(|t| (t.settings.pre, t.settings.post));
+        let times = self.times();
         for t in &self.tracks {
             let at = |m: String| err(format!("track {}: {m}", t.name));
             if t.kind == TrackKind::Quat {
                 if t.settings.rotation != RotationMode::Hermite {
                     return at("packed rotations are `hermite`".into());
+                }
+                if t.settings.hemisphere != Hemisphere::Keep {
+                    return at("packed rotations keep their hemisphere (`keep`)".into());
                 }
             } else if t.rebuild_w {
                 return at("only rotations rebuild w".into());
@@ -306,7 +325,7 @@ impl PackSource {
             if !t.tcb.is_finite() {
                 return at("tension, continuity and bias must be finite".into());
             }
-            if let Some(k) = uneven_weights(&self.times(), t) {
+            if let Some(k) = uneven_weights(&times, t) {
                 return at(format!(
                     "the key times' f64 differences vary (at key {k}: {} s from {}), so the tangent rule's weights would differ from key to key; start nearer 0, or use the uniform rule",
                     self.interval, self.start
