@@ -17,6 +17,11 @@ impl Clip {
     /// ([`crate::PackSource::to_clip`]) compiles to, bit for bit.
     pub fn from_packed(packed: Arc<Packed>) -> Result<Clip, PackError> {
         let source = packed.decode()?;
+        Clip::from_decoded(packed, &source)
+    }
+
+    /// [`from_packed`](Self::from_packed) given `packed`'s decoded integers.
+    fn from_decoded(packed: Arc<Packed>, source: &super::PackSource) -> Result<Clip, PackError> {
         let reference = source.to_clip()?;
         let mut clip = Clip::compile_impl(&reference, &CompileOptions::default(), true);
         if clip.groups.len() != 1 {
@@ -139,7 +144,9 @@ impl Clip {
     /// }
     /// ```
     pub fn from_bytes(bytes: &[u8]) -> Result<Clip, PackError> {
-        Clip::from_packed(Arc::new(Packed::from_bytes(bytes)?))
+        // The file's check decodes every key: compile from those.
+        let (packed, source) = Packed::read(bytes)?;
+        Clip::from_decoded(Arc::new(packed), &source)
     }
 
     /// The `.tcbc` bytes of a clip compiled from a packed one; `None` for

@@ -161,6 +161,12 @@ impl Packed {
     /// checked, and the stream decoded once to validate it. Errors are one
     /// line naming what is wrong.
     pub fn from_bytes(bytes: &[u8]) -> Result<Packed, PackError> {
+        Packed::read(bytes).map(|(packed, _)| packed)
+    }
+
+    /// [`from_bytes`](Self::from_bytes) and the integers its check decoded
+    /// (so that a loader decodes once).
+    pub(crate) fn read(bytes: &[u8]) -> Result<(Packed, PackSource), PackError> {
         if bytes.len() < HEADER || bytes[..8] != MAGIC {
             return err("not a .tcbc file (no TCBC magic number)");
         }
@@ -301,7 +307,7 @@ impl Packed {
             stream_len: len,
             note,
         };
-        packed.decode()?;
-        Ok(packed)
+        let source = packed.decode()?;
+        Ok((packed, source))
     }
 }

@@ -111,10 +111,16 @@ impl PackTrack {
     }
 }
 
-/// `x as f32 * step`: the one dequantization (the kernel's is this on 8 lanes).
+/// `x as f32 * step`: the one dequantization, on one value.
 #[inline(always)]
 pub fn dequantize(x: i32, step: f32) -> f32 {
-    x as f32 * step
+    dequantize_lanes(wide::i32x8::splat(x), wide::f32x8::splat(step)).to_array()[0]
+}
+
+/// [`dequantize`] on 8 lanes (the decoder's).
+#[inline(always)]
+pub(crate) fn dequantize_lanes(x: wide::i32x8, step: wide::f32x8) -> wide::f32x8 {
+    x.round_float() * step
 }
 
 /// Why a packed clip cannot be built or read: one line.

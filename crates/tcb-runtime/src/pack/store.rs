@@ -247,7 +247,7 @@ impl PackCache {
             };
             *x0 = *x1;
             *x1 = x;
-            *out = x.round_float() * *step;
+            *out = super::dequantize_lanes(x, *step);
         }
         let rot = &mut self.p[ring + g.rot_from..ring + np];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
