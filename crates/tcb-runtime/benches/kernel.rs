@@ -197,7 +197,8 @@ fn benches(c: &mut Criterion) {
 
 /// A packed clip (`tcb_runtime::pack`, what `tcb compress` writes): the
 /// bundled CMU capture (hermite) in steps of 1/4096, decoded as playback
-/// crosses keys (`packed/forward`, 60 fps), at random times (`packed/seek`:
+/// crosses keys (`packed/forward`, 60 fps; `packed/backward`, the same
+/// backwards), at random times (`packed/seek`:
 /// each a decode from the start of a block), and the same clip in f32
 /// (`packed/f32`).
 fn packed(c: &mut Criterion) {
@@ -226,6 +227,16 @@ fn packed(c: &mut Criterion) {
             })
         });
     }
+    // Backwards at 60 fps: each key crossed decodes from its block's start.
+    let mut back = Instance::new(compiled.clone());
+    let mut frame = 0u64;
+    g.bench_function("backward", |bench| {
+        bench.iter(|| {
+            frame += 1;
+            let t = b - (frame as f64 / 60.0) % (b - a);
+            black_box(back.sample(black_box(t)));
+        })
+    });
     let mut x = 7u64;
     let seeks: Vec<f64> = (0..1024)
         .map(|_| {
