@@ -499,17 +499,9 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
         rotation_tolerance: args.error.rotation_tolerance,
         seek_keys: Some(args.seek_keys),
     };
-    let bar = indicatif::ProgressBar::new(0).with_style(
-        indicatif::ProgressStyle::with_template("tcb: measuring {bar:30} {pos}/{len} clips")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let progress = |done: usize, total: usize| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    };
-    let result = tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, &progress);
-    bar.finish_and_clear();
-    let c = result?;
+    let c = with_progress("tcb: measuring {bar:30} {pos}/{len} clips", |progress| {
+        tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, progress)
+    })?;
     let s = &c.settings;
     match s.metric {
         tcb_fit::Metric::Shell => eprintln!(
@@ -531,6 +523,22 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     );
     println!("{}", c.summary_line());
     Ok(())
+}
+
+/// `work` with a progress bar on stderr (drawn only on a terminal) that it
+/// moves by calling its argument with (done, of how many).
+fn with_progress<T>(template: &str, work: impl FnOnce(&(dyn Fn(usize, usize) + Sync)) -> T) -> T {
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let result = work(&progress);
+    bar.finish_and_clear();
+    result
 }
 
 /// Any clip file as a source clip and its skeleton: a `.tcbc` as its
@@ -588,17 +596,9 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         clip: &loaded.clip,
         skeleton: loaded.skeleton.as_ref(),
     };
-    let bar = indicatif::ProgressBar::new(0).with_style(
-        indicatif::ProgressStyle::with_template("tcb: fitting {bar:30} {pos}/{len} groups")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let progress = |done: usize, total: usize| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    };
-    let result = tcb_fit::reduce(input, &options, &progress);
-    bar.finish_and_clear();
-    let reduced = result?;
+    let reduced = with_progress("tcb: fitting {bar:30} {pos}/{len} groups", |progress| {
+        tcb_fit::reduce(input, &options, progress)
+    })?;
     let s = &reduced.settings;
     match s.metric {
         tcb_fit::Metric::Shell => eprintln!(
