@@ -478,6 +478,13 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     if extension(&args.output) != "tcbc" {
         return Err(format!("{}: the output must end in .tcbc", args.output.display()).into());
     }
+    if extension(&args.input) == "tcbc" {
+        return Err(format!(
+            "{}: already packed; compress its source (BVH, glTF or clip JSON)",
+            args.input.display()
+        )
+        .into());
+    }
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
@@ -752,7 +759,9 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
 
 /// `tcb info` of a `.tcbc` file: what is stored and how it was made.
 fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
-    let file = std::fs::metadata(&args.clip)?.len();
+    let file = std::fs::metadata(&args.clip)
+        .map_err(|e| format!("{}: {e}", args.clip.display()))?
+        .len();
     let (clip, runtime) = load_tcbc(&args.clip)?;
     let packed = runtime.packed().expect("compiled from a packed clip");
     let head = packed.head();

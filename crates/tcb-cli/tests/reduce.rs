@@ -429,6 +429,10 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
         ),
         (vec![&uneven, "-o", out.to_str().unwrap()], "even grid"),
         (
+            vec!["x.tcbc", "-o", out.to_str().unwrap()],
+            "already packed",
+        ),
+        (
             vec![input, "-o", out.to_str().unwrap(), "--tolerance", "1e-12"],
             "error:",
         ),
@@ -459,6 +463,8 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
     bytes[n / 2] ^= 1;
     let bad = dir().join("bad.tcbc");
     std::fs::write(&bad, &bytes).unwrap();
+    let o = tcb(&["info", "missing.tcbc"]);
+    assert!(stderr(&o).contains("missing.tcbc: "), "{}", stderr(&o));
     for args in [vec!["sample", "--at", "0"], vec!["info"]] {
         let mut all = args.clone();
         all.insert(1, bad.to_str().unwrap());
