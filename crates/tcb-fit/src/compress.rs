@@ -23,7 +23,7 @@ use crate::reduce::{Metric, ReduceError, ReduceOptions, Settings, bound_joint, d
 use std::sync::Arc;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{Clip, TrackKind};
-use tcb_runtime::{PackSource, Packed};
+use tcb_runtime::{KeyValues, Packed};
 
 /// Options of [`compress`]; `None` takes the contract's default.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -104,18 +104,11 @@ pub fn compress(
         return Err(ReduceError::Empty);
     }
     let block = options.seek_keys.unwrap_or(tcb_runtime::pack::BLOCK_KEYS);
-    // Refuse what cannot be packed before searching; each track's largest
-    // magnitude (its integers at a step of 1).
-    let unit_steps = vec![1.0f32; clip.tracks().len()];
-    let unit =
-        PackSource::quantize(clip, &unit_steps).map_err(|e| ReduceError::Option(e.to_string()))?;
-    let largest: Vec<f64> = unit
-        .tracks
-        .iter()
-        .map(|t| {
-            let most = t.values.iter().flatten().map(|x| x.unsigned_abs()).max();
-            f64::from(most.unwrap_or(0)).max(1.0)
-        })
+    // The clip's keys, sampled once (refusing what cannot be packed before
+    // searching), and each track's largest magnitude.
+    let keys = KeyValues::sample(clip).map_err(|e| ReduceError::Option(e.to_string()))?;
+    let largest: Vec<f64> = (0..clip.tracks().len())
+        .map(|t| f64::from(keys.largest(t)).max(1.0))
         .collect();
     let reference = Arc::new(tcb_runtime::Clip::compile(clip));
     let rows = metric::play(&reference, &times);
@@ -125,8 +118,9 @@ pub fn compress(
     let mut measure = |steps: &[f32]| -> Result<(Measured, Packed), ReduceError> {
         evaluations += 1;
         progress(evaluations.min(total - 1), total);
-        let source =
-            PackSource::quantize(clip, steps).map_err(|e| ReduceError::Option(e.to_string()))?;
+        let source = keys
+            .quantize(steps)
+            .map_err(|e| ReduceError::Option(e.to_string()))?;
         let packed = Packed::encode_with(&source, block)
             .map_err(|e| ReduceError::Option(format!("--seek-keys: {e}")))?;
         let compiled = tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))

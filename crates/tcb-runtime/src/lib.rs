@@ -57,7 +57,7 @@ pub mod batch;
 pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
 pub use instance::{Instance, Playback, PlaybackError};
-pub use pack::{PackError, PackSource, PackTrack, Packed};
+pub use pack::{KeyValues, PackError, PackSource, PackTrack, Packed};
 
 /// The `mint` crate (feature `mint`): poses' glam values convert with
 /// `.into()`, so an engine on another glam version, nalgebra or cgmath

@@ -155,118 +155,7 @@ impl PackSource {
     /// bias and the clip's settings (a measurement against the source says
     /// how close that is).
     pub fn quantize(clip: &SourceClip, steps: &[f32]) -> Result<PackSource, PackError> {
-        let times = clip.key_times();
-        let n = times.len();
-        if n < 2 {
-            return err("a packed clip needs 2 keys or more");
-        }
-        let (start, interval) = (times[0], (times[n - 1] - times[0]) / (n - 1) as f64);
-        for (k, t) in times.iter().enumerate() {
-            if (t - (start + k as f64 * interval)).abs() > 1e-6 * interval {
-                return err(format!(
-                    "key time {t} s (number {k} of the clip's {n}, all tracks together) is not on an even grid of {interval} s from {start} s: a packed clip needs every track on one grid of evenly spaced keys (capture, baked animation); sample it on such a grid first"
-                ));
-            }
-        }
-        if steps.len() != clip.tracks().len() {
-            return err(format!(
-                "{} steps for {} tracks",
-                steps.len(),
-                clip.tracks().len()
-            ));
-        }
-        let mut tracks = Vec::with_capacity(steps.len());
-        for (t, &step) in clip.tracks().iter().zip(steps) {
-            if t.data.times().len() != n {
-                return err(format!(
-                    "track {} has {} keys, the clip {n}",
-                    t.name,
-                    t.data.times().len()
-                ));
-            }
-            let kind = t.data.kind();
-            let mut values: Vec<[f32; 4]> = (0..n)
-                .map(|k| {
-                    let mut v = [0.0f32; 4];
-                    t.data.sample_into(times[k], &mut v[..kind.dim()], None);
-                    v
-                })
-                .collect();
-            let mut settings = *t.data.settings();
-            settings.match_speed = false;
-            let mut rebuild_w = false;
-            if kind == TrackKind::Quat {
-                settings.rotation = RotationMode::Hermite;
-                // The keys are made continuous below, before rounding; kept
-                // as stored, so that the reference flips none the decoder
-                // does not (rounding can leave a dot product just below 0
-                // between keys half a turn apart).
-                settings.hemisphere = Hemisphere::Keep;
-                // Keys on one hemisphere, as the track plays them.
-                for k in 1..n {
-                    let d: f32 = (0..4).map(|c| values[k][c] * values[k - 1][c]).sum();
-                    if d < 0.0 {
-                        values[k] = values[k].map(|x| -x);
-                    }
-                }
-                let pos = values.iter().all(|v| v[3] > 0.0);
-                let neg = values.iter().all(|v| v[3] < 0.0);
-                if neg {
-                    values.iter_mut().for_each(|v| *v = v.map(|x| -x));
-                }
-                rebuild_w = pos || neg;
-            }
-            let q = |x: f32| {
-                let v = (f64::from(x) / f64::from(step)).round();
-                if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
-                    Err(PackError(format!(
-                        "track {}: step {step} is too fine for {x}",
-                        t.name
-                    )))
-                } else {
-                    Ok(v as i32)
-                }
-            };
-            let ints = |stored: usize| {
-                (0..stored)
-                    .map(|c| {
-                        values
-                            .iter()
-                            .map(|v| q(v[c]))
-                            .collect::<Result<Vec<i32>, _>>()
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            };
-            let mut ints4 = None;
-            if rebuild_w {
-                let xyz = ints(3)?;
-                if one_hemisphere(&xyz, step) {
-                    ints4 = Some(xyz);
-                } else {
-                    rebuild_w = false;
-                }
-            }
-            let values = match ints4 {
-                Some(v) => v,
-                None => ints(kind.dim())?,
-            };
-            tracks.push(PackTrack {
-                name: t.name.clone(),
-                kind,
-                settings,
-                tcb: Tcb::DEFAULT,
-                step,
-                rebuild_w,
-                values,
-            });
-        }
-        Ok(PackSource {
-            name: clip.name().to_string(),
-            start,
-            interval,
-            keys: n,
-            tracks,
-        })
+        KeyValues::sample(clip)?.quantize(steps)
     }
 
     /// Stored components over all tracks (the stream's lanes).
@@ -409,6 +298,175 @@ impl PackSource {
         }
         SourceClip::new(self.name.clone(), tracks)
             .map_err(|d| PackError(format!("track {} appears twice", d.0)))
+    }
+}
+
+/// A clip's key values on its even grid, as [`PackSource::quantize`] packs
+/// them: sampled once, so that a search over steps quantizes again without
+/// sampling again (`tcb compress`).
+#[derive(Clone, Debug)]
+pub struct KeyValues {
+    name: String,
+    start: f64,
+    interval: f64,
+    keys: usize,
+    tracks: Vec<TrackKeys>,
+}
+
+/// One track of [`KeyValues`].
+#[derive(Clone, Debug)]
+struct TrackKeys {
+    name: String,
+    kind: TrackKind,
+    settings: TrackSettings,
+    /// Per key, the components (rotations on one hemisphere, with `w >= 0`
+    /// where every key's `w` has one sign).
+    values: Vec<[f32; 4]>,
+    /// A rotation whose `w` keeps one sign: stored as `x y z` if it can be.
+    one_sign: bool,
+}
+
+impl KeyValues {
+    /// Sample `clip` at its keys: every track on one even grid (to 1e-6 of
+    /// the interval).
+    pub fn sample(clip: &SourceClip) -> Result<KeyValues, PackError> {
+        let times = clip.key_times();
+        let n = times.len();
+        if n < 2 {
+            return err("a packed clip needs 2 keys or more");
+        }
+        let (start, interval) = (times[0], (times[n - 1] - times[0]) / (n - 1) as f64);
+        for (k, t) in times.iter().enumerate() {
+            if (t - (start + k as f64 * interval)).abs() > 1e-6 * interval {
+                return err(format!(
+                    "key time {t} s (number {k} of the clip's {n}, all tracks together) is not on an even grid of {interval} s from {start} s: a packed clip needs every track on one grid of evenly spaced keys (capture, baked animation); sample it on such a grid first"
+                ));
+            }
+        }
+        let mut tracks = Vec::with_capacity(clip.tracks().len());
+        for t in clip.tracks() {
+            if t.data.times().len() != n {
+                return err(format!(
+                    "track {} has {} keys, the clip {n}",
+                    t.name,
+                    t.data.times().len()
+                ));
+            }
+            let kind = t.data.kind();
+            let mut values: Vec<[f32; 4]> = times
+                .iter()
+                .map(|&time| {
+                    let mut v = [0.0f32; 4];
+                    t.data.sample_into(time, &mut v[..kind.dim()], None);
+                    v
+                })
+                .collect();
+            let mut settings = *t.data.settings();
+            settings.match_speed = false;
+            let mut one_sign = false;
+            if kind == TrackKind::Quat {
+                settings.rotation = RotationMode::Hermite;
+                // The keys are made continuous here, before rounding; kept
+                // as stored, so that the reference flips none the decoder
+                // does not (rounding can leave a dot product just below 0
+                // between keys half a turn apart).
+                settings.hemisphere = Hemisphere::Keep;
+                for k in 1..n {
+                    let d: f32 = (0..4).map(|c| values[k][c] * values[k - 1][c]).sum();
+                    if d < 0.0 {
+                        values[k] = values[k].map(|x| -x);
+                    }
+                }
+                let pos = values.iter().all(|v| v[3] > 0.0);
+                let neg = values.iter().all(|v| v[3] < 0.0);
+                if neg {
+                    values.iter_mut().for_each(|v| *v = v.map(|x| -x));
+                }
+                one_sign = pos || neg;
+            }
+            tracks.push(TrackKeys {
+                name: t.name.clone(),
+                kind,
+                settings,
+                values,
+                one_sign,
+            });
+        }
+        Ok(KeyValues {
+            name: clip.name().to_string(),
+            start,
+            interval,
+            keys: n,
+            tracks,
+        })
+    }
+
+    /// Track `i`'s largest magnitude over its components and keys.
+    pub fn largest(&self, i: usize) -> f32 {
+        let t = &self.tracks[i];
+        let dim = t.kind.dim();
+        t.values
+            .iter()
+            .flat_map(|v| v[..dim].iter().map(|x| x.abs()))
+            .fold(0.0, f32::max)
+    }
+
+    /// Quantize: track `i` in steps of `steps[i]`; a rotation whose `w`
+    /// keeps one sign stores `x y z` unless its rounded keys would leave one
+    /// hemisphere.
+    pub fn quantize(&self, steps: &[f32]) -> Result<PackSource, PackError> {
+        if steps.len() != self.tracks.len() {
+            return err(format!(
+                "{} steps for {} tracks",
+                steps.len(),
+                self.tracks.len()
+            ));
+        }
+        let mut tracks = Vec::with_capacity(steps.len());
+        for (t, &step) in self.tracks.iter().zip(steps) {
+            let q = |x: f32| {
+                let v = (f64::from(x) / f64::from(step)).round();
+                if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
+                    Err(PackError(format!(
+                        "track {}: step {step} is too fine for {x}",
+                        t.name
+                    )))
+                } else {
+                    Ok(v as i32)
+                }
+            };
+            let ints = |stored: usize| {
+                (0..stored)
+                    .map(|c| {
+                        t.values
+                            .iter()
+                            .map(|v| q(v[c]))
+                            .collect::<Result<Vec<i32>, _>>()
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            };
+            let xyz = if t.one_sign { Some(ints(3)?) } else { None };
+            let (rebuild_w, values) = match xyz {
+                Some(xyz) if one_hemisphere(&xyz, step) => (true, xyz),
+                _ => (false, ints(t.kind.dim())?),
+            };
+            tracks.push(PackTrack {
+                name: t.name.clone(),
+                kind: t.kind,
+                settings: t.settings,
+                tcb: Tcb::DEFAULT,
+                step,
+                rebuild_w,
+                values,
+            });
+        }
+        Ok(PackSource {
+            name: self.name.clone(),
+            start: self.start,
+            interval: self.interval,
+            keys: self.keys,
+            tracks,
+        })
     }
 }
 
