@@ -35,9 +35,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 *time = t + phase;
             }
             if parallel {
-                batch::sample_all(&mut crowd, &times);
+                batch::sample_all(&mut crowd, &times).expect("a time per instance");
             } else {
-                batch::sample_all_sequential(&mut crowd, &times);
+                batch::sample_all_sequential(&mut crowd, &times).expect("a time per instance");
             }
         }
         let per = started.elapsed().as_secs_f64() / frames.max(1) as f64;

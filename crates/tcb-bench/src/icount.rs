@@ -65,7 +65,7 @@ pub fn batch_frames(s: &Scenario, instances: &mut [Instance]) {
         for (x, p) in times.iter_mut().zip(&s.phases) {
             *x = t + p;
         }
-        tcb_runtime::batch::sample_all(instances, &times);
+        tcb_runtime::batch::sample_all(instances, &times).expect("a time per instance");
         black_box(&instances[0]);
     }
 }

@@ -148,7 +148,8 @@ impl Scenario {
                     for (a, &p) in at.iter_mut().zip(&self.phases) {
                         *a = t + p;
                     }
-                    tcb_runtime::batch::sample_all(&mut instances, &at);
+                    tcb_runtime::batch::sample_all(&mut instances, &at)
+                        .expect("a time per instance");
                     black_box(&instances);
                 }
             })

@@ -126,7 +126,10 @@ impl Clip {
 
     /// The bound on what quantization moves `track`'s samples inside its
     /// keys, in the track's units (0 for a clip compiled without it; `None`
-    /// for a track of another layout); see [`crate::quant`].
+    /// for a track of another layout): `e_P + 4/27 (e_TO + e_TI)` with
+    /// `e_*` the largest error rounding made on its stored positions and
+    /// tangents (a sample is `h1 P0 + h2 P1 + h3 M0 + h4 M1`, `|h3|, |h4| <=
+    /// 4/27`), for rotations times what normalizing can grow it (about 2).
     pub fn quantization_error(&self, track: TrackId) -> Option<f32> {
         self.layout.slot(track)?;
         Some(self.quant_error.get(track.index).copied().unwrap_or(0.0))

@@ -156,8 +156,19 @@ impl TimeGrid {
         // segment, the table below with its other rows known to be off.
         if t0 <= time && time < tn {
             let (segment, s, rate) = self.real(time, cursor, 1.0);
-            let (h, dh, rate) =
-                sentinel_rows(true, false, false, false, s as f32, rate, 1.0, 0.0, true);
+            let (h, dh, rate) = sentinel_rows(
+                LaneRows {
+                    real: true,
+                    line: false,
+                    reset: false,
+                    hold: false,
+                    s: s as f32,
+                    rate,
+                    dir: 1.0,
+                    dt: 0.0,
+                },
+                true,
+            );
             return FrameBasis {
                 segment,
                 s,
@@ -201,7 +212,19 @@ impl TimeGrid {
                 if last { n } else { 0 }
             }
         };
-        let (h, dh, rate) = sentinel_rows(real, line, reset, hold, s as f32, rate, dir, dt, true);
+        let (h, dh, rate) = sentinel_rows(
+            LaneRows {
+                real,
+                line,
+                reset,
+                hold,
+                s: s as f32,
+                rate,
+                dir,
+                dt,
+            },
+            true,
+        );
         FrameBasis {
             segment,
             s,
@@ -214,25 +237,46 @@ impl TimeGrid {
     }
 }
 
+/// Where each lane of a frame is, for [`sentinel_rows`]: which row of the
+/// table in the module docs it takes, and the numbers that row reads.
+pub(crate) struct LaneRows<L: Lane> {
+    /// Inside a real segment, at `s` (`step` segments at `s = 0`, rate 0).
+    pub real: L::Mask,
+    /// On a linear extrapolation, `dt` past the end key.
+    pub line: L::Mask,
+    /// Reset to the identity (or zero).
+    pub reset: L::Mask,
+    /// Holding an end key.
+    pub hold: L::Mask,
+    /// The segment parameter of real lanes.
+    pub s: L,
+    /// ds/dt of real lanes, the direction in it.
+    pub rate: L,
+    /// The direction of lanes exactly at the last key (`oscillate`'s sign).
+    pub dir: L,
+    /// Seconds past the end key of `line` lanes.
+    pub dt: L,
+}
+
 /// The rows of the table in the module docs, for any lane type: lanes in
 /// a `real` segment take the basis at `s` (`step` segments come with
 /// `s = 0` and rate 0, so they hold their first key) and `rate` (with the
 /// direction in it); `line`, `reset` and `hold` lanes their fixed rows; the
 /// rest are exactly at the last key (`dir` carries `oscillate`'s sign).
-/// The one copy for the per-group frame (`f32`) and the loose lanes (`f32x8`).
-#[allow(clippy::too_many_arguments)]
+/// The one copy for the per-group frame (`f32`) and the loose lanes
+/// (`f32x8`). Without `velocity`, the derivative row is zeros.
 #[inline(always)]
-pub(crate) fn sentinel_rows<L: Lane>(
-    real: L::Mask,
-    line: L::Mask,
-    reset: L::Mask,
-    hold: L::Mask,
-    s: L,
-    rate: L,
-    dir: L,
-    dt: L,
-    velocity: bool,
-) -> ([L; 4], [L; 4], L) {
+pub(crate) fn sentinel_rows<L: Lane>(at: LaneRows<L>, velocity: bool) -> ([L; 4], [L; 4], L) {
+    let LaneRows {
+        real,
+        line,
+        reset,
+        hold,
+        s,
+        rate,
+        dir,
+        dt,
+    } = at;
     let (z, o) = (L::of(0.0), L::of(1.0));
     let at_end = !(real | line | reset | hold);
     let hb = hermite_basis(s);

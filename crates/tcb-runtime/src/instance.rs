@@ -54,9 +54,19 @@ pub struct Instance {
     /// Per group: expanded quantized keys (see `crate::store`).
     caches: Vec<KeyCache>,
     /// With a rig: the map into its layout and the pose in it.
-    rig: Option<Box<(RigMap, Pose)>>,
+    rig: Option<Box<RigOutput>>,
     /// Playback mode and speed.
-    playback: (Playback, f64),
+    mode: Playback,
+    speed: f64,
+}
+
+/// An instance's output in a rig's layout.
+#[derive(Clone, Debug)]
+struct RigOutput {
+    /// From the clip's layout into the rig's.
+    map: RigMap,
+    /// The pose in the rig's layout.
+    pose: Pose,
 }
 
 impl Instance {
@@ -71,7 +81,8 @@ impl Instance {
             caches: clip.groups.iter().map(|g| g.keys.cache()).collect(),
             clip,
             rig: None,
-            playback: (Playback::Clip, 1.0),
+            mode: Playback::Clip,
+            speed: 1.0,
         }
     }
 
@@ -98,18 +109,18 @@ impl Instance {
         if !speed.is_finite() {
             return Err(PlaybackError { speed });
         }
-        self.playback = (mode, speed);
+        (self.mode, self.speed) = (mode, speed);
         Ok(())
     }
 
     /// The playback mode and speed.
     pub fn playback(&self) -> (Playback, f64) {
-        self.playback
+        (self.mode, self.speed)
     }
 
     /// The clip time `time` plays, and the factor its velocities take.
     fn clip_time(&self, time: f64) -> (f64, f32) {
-        let (mode, speed) = self.playback;
+        let (mode, speed) = (self.mode, self.speed);
         let t = time * speed;
         if mode == Playback::Clip {
             return (t, speed as f32);
@@ -142,7 +153,10 @@ impl Instance {
     pub fn with_rig(clip: Arc<Clip>, rig: &Arc<Rig>) -> Result<Self, RigError> {
         let map = rig.map(&clip)?;
         let mut inst = Instance::new(clip);
-        inst.rig = Some(Box::new((map, rig.rest_pose())));
+        inst.rig = Some(Box::new(RigOutput {
+            map,
+            pose: rig.rest_pose(),
+        }));
         Ok(inst)
     }
 
@@ -151,8 +165,8 @@ impl Instance {
     #[must_use]
     pub fn with_velocities(mut self) -> Self {
         self.pose.add_velocities();
-        if let Some((_, pose)) = self.rig.as_deref_mut() {
-            pose.add_velocities();
+        if let Some(rig) = self.rig.as_deref_mut() {
+            rig.pose.add_velocities();
         }
         self
     }
@@ -163,8 +177,8 @@ impl Instance {
     /// towards the rest pose.
     pub fn coverage_mask(&self) -> BlendMask {
         match &self.rig {
-            Some(rig) => BlendMask::for_layout(&rig.1.layout, |t| {
-                f32::from(u8::from(rig.0.covered[t.index]))
+            Some(rig) => BlendMask::for_layout(&rig.pose.layout, |t| {
+                f32::from(u8::from(rig.map.covered[t.index]))
             }),
             None => BlendMask::new(&self.clip, |_| 1.0),
         }
@@ -178,7 +192,7 @@ impl Instance {
     /// The last sampled pose (in the rig's layout if the instance has one).
     pub fn pose(&self) -> &Pose {
         match &self.rig {
-            Some(rig) => &rig.1,
+            Some(rig) => &rig.pose,
             None => &self.pose,
         }
     }
@@ -203,9 +217,9 @@ impl Instance {
             v.iter_mut().for_each(|x| *x *= r);
         }
         match self.rig.as_deref_mut() {
-            Some((map, out)) => {
-                map.apply(&self.pose, out);
-                out
+            Some(RigOutput { map, pose }) => {
+                map.apply(&self.pose, pose);
+                pose
             }
             None => &self.pose,
         }

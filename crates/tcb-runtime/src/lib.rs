@@ -50,7 +50,7 @@ mod layout;
 mod loose;
 pub mod pack;
 pub mod pose;
-pub mod quant;
+mod quant;
 pub mod rig;
 mod segment;
 pub mod skeleton;

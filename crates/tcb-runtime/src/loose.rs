@@ -26,7 +26,7 @@
 //! The rows are evaluated by the same [`tcb_core::basis::hermite`] on
 //! `f32x8` as every other kernel, from the same f64 `u` as the reference,
 //! so the values are the reference's bit for bit.
-use crate::grid::{TimeGrid, sentinel_rows};
+use crate::grid::{LaneRows, TimeGrid, sentinel_rows};
 use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
@@ -63,7 +63,7 @@ pub(crate) struct LooseLane {
 }
 
 /// A loose lane's keys, in f32 or in 16 bits with a range per component
-/// and control (see [`crate::quant`]; expanded only when a lane crosses a key).
+/// and control (see `crate::quant`; expanded only when a lane crosses a key).
 #[derive(Clone, Debug)]
 enum Keys {
     F32(Vec<[f32; KEY_STRIDE]>),
@@ -118,7 +118,7 @@ impl LooseLane {
         }
     }
 
-    /// Store the keys in 16 bits (as [`crate::quant`] does for groups) and
+    /// Store the keys in 16 bits (as `crate::quant` does for groups) and
     /// return, per component, the largest error made on `[P, TO, TI]`.
     pub fn quantize(&mut self) -> Vec<[f32; KEY_STRIDE]> {
         let Keys::F32(keys) = &self.keys else {
@@ -801,14 +801,16 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
     let dirs = f32x8_of(dir[0], dir[1]);
     let cyc = f32x8_of(cycles[0], cycles[1]);
     let (h, dh, rate) = sentinel_rows(
-        realm,
-        line,
-        reset,
-        hold,
-        s32,
-        f32x8_of(rate[0], rate[1]),
-        dirs,
-        f32x8_of(dt[0], dt[1]),
+        LaneRows {
+            real: realm,
+            line,
+            reset,
+            hold,
+            s: s32,
+            rate: f32x8_of(rate[0], rate[1]),
+            dir: dirs,
+            dt: f32x8_of(dt[0], dt[1]),
+        },
         velocity,
     );
     Rows {

@@ -1113,8 +1113,8 @@ fn batch_equals_sequential() {
     let mut rng = Rng(99);
     for _ in 0..5 {
         let times: Vec<f64> = (0..257).map(|_| rng.f(-5.0, 20.0)).collect();
-        tcb_runtime::batch::sample_all(&mut par, &times);
-        tcb_runtime::batch::sample_all_sequential(&mut seq, &times);
+        tcb_runtime::batch::sample_all(&mut par, &times).unwrap();
+        tcb_runtime::batch::sample_all_sequential(&mut seq, &times).unwrap();
         for (p, s) in par.iter().zip(&seq) {
             assert_eq!(p.pose().as_slice(), s.pose().as_slice());
         }

@@ -34,13 +34,24 @@ use std::sync::Arc;
 use tcb_core::{Extrapolation, TrackData};
 use wide::f32x8;
 
-/// Choices made when a clip is compiled.
+/// Choices made when a clip is compiled: `Default` and the builders, so
+/// that a new option does not break callers (a struct literal does not
+/// compile outside the crate).
+///
+/// ```
+/// let options = tcb_runtime::CompileOptions::default().quantize(true);
+/// assert!(options.quantize && !options.exact_velocities);
+/// ```
+///
+/// ```compile_fail
+/// let options = tcb_runtime::CompileOptions { quantize: true, exact_velocities: false };
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct CompileOptions {
     /// Store the controls in 16 bits per component with a per-channel
-    /// range (see [`crate::quant`] for the error bound,
-    /// [`Clip::quantization_error`] for each track's). Tracks on their own
+    /// range (each track's error bound: [`Clip::quantization_error`]).
+    /// Tracks on their own
     /// key times are expanded only when they cross a key.
     pub quantize: bool,
     /// Evaluate every squad (and slerp) segment's velocity by squad's own
