@@ -20,6 +20,7 @@
 pub mod baseline;
 pub mod icount;
 pub mod measure;
+pub mod noise;
 pub mod peer;
 pub mod report;
 pub mod scenarios;

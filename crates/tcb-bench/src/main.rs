@@ -2,7 +2,9 @@
 //! on the bundled real data. `--json PATH` or `--save-baseline NAME` saves
 //! it with the machine's fingerprint; `--check PATH` or `--baseline NAME`
 //! compares with a saved one and exits 1 when bytes grew, or (same machine
-//! and build only) a ratio fell by more than `--max-regression` percent.
+//! and build only) the runtime got slower beyond the noise its rounds
+//! measured and by more than `--max-regression` percent, in its own time
+//! and against the scalar baseline's in the same rounds (`report::check`).
 //! `--icount` counts instructions under callgrind instead: the CI gate.
 
 #![forbid(unsafe_code)]
@@ -37,7 +39,9 @@ struct Args {
     /// Compare with a saved JSON report (--json); exit 1 on a regression.
     #[arg(long, value_name = "BASELINE.json")]
     check: Option<PathBuf>,
-    /// Largest allowed fall of a same-machine ratio, percent.
+    /// Against a same-machine baseline: the smallest slowdown of the
+    /// runtime reported as a regression, percent (it must also exceed 3
+    /// MADs of the rounds, in its own time and over the scalar baseline's).
     #[arg(long, value_name = "PCT", default_value_t = 10.0)]
     max_regression: f64,
     /// The motion-capture file for character, crowd and seek.
