@@ -5,6 +5,8 @@
 //! and build only) the runtime got slower beyond the noise its rounds
 //! measured and by more than `--max-regression` percent, in its own time
 //! and against the scalar baseline's in the same rounds (`report::check`).
+//! `--markdown FILE` writes this machine's table into a markdown document
+//! (`docs/benchmarks.md`; [`tcb_bench::markdown`]).
 //! `--icount` counts instructions under callgrind instead: the CI gate.
 
 #![forbid(unsafe_code)]
@@ -13,7 +15,7 @@ use clap::Parser;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
-use tcb_bench::{icount, report, scenarios};
+use tcb_bench::{icount, markdown, report, scenarios};
 
 #[derive(Parser)]
 #[command(
@@ -29,6 +31,12 @@ struct Args {
     /// Write the report as JSON here too (with the machine fingerprint).
     #[arg(long, value_name = "PATH")]
     json: Option<PathBuf>,
+    /// Put this machine's and build's table (dated, with the command) into
+    /// this markdown file, between its "tcb-bench --markdown" comment
+    /// lines, replacing the table of the same machine and build and
+    /// keeping the others and the rest of the file (created if missing).
+    #[arg(long, value_name = "FILE.md", conflicts_with = "icount")]
+    markdown: Option<PathBuf>,
     /// Save the report as a named baseline of this machine
     /// (target/tcb-bench/NAME.json), to compare later runs with.
     #[arg(long, value_name = "NAME")]
@@ -278,9 +286,19 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         (None, None) => None,
     };
     let saved = read_json(compare.as_deref())?;
+    // And the markdown file, for the same reason.
+    let markdown_doc = match &args.markdown {
+        Some(p) if p.exists() => {
+            let doc = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            markdown::check(&doc, &p.display().to_string())?;
+            Some(doc)
+        }
+        _ => None,
+    };
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
+    let load = markdown::load_average();
     let names: Option<Vec<&str>> = args
         .only
         .as_ref()
@@ -325,6 +343,22 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         tcb_io::write_atomically(path, text.as_bytes())?;
+    }
+    if let Some(path) = &args.markdown {
+        let argv: Vec<String> = std::env::args().skip(1).collect();
+        let command = markdown::command(
+            env!("TCB_BENCH_RUSTFLAGS"),
+            env!("TCB_BENCH_PROFILE"),
+            &argv,
+        );
+        let table = markdown::table(&rows, &here, &timing, &command, &report::today(), load);
+        let doc = markdown::update(markdown_doc.as_deref(), &table, &path.display().to_string())?;
+        tcb_io::write_atomically(path, doc.as_bytes())?;
+        println!(
+            "\nwrote \"{}\" into {}",
+            markdown::heading(&here).trim_start_matches("### "),
+            path.display()
+        );
     }
     if let (Some(name), Some(path)) = (&args.save_baseline, &save) {
         println!("\nsaved as baseline '{name}' ({})", path.display());
