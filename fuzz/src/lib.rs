@@ -76,10 +76,7 @@ pub fn runtime(data: &[u8]) {
     }
     // Half the inputs (by the number of times, so that the corpus reads as
     // before) compile with exact squad velocities.
-    let options = tcb_runtime::CompileOptions {
-        exact_velocities: times.len() % 2 == 1,
-        ..Default::default()
-    };
+    let options = tcb_runtime::CompileOptions::default().exact_velocities(times.len() % 2 == 1);
     check(&clip, &times, &options);
 }
 

@@ -276,10 +276,7 @@ pub fn character(bvh: &Path, rotation: RotationMode) -> Result<Scenario, tcb_io:
 pub fn character_quantized(bvh: &Path) -> Result<Scenario, tcb_io::Error> {
     let mut s = character(bvh, RotationMode::Hermite)?;
     s.name = "character-quantized".into();
-    let options = tcb_runtime::CompileOptions {
-        quantize: true,
-        ..Default::default()
-    };
+    let options = tcb_runtime::CompileOptions::default().quantize(true);
     s.clip = Arc::new(tcb_runtime::Clip::compile_with(&s.source, &options));
     s.peer = None;
     Ok(s)

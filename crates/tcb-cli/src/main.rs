@@ -676,10 +676,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     let loaded = tcb_io::load_with(&args.clip, &options)?;
     warn(&loaded.warnings);
     let clip = &loaded.clip;
-    let options = tcb_runtime::CompileOptions {
-        quantize: args.quantize,
-        ..Default::default()
-    };
+    let options = tcb_runtime::CompileOptions::default().quantize(args.quantize);
     let runtime = tcb_runtime::Clip::compile_with(clip, &options);
     let stats = runtime.stats();
     let keys: usize = clip.tracks().iter().map(|t| t.data.times().len()).sum();
@@ -860,10 +857,7 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
         fps: args.fps,
         instances: args.instances,
         import: import_options(&args.clip, args.rotation, args.animation.as_ref())?,
-        compile: tcb_runtime::CompileOptions {
-            quantize: args.quantize,
-            ..Default::default()
-        },
+        compile: tcb_runtime::CompileOptions::default().quantize(args.quantize),
     };
     let scenario = tcb_bench::scenarios::file_with(&args.clip, &options)?;
     if scenario.source.tracks().is_empty() {
@@ -1018,10 +1012,7 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
     } else {
         // Velocities printed are squad's own (the contract's numbers), not
         // the cubic's that a game loop plays (5e-5 of the speed off).
-        let options = tcb_runtime::CompileOptions {
-            exact_velocities: args.velocity,
-            ..Default::default()
-        };
+        let options = tcb_runtime::CompileOptions::default().exact_velocities(args.velocity);
         // A packed clip plays its own stream (its reference is `clip`).
         let runtime = packed.unwrap_or_else(|| {
             std::sync::Arc::new(tcb_runtime::Clip::compile_with(&clip, &options))

@@ -40,28 +40,7 @@ use crate::tangent::{TangentKey, key_tangents};
 use crate::track::{Track, check_keys, keys_or_default, locate, segment_eases};
 use glam::{DQuat, DVec3, DVec4, Quat, Vec4};
 
-/// `log` of a unit quaternion: `(v sin(th/2), cos(th/2)) -> v th/2`.
-pub fn quat_log(q: DQuat) -> DVec3 {
-    let v = DVec3::new(q.x, q.y, q.z);
-    let sin = v.length();
-    if sin == 0.0 {
-        return DVec3::ZERO;
-    }
-    v * (sin.atan2(q.w) / sin)
-}
-
-/// `exp` of a pure quaternion: `v -> (v/|v| sin|v|, cos|v|)`.
-pub fn quat_exp(v: DVec3) -> DQuat {
-    let th = v.length();
-    // sin(th)/th, by its series where th is tiny.
-    let sinc = if th < 1e-6 {
-        1.0 - th * th / 6.0
-    } else {
-        th.sin() / th
-    };
-    let xyz = v * sinc;
-    DQuat::from_xyzw(xyz.x, xyz.y, xyz.z, th.cos())
-}
+pub use crate::squad::{quat_exp, quat_log};
 
 /// Spherical linear interpolation without hemisphere correction,
 /// `p exp(s log(p^-1 q))` ([`crate::squad::slerp_power`]). Any `s` is

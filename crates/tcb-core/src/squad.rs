@@ -24,13 +24,36 @@ use crate::lane::Lane;
 use crate::quat::mul;
 use glam::{DQuat, DVec3};
 
+/// `log` of a unit quaternion: `(v sin(th/2), cos(th/2)) -> v th/2`.
+pub fn quat_log(q: DQuat) -> DVec3 {
+    let v = DVec3::new(q.x, q.y, q.z);
+    let sin = v.length();
+    if sin == 0.0 {
+        return DVec3::ZERO;
+    }
+    v * (sin.atan2(q.w) / sin)
+}
+
+/// `exp` of a pure quaternion: `v -> (v/|v| sin|v|, cos|v|)`.
+pub fn quat_exp(v: DVec3) -> DQuat {
+    let th = v.length();
+    // sin(th)/th, by its series where th is tiny.
+    let sinc = if th < 1e-6 {
+        1.0 - th * th / 6.0
+    } else {
+        th.sin() / th
+    };
+    let xyz = v * sinc;
+    DQuat::from_xyzw(xyz.x, xyz.y, xyz.z, th.cos())
+}
+
 /// Controls of one squad segment: `q0 [x y z w], n [x y z], alpha, a [x y z w], m [x y z], beta`.
 pub const CONTROLS: usize = 16;
 
 /// `p`, then the unit axis and angle of `log(p^-1 q)`, so that
 /// `slerp(p, q, s) = p exp(s alpha n)` (no hemisphere flip).
 pub fn slerp_controls(p: DQuat, q: DQuat) -> [f64; 8] {
-    let v = crate::rotation::quat_log(p.conjugate() * q);
+    let v = quat_log(p.conjugate() * q);
     let alpha = v.length();
     let n = if alpha > 0.0 { v / alpha } else { DVec3::ZERO };
     [p.x, p.y, p.z, p.w, n.x, n.y, n.z, alpha]

@@ -167,10 +167,7 @@ fn benches(c: &mut Criterion) {
     let turning = skeleton_turning(31, 200, RotationMode::Squad, 30.0);
     assert!(Clip::compile(&turning).stats().exact_segments > 1000);
     play(c, "skeleton_squad_exact", &turning, 31);
-    let quantize = CompileOptions {
-        quantize: true,
-        ..Default::default()
-    };
+    let quantize = CompileOptions::default().quantize(true);
     play_with(
         c,
         "skeleton_hermite_quantized",

@@ -27,9 +27,11 @@
 //! Scale tracks are vectors here, so their difference is added too (ozz
 //! multiplies scales); the two agree at weights 0 and 1 on a unit reference.
 
-use crate::clip::{Clip, TrackId};
+use crate::clip::Clip;
 use crate::kernel::normalize;
-use crate::pose::{Pose, PoseLayout};
+use crate::layout::PoseLayout;
+use crate::layout::TrackId;
+use crate::pose::Pose;
 use std::fmt;
 use std::ops::Range;
 use std::sync::Arc;

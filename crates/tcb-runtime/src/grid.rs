@@ -91,6 +91,22 @@ impl TimeGrid {
         self.steps.get(k).copied().unwrap_or(false)
     }
 
+    /// The two keys stored segment `seg` reads: `(a, b)` with
+    /// `P0 = a.P, M0 = a.TO, P1 = b.P, M1 = b.TI`. A `step` segment is played
+    /// at `s = 0` (basis `[1, 0, 0, 0]`), and its `b` is key 0, whose `TI` is
+    /// zero: its own key's `TI` belongs to the segment before and may be
+    /// infinite, and `0 * inf` would be NaN.
+    #[inline]
+    pub fn key_pair(&self, seg: usize) -> (usize, usize) {
+        let n = self.times.len();
+        match seg {
+            0 => (n, n + 1),
+            s if s == n => (n + 2, n + 3),
+            s if self.is_step(s - 1) => (s - 1, 0),
+            s => (s - 1, s),
+        }
+    }
+
     /// The same grid with `eases` and `steps` emptied where they say nothing.
     pub fn compact(mut self) -> Self {
         if self.eases.iter().all(SegmentEase::is_none) {
@@ -128,8 +144,10 @@ impl TimeGrid {
         (k + 1, eased, (ds_du / d) as f32 * dir)
     }
 
-    /// The basis for `time` (any f64), advancing `cursor`.
-    #[inline]
+    /// The basis for `time` (any f64), advancing `cursor`. Out of line: once
+    /// a group per frame, and inlined into the caller it takes registers the
+    /// kernels' loop needs (+1 instruction per block in `wide`).
+    #[inline(never)]
     pub fn frame(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
         let n = self.times.len();
         let (t0, tn) = (self.times[0], self.times[n - 1]);

@@ -1,14 +1,12 @@
 //! Per-instance playback: cursors and a pose, sampled without allocating.
 
-use crate::BlendMask;
-use crate::clip::{Clip, Group};
-use crate::grid::{Cursor, FrameBasis};
-use crate::kernel;
+use crate::blend::BlendMask;
+use crate::clip::Clip;
+use crate::grid::Cursor;
 use crate::loose::LooseState;
 use crate::pose::Pose;
 use crate::rig::{Rig, RigError, RigMap};
 use crate::store::KeyCache;
-use crate::store::Segment;
 use std::sync::Arc;
 use wide::f32x8;
 
@@ -229,21 +227,13 @@ pub(crate) fn sample_into(
     } = pose;
     if clip.packed.is_some() {
         // One group, decoded from its stream (`crate::pack`).
-        sample_packed(
-            clip,
-            time,
-            cursors,
-            values,
-            velocities.as_deref_mut(),
-            caches,
-        );
+        for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
+            g.sample_packed(time, cursor, cache, values, velocities.as_deref_mut());
+        }
         return;
     }
     for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
-        let f = g.grid.frame(time, cursor);
-        let (ka, kb) = crate::clip::key_pair(&g.grid, f.segment);
-        let controls = g.keys.segment(ka, kb, cache);
-        sample_group(g, f, controls, values, velocities.as_deref_mut());
+        g.sample(time, cursor, cache, values, velocities.as_deref_mut());
     }
     if clip.loose.blocks > 0 {
         crate::loose::sample::<false>(&clip.loose, loose, time, values, velocities.as_deref_mut());
@@ -251,95 +241,5 @@ pub(crate) fn sample_into(
     let r = &clip.loose_rot;
     if r.blocks > 0 {
         crate::loose::sample::<true>(r, loose_rot, time, values, velocities.as_deref_mut());
-    }
-}
-
-/// A packed clip (`crate::pack`): its groups' controls come from decoded
-/// keys. Out of line, so that the f32 groups' loop stays as it was.
-#[inline(never)]
-fn sample_packed(
-    clip: &Clip,
-    time: f64,
-    cursors: &mut [Cursor],
-    values: &mut [f32x8],
-    mut velocities: Option<&mut [f32x8]>,
-    caches: &mut [KeyCache],
-) {
-    for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
-        let f = g.grid.frame(time, cursor);
-        let (ka, kb) = crate::clip::key_pair(&g.grid, f.segment);
-        let Some((keys, state)) = g.keys.packed(cache) else {
-            unreachable!("every group of a packed clip is packed")
-        };
-        let controls = keys.segment(ka, kb, state);
-        sample_group(g, f, controls, values, velocities.as_deref_mut());
-    }
-}
-
-/// One group's kernels on its segment's controls: vectors, rotations,
-/// exact squad lanes.
-#[inline(always)]
-fn sample_group(
-    g: &Group,
-    f: FrameBasis,
-    controls: Segment,
-    values: &mut [f32x8],
-    mut velocities: Option<&mut [f32x8]>,
-) {
-    let (h, dh, rate) = (f.h, f.dh, f.rate);
-    let seg = f.segment;
-    let (cv, cq) = controls.split_at(g.vec_blocks);
-    if g.vec_blocks > 0 {
-        let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
-        kernel::vectors(cv, h, out);
-        if f.cycles != 0.0 && !g.delta.is_empty() {
-            kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
-        }
-        if let Some(v) = velocities.as_deref_mut() {
-            kernel::vector_velocities(cv, dh, rate, &mut v[g.vec_out..g.vec_out + g.vec_blocks]);
-        }
-    }
-    if g.hq_blocks > 0 {
-        let hq_out = g.vec_out + g.vec_blocks;
-        let range = hq_out..hq_out + 4 * g.hq_blocks;
-        if f.reset {
-            kernel::identity(&mut values[range.clone()]);
-            if let Some(v) = velocities.as_deref_mut() {
-                v[range].fill(f32x8::ZERO);
-            }
-        } else {
-            kernel::hermite_quats(
-                cq,
-                h,
-                dh,
-                rate,
-                &mut values[range.clone()],
-                velocities.as_deref_mut().map(|v| &mut v[range]),
-            );
-            let exact = match g.exact_at.get(seg..seg + 2) {
-                Some(at) => &g.exact[at[0] as usize..at[1] as usize],
-                None => &[],
-            };
-            for e in exact {
-                // Without velocities, lanes whose cubic misses only the
-                // velocity keep the cubic.
-                let mask = match velocities {
-                    Some(_) => e.mask,
-                    None if e.values => e.value_mask,
-                    None => continue,
-                };
-                let at = hq_out + 4 * e.block as usize;
-                let planes = at..at + 4;
-                kernel::exact_quats(
-                    e,
-                    &g.exact_controls[e.controls as usize],
-                    mask,
-                    f.s,
-                    f.rate,
-                    &mut values[planes.clone()],
-                    velocities.as_deref_mut().map(|v| &mut v[planes]),
-                );
-            }
-        }
     }
 }

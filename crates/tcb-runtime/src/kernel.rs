@@ -1,18 +1,10 @@
 //! The SIMD kernels: one stored segment, eight channels per `f32x8`, the
 //! frame's rows broadcast. No branch depends on a channel.
 
-use crate::store::Segment;
+use crate::exact::{Exact, SQ_STRIDE};
+use crate::segment::Segment;
 use tcb_core::basis::hermite;
 use wide::{f32x8, f64x4};
-
-/// `[P, TO, TI]` of one channel at one key (`clip::per_key`).
-pub(crate) const KEY_STRIDE: usize = 3;
-/// `[P, TO, TI]` x `[x, y, z, w]` of one rotation at one key.
-pub(crate) const HQ_STRIDE: usize = 12;
-/// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
-/// of 4 quaternions in f64 ([`tcb_core::squad::CONTROLS`]): the two outer
-/// slerps of squad as start point, log axis and log angle.
-pub(crate) const SQ_STRIDE: usize = tcb_core::squad::CONTROLS;
 
 #[inline(always)]
 pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
@@ -230,7 +222,7 @@ pub(crate) fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4
 /// frames reach an exact entry.
 #[inline(never)]
 pub(crate) fn exact_quats(
-    e: &crate::clip::Exact,
+    e: &Exact,
     controls: &[f64x4; 2 * SQ_STRIDE],
     mask: f32x8,
     s: f64,

@@ -40,14 +40,19 @@
 
 pub mod blend;
 pub mod clip;
+mod compile;
+mod exact;
 pub(crate) mod grid;
+mod group;
 mod instance;
 mod kernel;
+mod layout;
 mod loose;
 pub mod pack;
 pub mod pose;
 pub mod quant;
 pub mod rig;
+mod segment;
 pub mod skeleton;
 mod store;
 
@@ -55,8 +60,10 @@ mod store;
 pub mod batch;
 
 pub use blend::{BlendMask, blend};
-pub use clip::{Clip, ClipStats, CompileOptions, GridStats, TrackId, TrackSlot};
+pub use clip::{Clip, ClipStats, GridStats};
+pub use compile::CompileOptions;
 pub use instance::{Instance, Playback, PlaybackError};
+pub use layout::{PoseLayout, TrackId, TrackSlot};
 pub use pack::{KeyValues, PackError, PackSource, PackTrack, Packed};
 
 /// The `mint` crate (feature `mint`): poses' glam values convert with

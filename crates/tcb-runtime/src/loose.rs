@@ -26,9 +26,8 @@
 //! The rows are evaluated by the same [`tcb_core::basis::hermite`] on
 //! `f32x8` as every other kernel, from the same f64 `u` as the reference,
 //! so the values are the reference's bit for bit.
-use crate::clip::{key_pair, per_key};
 use crate::grid::{TimeGrid, sentinel_rows};
-use crate::kernel::KEY_STRIDE;
+use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
 use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::{SegmentEase, ease};
@@ -161,7 +160,7 @@ impl LooseLane {
     }
 
     /// `[P0, P1, M0, M1]` of each component from keys `ka` and `kb` (see
-    /// [`key_pair`]) into the lane's planes of the instance's controls
+    /// `TimeGrid::key_pair`) into the lane's planes of the instance's controls
     /// (`ctl`, as f32s; see [`put_controls`]).
     #[inline(always)]
     fn segment(&self, ka: usize, kb: usize, ctl: &mut [f32]) {
@@ -449,7 +448,7 @@ impl LooseState {
     }
 
     /// Load stored segment `seg` of lane `l` into its window, ease and
-    /// controls (what [`key_pair`] says, without its general match: this runs
+    /// controls (what `TimeGrid::key_pair` says, without its general match: this runs
     /// each time a lane crosses a key).
     #[inline(never)]
     fn load(&mut self, loose: &Loose, l: usize, seg: usize) {
@@ -492,7 +491,7 @@ impl LooseState {
                 n + 3,
             )
         };
-        debug_assert_eq!((ka, kb), key_pair(&lane.grid, seg));
+        debug_assert_eq!((ka, kb), lane.grid.key_pair(seg));
         self.set_window(l, seg, [ws, we, d], Some(ease));
         lane.segment(ka, kb, bytemuck::cast_slice_mut(&mut self.ctl));
     }
@@ -621,7 +620,7 @@ impl LooseState {
         k: &[[f32; KEY_STRIDE]],
     ) {
         debug_assert!(lane.plain && lane.dim == N && seg >= 1);
-        debug_assert_eq!((seg - 1, seg), key_pair(&lane.grid, seg));
+        debug_assert_eq!((seg - 1, seg), lane.grid.key_pair(seg));
         self.set_window(l, seg, [ws, we, we - ws], None);
         // Keys `seg - 1` and `seg`, `N` components each.
         let keys = &k[(seg - 1) * N..][..2 * N];

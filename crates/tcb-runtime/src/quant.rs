@@ -26,6 +26,12 @@
 
 use wide::{f32x8, i32x8, u16x8};
 
+/// What errors `[e_P, e_TO, e_TI]` in a segment's stored controls can move
+/// a sample inside it: `e_P + 4/27 (e_TO + e_TI)` (module docs).
+pub(crate) fn sample_bound(e: [f32; 3]) -> f32 {
+    e[0] + 4.0 / 27.0 * (e[1] + e[2])
+}
+
 /// One group's controls in 16 bits, laid out as the f32 ones
 /// ([`crate::store`]): `[P TO]` per key and `TI` where it differs.
 #[derive(Clone, Debug)]

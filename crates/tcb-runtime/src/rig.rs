@@ -33,8 +33,9 @@
 //! assert!((out.quat(hips).unwrap().length() - 1.0).abs() < 1e-6);
 //! ```
 
-use crate::clip::{Clip, TrackId, TrackSlot};
-use crate::pose::{Pose, PoseLayout};
+use crate::clip::Clip;
+use crate::layout::{PoseLayout, TrackId, TrackSlot, plane_slots};
+use crate::pose::Pose;
 use std::collections::HashMap;
 use std::fmt;
 use std::sync::Arc;
@@ -146,7 +147,7 @@ impl Rig {
         let mut flat = vec![0.0f32; 8 * (vec_blocks + rot_blocks)];
         for (out, ids) in [(0, &vec), (vec_blocks, &rot)] {
             for (lane, &i) in ids.iter().enumerate() {
-                slots[i].index = crate::clip::plane_slots(out, lane);
+                slots[i].index = plane_slots(out, lane);
                 for c in 0..4 {
                     flat[slots[i].index[c]] = tracks[i].rest[c];
                 }
@@ -155,7 +156,7 @@ impl Rig {
         // Padding rotation lanes: the identity, so blending and
         // normalizing them stays finite.
         for lane in rot.len()..rot.len().div_ceil(8) * 8 {
-            flat[crate::clip::plane_slots(vec_blocks, lane)[3]] = 1.0;
+            flat[plane_slots(vec_blocks, lane)[3]] = 1.0;
         }
         let quat_blocks = (0..rot_blocks / 4).map(|b| vec_blocks + 4 * b).collect();
         let rest = flat

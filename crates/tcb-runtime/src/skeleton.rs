@@ -1,8 +1,9 @@
 //! Binding a joint hierarchy to a clip: from a sampled [`Pose`] to local
 //! and model-space joint transforms.
 
-use crate::pose::PoseLayout;
-use crate::{Clip, Pose, TrackId};
+use crate::clip::Clip;
+use crate::layout::{PoseLayout, TrackId};
+use crate::pose::Pose;
 use glam::Affine3A;
 use tcb_core::TrackKind;
 use tcb_core::skeleton::{Skeleton, Transform};

@@ -1,6 +1,6 @@
 //! A group's controls, stored once per key.
 //!
-//! Every key (and sentinel pseudo-key, see `clip::per_key`) holds three
+//! Every key (and sentinel pseudo-key, see [`per_key`]) holds three
 //! sections of `planes` vectors of 8 lanes: `P`, `TO` (the outgoing
 //! tangent, `M0` of the segment it starts) and `TI` (the incoming one,
 //! `M1` of the segment it ends). A group's planes are its vector blocks
@@ -23,37 +23,49 @@
 
 use crate::pack::store::{PackCache, PackedKeys};
 use crate::quant::Quantized;
+use crate::segment::Segment;
 use wide::f32x8;
 
-/// The four controls of one stored segment from key `a` to key `b`
-/// (`planes` vectors each): `P0 = a.P`, `M0 = a.TO`, `P1 = b.P`,
-/// `M1 = b.TI`.
-#[derive(Clone, Copy)]
-pub(crate) struct Segment<'a> {
-    pub p0: &'a [f32x8],
-    pub m0: &'a [f32x8],
-    pub p1: &'a [f32x8],
-    pub m1: &'a [f32x8],
-}
+/// `[P, TO, TI]` of one channel at one key ([`per_key`]).
+pub(crate) const KEY_STRIDE: usize = 3;
+/// `[P, TO, TI]` x `[x, y, z, w]` of one rotation at one key.
+pub(crate) const HQ_STRIDE: usize = 12;
 
-impl<'a> Segment<'a> {
-    /// The first `n` planes and the rest.
-    #[inline(always)]
-    pub fn split_at(self, n: usize) -> (Segment<'a>, Segment<'a>) {
-        let (p0, q0) = self.p0.split_at(n);
-        let (m0, n0) = self.m0.split_at(n);
-        let (p1, q1) = self.p1.split_at(n);
-        let (m1, n1) = self.m1.split_at(n);
-        (
-            Segment { p0, m0, p1, m1 },
-            Segment {
-                p0: q0,
-                m0: n0,
-                p1: q1,
-                m1: n1,
-            },
-        )
+/// A channel's controls per key, `[P, TO, TI]` (`TO_k` = `M0` of segment
+/// k, `TI_k` = `M1` of segment k-1; nothing is stored twice), for the n
+/// keys, then the sentinels as four pseudo-keys `pre_a pre_b post_a post_b`
+/// that give back `[P0, P1, M0, M1]` of stored segments 0 and n the same
+/// way (see `TimeGrid::key_pair`).
+pub(crate) fn per_key(rows: &[[f32; 4]]) -> Vec<[f32; KEY_STRIDE]> {
+    let n = rows.len() - 1;
+    let mut out: Vec<[f32; KEY_STRIDE]> = (0..n)
+        .map(|k| {
+            let p = if k < n - 1 {
+                rows[k + 1][0]
+            } else {
+                rows[n][0]
+            };
+            let to = if k < n - 1 { rows[k + 1][2] } else { 0.0 };
+            let ti = if k > 0 { rows[k][3] } else { 0.0 };
+            [p, to, ti]
+        })
+        .collect();
+    // The sentinels are read only through the fixed rows of `grid.rs` (hold,
+    // reset, line, at the last key), whose zeros must not meet an infinite
+    // tangent (a key whose parameters overflow f32): there, 0 * inf would
+    // be NaN where the reference returns the key, or zero.
+    let finite = |x: f32| {
+        if x.is_nan() {
+            0.0
+        } else {
+            x.clamp(-f32::MAX, f32::MAX)
+        }
+    };
+    for r in [rows[0], rows[n]].map(|r| r.map(finite)) {
+        out.push([r[0], r[2], 0.0]);
+        out.push([r[1], 0.0, r[3]]);
     }
+    out
 }
 
 /// The numbers, in f32 or in 16 bits.

@@ -211,10 +211,7 @@ fn quantizing_extreme_ranges() {
     .expect("one track");
     let c = Arc::new(Clip::compile_with(
         &src,
-        &CompileOptions {
-            quantize: true,
-            ..Default::default()
-        },
+        &CompileOptions::default().quantize(true),
     ));
     let id = c.track("v").unwrap();
     let mut i = Instance::new(c);

@@ -655,10 +655,7 @@ fn cmu_capture_in_both_rotation_modes() {
         let mut inst = Instance::new(compiled).with_velocities();
         // With `exact_velocities`, every velocity within 1e-5 of the
         // reference's, per component (the contract's check).
-        let options = tcb_runtime::CompileOptions {
-            exact_velocities: true,
-            ..Default::default()
-        };
+        let options = tcb_runtime::CompileOptions::default().exact_velocities(true);
         let mut exact = Instance::new(Arc::new(Clip::compile_with(&clip, &options)));
         exact = exact.with_velocities();
         let n = clip.channel_count();
@@ -1129,10 +1126,7 @@ fn batch_equals_sequential() {
 /// ease and channel count; and the bound is not vacuous.
 #[test]
 fn quantized_clips_stay_within_their_stated_bound() {
-    let options = tcb_runtime::CompileOptions {
-        quantize: true,
-        ..Default::default()
-    };
+    let options = tcb_runtime::CompileOptions::default().quantize(true);
     let mut bounded = 0;
     for (seed, channels) in (0..60u64).zip([0, 1, 7, 8, 9, 63, 64, 65].into_iter().cycle()) {
         let clip = random_clip(seed + 1000, channels);
@@ -1193,10 +1187,7 @@ fn quantized_clips_stay_within_their_stated_bound() {
 /// random access (a fresh instance per time), bit for bit.
 #[test]
 fn quantized_forward_playback_equals_random_access() {
-    let options = tcb_runtime::CompileOptions {
-        quantize: true,
-        ..Default::default()
-    };
+    let options = tcb_runtime::CompileOptions::default().quantize(true);
     for seed in 0..20u64 {
         let clip = random_clip(seed + 77, 9 + seed as usize);
         let small = Arc::new(Clip::compile_with(&clip, &options));

@@ -59,10 +59,7 @@ fn steady_playback_and_blending_allocate_nothing() {
     ] {
         let clip = tcb_io::load_clip(format!("{root}/{name}").as_ref()).unwrap();
         clips.push(Arc::new(tcb_runtime::Clip::compile(&clip)));
-        let quantize = tcb_runtime::CompileOptions {
-            quantize: true,
-            ..Default::default()
-        };
+        let quantize = tcb_runtime::CompileOptions::default().quantize(true);
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
     }
     // A packed clip (decoded as playback crosses keys, seeks included).

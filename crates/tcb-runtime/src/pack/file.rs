@@ -8,15 +8,13 @@
 //! fields can describe (so what it allocates grows with the file, not with
 //! what the file claims).
 
-use super::{PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, check_block, err};
+use super::{
+    MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, VERSION, check_block, err,
+};
 use tcb_core::TrackKind;
 use tcb_core::TrackSettings;
 use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
 
-/// The first 8 bytes of a `.tcbc` file.
-pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
 const HEADER: usize = 24;
 const KINDS: [TrackKind; 5] = [
     TrackKind::Scalar,

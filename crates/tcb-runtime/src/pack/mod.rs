@@ -135,7 +135,7 @@ impl fmt::Display for PackError {
 
 impl std::error::Error for PackError {}
 
-fn err<T>(msg: impl Into<String>) -> Result<T, PackError> {
+pub(crate) fn err<T>(msg: impl Into<String>) -> Result<T, PackError> {
     Err(PackError(msg.into()))
 }
 
@@ -882,7 +882,10 @@ impl Packed {
     }
 }
 
-mod compile;
+/// The first 8 bytes of a `.tcbc` file.
+pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
+/// The format version this build writes and reads.
+pub const VERSION: u32 = 1;
+
 mod file;
-pub use file::{MAGIC, VERSION};
 pub(crate) mod store;

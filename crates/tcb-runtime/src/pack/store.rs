@@ -18,7 +18,7 @@
 //! kernel normalizes the curve it plays).
 
 use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
-use crate::store::Segment;
+use crate::segment::Segment;
 use std::sync::Arc;
 use wide::{f32x8, i32x8};
 

@@ -2,10 +2,10 @@
 //! group, then its controls replaced by the packed stream, checked segment
 //! by segment to give the same bits.
 
-use super::store::PackedKeys;
-use super::{PackError, Packed};
-use crate::clip::{Clip, CompileOptions, key_pair};
-use crate::pack::err;
+use super::{CompileOptions, compile_impl};
+use crate::clip::Clip;
+use crate::pack::store::PackedKeys;
+use crate::pack::{PackError, PackSource, Packed, err, key_weights};
 use std::sync::Arc;
 use tcb_core::TrackKind;
 use wide::f32x8;
@@ -21,9 +21,9 @@ impl Clip {
     }
 
     /// [`from_packed`](Self::from_packed) given `packed`'s decoded integers.
-    fn from_decoded(packed: Arc<Packed>, source: &super::PackSource) -> Result<Clip, PackError> {
+    fn from_decoded(packed: Arc<Packed>, source: &PackSource) -> Result<Clip, PackError> {
         let reference = source.to_clip()?;
-        let mut clip = Clip::compile_impl(&reference, &CompileOptions::default(), true);
+        let mut clip = compile_impl(&reference, &CompileOptions::default(), true);
         if clip.groups.len() != 1 {
             return err(format!(
                 "a packed clip compiles to one group, not {}",
@@ -42,7 +42,7 @@ impl Clip {
         for (t, slot) in source.tracks.iter().zip(clip.layout.tracks()) {
             // Every interior key's weights are key 1's (`PackSource::validate`).
             let w = if n > 2 {
-                super::key_weights(&times, t, 1)
+                key_weights(&times, t, 1)
             } else {
                 [0.0; 4]
             };
@@ -90,7 +90,7 @@ impl Clip {
         let mut cache = keys.cache();
         let mut f32_cache = g.keys.cache();
         for seg in 0..=n {
-            let (a, b) = key_pair(&g.grid, seg);
+            let (a, b) = g.grid.key_pair(seg);
             let want = g.keys.segment(a, b, &mut f32_cache);
             let got = keys.segment(a, b, &mut cache);
             let pairs = [
@@ -147,16 +147,5 @@ impl Clip {
         // The file's check decodes every key: compile from those.
         let (packed, source) = Packed::read(bytes)?;
         Clip::from_decoded(Arc::new(packed), &source)
-    }
-
-    /// The `.tcbc` bytes of a clip compiled from a packed one; `None` for
-    /// others (compile them with `tcb compress` first).
-    pub fn to_bytes(&self) -> Option<Vec<u8>> {
-        self.packed.as_ref().map(|p| p.to_bytes())
-    }
-
-    /// The packed clip this clip was compiled from, if any.
-    pub fn packed(&self) -> Option<&Arc<Packed>> {
-        self.packed.as_ref()
     }
 }
