@@ -214,6 +214,11 @@ pub fn compress(
             "the packed clip does not read back from its bytes".into(),
         ));
     }
+    // The runtime plays its keys as the reference compiles them, bit for
+    // bit (a loader does not decode them all to check it).
+    tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
+        .and_then(|c| c.verify_packed())
+        .map_err(|e| ReduceError::Build(e.to_string()))?;
     let bytes = file.len();
     let values = packed.head().keys * packed.head().lanes();
     Ok(Compressed {

@@ -54,6 +54,7 @@ fn plays_its_reference(source: &PackSource, block: usize) {
     let packed = Arc::new(Packed::encode_with(source, block).unwrap());
     assert_eq!(packed.block_keys(), block);
     let clip = Arc::new(Clip::from_packed(packed.clone()).unwrap());
+    clip.verify_packed().unwrap();
     let reference = Arc::new(Clip::compile(&source.to_clip().unwrap()));
     let n = clip.channel_count();
     let (mut a, mut b) = (
@@ -98,6 +99,7 @@ fn file_round_trip() {
     assert_eq!(back, packed);
     assert_eq!(back.decode().unwrap(), source);
     let clip = Clip::from_bytes(&bytes).unwrap();
+    clip.verify_packed().unwrap();
     assert_eq!(clip.to_bytes().unwrap(), bytes);
     assert!(
         Clip::compile(&source.to_clip().unwrap())
@@ -182,7 +184,7 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();
     Packed::from_bytes(&bytes).unwrap();
-    Clip::from_bytes(&bytes).unwrap();
+    Clip::from_bytes(&bytes).unwrap().verify_packed().unwrap();
     source.tracks.clear();
     let e = Packed::encode(&source).unwrap_err().to_string();
     assert!(e.contains("no tracks"), "{e}");

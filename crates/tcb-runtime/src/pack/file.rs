@@ -159,12 +159,17 @@ impl Packed {
     /// checked, and the stream decoded once to validate it. Errors are one
     /// line naming what is wrong.
     pub fn from_bytes(bytes: &[u8]) -> Result<Packed, PackError> {
-        Packed::read(bytes).map(|(packed, _)| packed)
+        let packed = Packed::read(bytes)?;
+        packed.decode()?;
+        Ok(packed)
     }
 
-    /// [`from_bytes`](Self::from_bytes) and the integers its check decoded
-    /// (so that a loader decodes once).
-    pub(crate) fn read(bytes: &[u8]) -> Result<(Packed, PackSource), PackError> {
+    /// [`from_bytes`](Self::from_bytes) without decoding the stream: the
+    /// header, checksum, lengths, settings and the stream's structure
+    /// ([`Packed::check_structure`]) checked, not the integers (what
+    /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
+    /// decoding every key takes a few).
+    pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
         if bytes.len() < HEADER || bytes[..8] != MAGIC {
             return err("not a .tcbc file (no TCBC magic number)");
         }
@@ -305,7 +310,8 @@ impl Packed {
             stream_len: len,
             note,
         };
-        let source = packed.decode()?;
-        Ok((packed, source))
+        packed.head.validate_head()?;
+        packed.check_structure()?;
+        Ok(packed)
     }
 }

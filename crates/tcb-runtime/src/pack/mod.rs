@@ -29,6 +29,7 @@
 //! the reference compiles to.
 
 use std::fmt;
+use std::ops::Range;
 use tcb_core::params::{Hemisphere, RotationMode, TangentRule, Tcb};
 use tcb_core::{
     Clip as SourceClip, KeyParams, NamedTrack, RotationTrack, Track, TrackData, TrackKind,
@@ -47,10 +48,11 @@ pub const SEGMENT_KEYS: usize = 16;
 const WIDTH_BITS: u32 = 5;
 /// The largest integer magnitude (f32 holds every integer below 2^24).
 pub const MAX_INT: i32 = 1 << 24;
-/// The most keys over all tracks a packed clip may hold: loading compiles
-/// the reference in full (about 50 bytes a key and component), so this
-/// bounds what a small file of constant tracks can make a loader allocate
-/// (CMU 01_01 has 88,064).
+/// The most keys over all tracks a packed clip may hold: decoding in full
+/// ([`Packed::from_bytes`], `Clip::verify_packed`, about 50 bytes a key and
+/// component with the reference compiled) allocates in proportion to them,
+/// so this bounds what a small file of constant tracks can make a reader
+/// allocate (CMU 01_01 has 88,064). Loading allocates the grid's times.
 pub const MAX_TRACK_KEYS: usize = 1 << 22;
 
 /// A clip in integers: one even grid of `keys` key times from `start`,
@@ -165,6 +167,31 @@ impl PackSource {
 
     /// Check what the format and the runtime need (see the field docs).
     pub fn validate(&self) -> Result<(), PackError> {
+        self.validate_head()?;
+        for t in &self.tracks {
+            let at = |m: String| err(format!("track {}: {m}", t.name));
+            if t.values.len() != t.stored() {
+                return at(format!(
+                    "{} components given, {} stored",
+                    t.values.len(),
+                    t.stored()
+                ));
+            }
+            for v in &t.values {
+                if v.len() != self.keys {
+                    return at(format!("{} values, not {}", v.len(), self.keys));
+                }
+                if let Some(x) = v.iter().find(|x| x.unsigned_abs() >= MAX_INT as u32) {
+                    return at(format!("integer {x} is outside +-2^24"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// [`validate`](Self::validate) but for the integers: the grid, the
+    /// tracks' settings, steps and weights.
+    pub(crate) fn validate_head(&self) -> Result<(), PackError> {
         if self.tracks.is_empty() {
             return err("a packed clip with no tracks");
         }
@@ -195,7 +222,7 @@ impl PackSource {
             .tracks
             .first()
             .map(|t| (t.settings.pre, t.settings.post));
-        let times = self.times();
+        let intervals = Intervals::of(&self.times());
         for t in &self.tracks {
             let at = |m: String| err(format!("track {}: {m}", t.name));
             if t.kind == TrackKind::Quat {
@@ -220,26 +247,11 @@ impl PackSource {
             if !t.tcb.is_finite() {
                 return at("tension, continuity and bias must be finite".into());
             }
-            if let Some(k) = uneven_weights(&times, t) {
+            if let Some(k) = intervals.uneven_weights(t) {
                 return at(format!(
                     "the key times' f64 differences vary (at key {k}: {} s from {}), so the tangent rule's weights would differ from key to key; start nearer 0, or use the uniform rule",
                     self.interval, self.start
                 ));
-            }
-            if t.values.len() != t.stored() {
-                return at(format!(
-                    "{} components given, {} stored",
-                    t.values.len(),
-                    t.stored()
-                ));
-            }
-            for v in &t.values {
-                if v.len() != self.keys {
-                    return at(format!("{} values, not {}", v.len(), self.keys));
-                }
-                if let Some(x) = v.iter().find(|x| x.unsigned_abs() >= MAX_INT as u32) {
-                    return at(format!("integer {x} is outside +-2^24"));
-                }
             }
         }
         Ok(())
@@ -250,12 +262,19 @@ impl PackSource {
     /// decoded keys are checked against).
     pub fn to_clip(&self) -> Result<SourceClip, PackError> {
         self.validate()?;
-        let times = self.times();
+        self.reference(&self.times())
+    }
+
+    /// The reference on keys at `times` (the values' keys, in order): all
+    /// of them for [`to_clip`](Self::to_clip), or a few (a loader's, see
+    /// `crate::compile`).
+    pub(crate) fn reference(&self, times: &[f64]) -> Result<SourceClip, PackError> {
         let mut tracks = Vec::with_capacity(self.tracks.len());
         for t in &self.tracks {
-            let vals: Vec<[f32; 4]> = (0..self.keys).map(|k| t.value(k)).collect();
+            let (s, n) = (&t.settings, times.len());
+            let vals: Vec<[f32; 4]> = (0..n).map(|k| t.value(k)).collect();
             let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", t.name));
-            let (s, n) = (&t.settings, self.keys);
+            let times = times.to_vec();
             let data = match t.kind {
                 TrackKind::Scalar => {
                     let v = vals.iter().map(|v| v[0]).collect();
@@ -503,8 +522,12 @@ pub(crate) fn check_block(block: usize) -> Result<(), PackError> {
 /// The tangent rule's chord weights of `t` at key `k` of `times`, rounded to
 /// f32 as `tcb_core::Vector::scale` rounds them: `[in_a, in_b, out_a, out_b]`.
 pub(crate) fn key_weights(times: &[f64], t: &PackTrack, k: usize) -> [f32; 4] {
+    chord_weights(t, times[k] - times[k - 1], times[k + 1] - times[k])
+}
+
+/// [`key_weights`] of a key between intervals `d_in` and `d_out`.
+fn chord_weights(t: &PackTrack, d_in: f64, d_out: f64) -> [f32; 4] {
     use tcb_core::tangent::ChordWeights;
-    let (d_in, d_out) = (times[k] - times[k - 1], times[k + 1] - times[k]);
     let s = &t.settings;
     let cw = if s.continuity_fade {
         ChordWeights::with_continuity_fade(s.tangent_rule, t.tcb, d_in, d_out)
@@ -514,16 +537,41 @@ pub(crate) fn key_weights(times: &[f64], t: &PackTrack, k: usize) -> [f32; 4] {
     [cw.in_a, cw.in_b, cw.out_a, cw.out_b].map(|x| x as f32)
 }
 
-/// The first interior key whose weights differ from key 1's (times far
-/// from 0 for their interval make the f64 intervals differ in their last
-/// bits, and every rule but `uniform` weighs by them), or `None`.
-fn uneven_weights(times: &[f64], t: &PackTrack) -> Option<usize> {
-    let n = times.len();
-    if n < 4 || t.settings.tangent_rule == TangentRule::Uniform {
-        return None;
+/// The distinct `(d_in, d_out)` pairs of a grid's interior keys (their f64
+/// intervals differ in their last bits far from 0), each with the first key
+/// that has it: a track's weights are checked once per pair, not per key.
+struct Intervals {
+    /// `(d_in, d_out, first key)`, key 1's first.
+    pairs: Vec<(f64, f64, usize)>,
+}
+
+impl Intervals {
+    fn of(times: &[f64]) -> Intervals {
+        let mut seen = std::collections::HashMap::new();
+        let mut pairs = Vec::new();
+        for k in 1..times.len().saturating_sub(1) {
+            let (d_in, d_out) = (times[k] - times[k - 1], times[k + 1] - times[k]);
+            seen.entry((d_in.to_bits(), d_out.to_bits()))
+                .or_insert_with(|| {
+                    pairs.push((d_in, d_out, k));
+                });
+        }
+        Intervals { pairs }
     }
-    let first = key_weights(times, t, 1);
-    (2..n - 1).find(|&k| key_weights(times, t, k) != first)
+
+    /// The first interior key whose weights differ from key 1's (every rule
+    /// but `uniform` weighs by the intervals), or `None`.
+    fn uneven_weights(&self, t: &PackTrack) -> Option<usize> {
+        if t.settings.tangent_rule == TangentRule::Uniform {
+            return None;
+        }
+        let (&(d_in, d_out, _), rest) = self.pairs.split_first()?;
+        let first = chord_weights(t, d_in, d_out);
+        rest.iter()
+            .filter(|(i, o, _)| chord_weights(t, *i, *o) != first)
+            .map(|p| p.2)
+            .min()
+    }
 }
 
 /// `n` keys with `tcb` (none: the defaults).
@@ -590,14 +638,13 @@ pub(crate) fn window(words: &[u64], pos: usize) -> u64 {
 /// Bytes (little-endian, padded with zeros) as words, plus two words of
 /// padding.
 pub(crate) fn to_words(bytes: &[u8]) -> Vec<u64> {
-    let mut words: Vec<u64> = bytes
-        .chunks(8)
-        .map(|c| {
-            let mut b = [0u8; 8];
-            b[..c.len()].copy_from_slice(c);
-            u64::from_le_bytes(b)
-        })
-        .collect();
+    // Sized once: the stream is the largest thing a loader allocates.
+    let mut words = Vec::with_capacity(bytes.len().div_ceil(8) + 2);
+    words.extend(bytes.chunks(8).map(|c| {
+        let mut b = [0u8; 8];
+        b[..c.len()].copy_from_slice(c);
+        u64::from_le_bytes(b)
+    }));
     words.extend([0, 0]);
     words
 }
@@ -781,34 +828,106 @@ impl Packed {
     /// file read: every width, length and integer is validated).
     pub fn decode(&self) -> Result<PackSource, PackError> {
         let n = self.head.keys;
+        let mut x: Vec<Vec<i32>> = (0..self.abs_bits.len())
+            .map(|_| Vec::with_capacity(n))
+            .collect();
+        self.walk(0..self.segments(), Some(&mut x))?;
+        let mut source = self.head.clone();
+        let mut lanes = x.into_iter();
+        for t in &mut source.tracks {
+            t.values = lanes.by_ref().take(t.stored()).collect();
+        }
+        source.validate()?;
+        Ok(source)
+    }
+
+    /// Check the stream's structure without decoding a key: every
+    /// segment's headers (widths in range, a block's first segment with
+    /// absolute widths) and its length in bits against the segment table.
+    /// What a reader needs for the runtime never to read past the stream or
+    /// take a width of 32 bits or more; the integers themselves are
+    /// [`decode`](Self::decode)'s to check.
+    pub(crate) fn check_structure(&self) -> Result<(), PackError> {
+        self.walk(0..self.segments(), None)
+    }
+
+    /// Segments of the stream (16 keys each, the last maybe fewer).
+    fn segments(&self) -> usize {
+        self.head.keys.div_ceil(SEGMENT_KEYS)
+    }
+
+    /// The integers of keys `at` (ascending): per stored lane, one per key
+    /// of `at`, decoding only the segments that hold them (from their
+    /// block's start).
+    pub(crate) fn decode_keys(&self, at: &[usize]) -> Result<Vec<Vec<i32>>, PackError> {
         let lanes = self.abs_bits.len();
-        let mut x: Vec<Vec<i32>> = (0..lanes).map(|_| Vec::with_capacity(n)).collect();
+        let mut out: Vec<Vec<i32>> = vec![Vec::with_capacity(at.len()); lanes];
+        let mut x: Vec<Vec<i32>> = vec![Vec::new(); lanes];
+        let mut from = usize::MAX; // first key decoded into `x`
+        for &k in at {
+            if k >= self.head.keys {
+                return err(format!("key {k} of {}", self.head.keys));
+            }
+            let have = from <= k && k < from + x[0].len();
+            if !have {
+                let first = k / self.block * self.block;
+                let last_seg = k / SEGMENT_KEYS;
+                x.iter_mut().for_each(Vec::clear);
+                self.walk(first / SEGMENT_KEYS..last_seg + 1, Some(&mut x))?;
+                from = first;
+            }
+            for (o, xl) in out.iter_mut().zip(&x) {
+                o.push(xl[k - from]);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Walk segments `segs` of the stream (the first at a block's start),
+    /// checking each one's headers and length against the segment table;
+    /// with `x`, decoding their keys into it (per lane, from the first
+    /// segment's first key), else stepping over them.
+    fn walk(&self, segs: Range<usize>, mut x: Option<&mut [Vec<i32>]>) -> Result<(), PackError> {
+        let n = self.head.keys;
+        let lanes = self.abs_bits.len();
+        let first_key = segs.start * SEGMENT_KEYS;
+        debug_assert!(first_key.is_multiple_of(self.block));
         let mut widths = vec![0u32; lanes];
         let mut orders = vec![2u32; lanes];
         let bits = self.stream_len * 8;
-        let mut pos = 0usize;
+        // From the table's entry, but the stream's first segment from bit 0.
+        let mut pos = if segs.start == 0 {
+            0
+        } else {
+            self.seg_at[segs.start] as usize
+        };
+        fn ends_early<T>() -> Result<T, PackError> {
+            err("the packed stream ends early")
+        }
         let take = |pos: &mut usize, w: u32| -> Result<u32, PackError> {
             if *pos + w as usize > bits {
-                return err("the packed stream ends early");
+                return ends_early();
             }
             let v = read_bits(&self.stream, *pos, w);
             *pos += w as usize;
             Ok(v)
         };
-        for (j, s) in (0..n).step_by(SEGMENT_KEYS).enumerate() {
+        for j in segs.clone() {
+            let s = j * SEGMENT_KEYS;
             if pos != self.seg_at[j] as usize {
                 return err(format!(
                     "segment {j} starts at bit {pos}, the table says {}",
                     self.seg_at[j]
                 ));
             }
+            let block_start = s.is_multiple_of(self.block);
             for (wd, order) in widths.iter_mut().zip(orders.iter_mut()) {
                 if pos > bits {
-                    return err("the packed stream ends early");
+                    return ends_early();
                 }
-                let before = if s % self.block == 0 { 0 } else { *wd };
+                let before = if block_start { 0 } else { *wd };
                 let (o, w, used) = read_header(&self.stream, pos, before);
-                if s % self.block == 0 && used != 3 + WIDTH_BITS as usize {
+                if block_start && used != 3 + WIDTH_BITS as usize {
                     return err(format!("segment {j} starts a block with a relative width"));
                 }
                 if w >= 1 << WIDTH_BITS {
@@ -817,18 +936,32 @@ impl Packed {
                 (*order, *wd) = (o, w);
                 pos += used;
                 if pos > bits {
-                    return err("the packed stream ends early");
+                    return ends_early();
                 }
             }
             let end = (s + SEGMENT_KEYS).min(n);
-            if s % self.block == 0 {
+            // Keys of the segment coded as residuals (not a block's first two).
+            let rows = (s..end).filter(|k| k % self.block >= 2).count();
+            let Some(x) = x.as_deref_mut() else {
+                let mut skip = widths.iter().map(|w| *w as usize * rows).sum::<usize>();
+                if block_start {
+                    let sum = |b: &[u8]| b.iter().map(|b| usize::from(*b)).sum::<usize>();
+                    skip += sum(&self.abs_bits) + sum(&self.delta_bits);
+                }
+                pos += skip;
+                if pos > bits {
+                    return ends_early();
+                }
+                continue;
+            };
+            if block_start {
                 for (l, xl) in x.iter_mut().enumerate() {
                     xl.push(unzigzag(take(&mut pos, u32::from(self.abs_bits[l]))?));
                 }
                 for (l, xl) in x.iter_mut().enumerate() {
                     let d = unzigzag(take(&mut pos, u32::from(self.delta_bits[l]))?);
                     if s + 1 < n {
-                        let v = xl[s].wrapping_add(d);
+                        let v = xl[s - first_key].wrapping_add(d);
                         xl.push(v);
                     }
                 }
@@ -839,26 +972,21 @@ impl Packed {
                         continue;
                     }
                     let r = unzigzag(take(&mut pos, widths[l])?);
+                    let i = k - first_key;
                     let trend = if orders[l] == 2 {
-                        xl[k - 1].wrapping_sub(xl[k - 2])
+                        xl[i - 1].wrapping_sub(xl[i - 2])
                     } else {
                         0
                     };
-                    let v = xl[k - 1].wrapping_add(trend).wrapping_add(r);
+                    let v = xl[i - 1].wrapping_add(trend).wrapping_add(r);
                     xl.push(v);
                 }
             }
         }
-        if pos != *self.seg_at.last().expect("segments + 1 entries") as usize {
+        if pos != self.seg_at[segs.end] as usize {
             return err("the packed stream's length disagrees with its table");
         }
-        let mut source = self.head.clone();
-        let mut lanes = x.into_iter();
-        for t in &mut source.tracks {
-            t.values = lanes.by_ref().take(t.stored()).collect();
-        }
-        source.validate()?;
-        Ok(source)
+        Ok(())
     }
 
     /// Keys per block (a seek decodes up to this many less one).
