@@ -9,6 +9,7 @@
 //! cargo run --release -p tcb-bench -- --quick            # a first look, under 10 s
 //! cargo run --release -p tcb-bench                       # the full report
 //! cargo run --release -p tcb-bench -- --save-baseline before   # then --baseline before
+//! cargo run --release -p tcb-bench -- --markdown docs/benchmarks.md   # this machine's current table
 //! cargo run --release -p tcb-bench -- --icount --icount-check benches/icount.json   # the gate
 //! ```
 //!
@@ -19,7 +20,9 @@
 
 pub mod baseline;
 pub mod icount;
+pub mod markdown;
 pub mod measure;
+pub mod noise;
 pub mod peer;
 pub mod report;
 pub mod scenarios;

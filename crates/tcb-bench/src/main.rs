@@ -2,7 +2,11 @@
 //! on the bundled real data. `--json PATH` or `--save-baseline NAME` saves
 //! it with the machine's fingerprint; `--check PATH` or `--baseline NAME`
 //! compares with a saved one and exits 1 when bytes grew, or (same machine
-//! and build only) a ratio fell by more than `--max-regression` percent.
+//! and build only) the runtime got slower beyond the noise its rounds
+//! measured and by more than `--max-regression` percent, in its own time
+//! and against the scalar baseline's in the same rounds (`report::check`).
+//! `--markdown FILE` writes this machine's table into a markdown document
+//! (`docs/benchmarks.md`; [`tcb_bench::markdown`]).
 //! `--icount` counts instructions under callgrind instead: the CI gate.
 
 #![forbid(unsafe_code)]
@@ -11,7 +15,7 @@ use clap::Parser;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
-use tcb_bench::{icount, report, scenarios};
+use tcb_bench::{icount, markdown, report, scenarios};
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +31,12 @@ struct Args {
     /// Write the report as JSON here too (with the machine fingerprint).
     #[arg(long, value_name = "PATH")]
     json: Option<PathBuf>,
+    /// Put this machine's and build's table (dated, with the command) into
+    /// this markdown file, between its "tcb-bench --markdown" comment
+    /// lines, replacing the table of the same machine and build and
+    /// keeping the others and the rest of the file (created if missing).
+    #[arg(long, value_name = "FILE.md", conflicts_with = "icount")]
+    markdown: Option<PathBuf>,
     /// Save the report as a named baseline of this machine
     /// (target/tcb-bench/NAME.json), to compare later runs with.
     #[arg(long, value_name = "NAME")]
@@ -37,7 +47,9 @@ struct Args {
     /// Compare with a saved JSON report (--json); exit 1 on a regression.
     #[arg(long, value_name = "BASELINE.json")]
     check: Option<PathBuf>,
-    /// Largest allowed fall of a same-machine ratio, percent.
+    /// Against a same-machine baseline: the smallest slowdown of the
+    /// runtime reported as a regression, percent (it must also exceed 3
+    /// MADs of the rounds, in its own time and over the scalar baseline's).
     #[arg(long, value_name = "PCT", default_value_t = 10.0)]
     max_regression: f64,
     /// The motion-capture file for character, crowd and seek.
@@ -274,9 +286,19 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         (None, None) => None,
     };
     let saved = read_json(compare.as_deref())?;
+    // And the markdown file, for the same reason.
+    let markdown_doc = match &args.markdown {
+        Some(p) if p.exists() => {
+            let doc = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            markdown::check(&doc, &p.display().to_string())?;
+            Some(doc)
+        }
+        _ => None,
+    };
     if cfg!(debug_assertions) {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
+    let load = markdown::load_average();
     let names: Option<Vec<&str>> = args
         .only
         .as_ref()
@@ -321,6 +343,22 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         tcb_io::write_atomically(path, text.as_bytes())?;
+    }
+    if let Some(path) = &args.markdown {
+        let argv: Vec<String> = std::env::args().skip(1).collect();
+        let command = markdown::command(
+            env!("TCB_BENCH_RUSTFLAGS"),
+            env!("TCB_BENCH_PROFILE"),
+            &argv,
+        );
+        let table = markdown::table(&rows, &here, &timing, &command, &report::today(), load);
+        let doc = markdown::update(markdown_doc.as_deref(), &table, &path.display().to_string())?;
+        tcb_io::write_atomically(path, doc.as_bytes())?;
+        println!(
+            "\nwrote \"{}\" into {}",
+            markdown::heading(&here).trim_start_matches("### "),
+            path.display()
+        );
     }
     if let (Some(name), Some(path)) = (&args.save_baseline, &save) {
         println!("\nsaved as baseline '{name}' ({})", path.display());

@@ -1,6 +1,7 @@
 //! Timing for the report: implementations measured round-robin in the same
 //! process, so that machine noise hits them alike and their ratios hold
-//! across machines; medians, not means.
+//! across machines; every round is kept, for medians and spreads
+//! ([`crate::noise`]).
 
 use std::time::{Duration, Instant};
 
@@ -14,9 +15,10 @@ pub struct Subject<'a> {
     pub run: Box<dyn FnMut() + 'a>,
 }
 
-/// Median seconds per pass of each subject: each is calibrated to about
-/// `slice` per timing, then `rounds` rounds time every subject once each.
-pub fn median_seconds(subjects: &mut [Subject], rounds: usize, slice: Duration) -> Vec<f64> {
+/// Seconds per pass of each subject in every round: each is calibrated to
+/// about `slice` per timing, then `rounds` rounds time every subject once
+/// each (so round `i` of two subjects ran back to back).
+pub fn rounds_seconds(subjects: &mut [Subject], rounds: usize, slice: Duration) -> Vec<Vec<f64>> {
     let mut iters = Vec::with_capacity(subjects.len());
     for s in subjects.iter_mut() {
         (s.run)(); // warm caches and cursors
@@ -39,19 +41,5 @@ pub fn median_seconds(subjects: &mut [Subject], rounds: usize, slice: Duration) 
             samples[i].push(start.elapsed().as_secs_f64() / iters[i] as f64);
         }
     }
-    samples.into_iter().map(median).collect()
-}
-
-/// The median (the mean of the middle two for an even count).
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
+    samples
 }

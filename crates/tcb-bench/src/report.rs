@@ -1,7 +1,8 @@
 //! The comparison report: measurement, table, JSON, targets and the
 //! regression check.
 
-use crate::measure::{Subject, median_seconds};
+use crate::measure::{Subject, rounds_seconds};
+use crate::noise::{self, Rule};
 use crate::scenarios::Scenario;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
@@ -169,8 +170,13 @@ pub struct Row {
     pub name: String,
     /// Values per sample.
     pub channels: usize,
-    /// ns per channel-sample: baseline, runtime, runtime_parallel, splines.
+    /// ns per channel-sample, the median of the rounds: baseline, runtime,
+    /// runtime_parallel, splines.
     pub ns: Vec<(&'static str, f64)>,
+    /// ns per channel-sample of every round, per column (round `i` of each
+    /// column timed back to back): the spreads, and the paired ratios of
+    /// [`check`].
+    pub rounds: Vec<(&'static str, Vec<f64>)>,
     /// Runtime vs baseline, per channel (both one thread).
     pub speedup_vs_baseline: f64,
     /// Runtime vs splines.
@@ -200,6 +206,14 @@ impl Row {
     /// ns per channel-sample of one column.
     pub fn ns_of(&self, name: &str) -> Option<f64> {
         self.ns.iter().find(|(n, _)| *n == name).map(|p| p.1)
+    }
+
+    /// ns per channel-sample of one column, every round.
+    pub fn rounds_of(&self, name: &str) -> Option<&[f64]> {
+        self.rounds
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|p| p.1.as_slice())
     }
 }
 
@@ -268,9 +282,11 @@ pub fn measure(s: &Scenario, timing: &Timing) -> Row {
             run: Box::new(s.read_pass()),
         });
     }
-    let secs = median_seconds(&mut subjects, timing.rounds, timing.slice);
+    let secs = rounds_seconds(&mut subjects, timing.rounds, timing.slice);
     for (sub, t) in subjects.iter().zip(&secs) {
-        row.ns.push((sub.name, t * 1e9 / sub.samples));
+        let ns: Vec<f64> = t.iter().map(|t| t * 1e9 / sub.samples).collect();
+        row.ns.push((sub.name, noise::median(&ns)));
+        row.rounds.push((sub.name, ns));
     }
     let rt = row.ns_of("runtime").expect("always timed");
     row.speedup_vs_baseline = row.ns_of("baseline").expect("always timed") / rt;
@@ -280,6 +296,7 @@ pub fn measure(s: &Scenario, timing: &Timing) -> Row {
     row.threads_speedup = row.ns_of("threads").map(|x| rt / x);
     row.ns_per_joint = s.joints.map(|j| rt * s.channels() as f64 / j as f64);
     row.ns.retain(|(n, _)| *n != "read_limit");
+    row.rounds.retain(|(n, _)| *n != "read_limit");
     row
 }
 
@@ -311,6 +328,12 @@ pub fn to_json(rows: &[Row], here: &Fingerprint, timing: &Timing) -> Value {
                     .map(|(n, v)| (n.to_string(), json!(v)))
                     .collect();
             m.insert("ns_per_channel".into(), Value::Object(ns));
+            let rounds: Map<String, Value> = r
+                .rounds
+                .iter()
+                .map(|(n, v)| (n.to_string(), json!(v)))
+                .collect();
+            m.insert("rounds_ns_per_channel".into(), Value::Object(rounds));
             m.insert("speedup_vs_baseline".into(), json!(r.speedup_vs_baseline));
             m.insert("bytes".into(), json!(r.bytes));
             if let Some(f) = r.file_bytes {
@@ -585,19 +608,60 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
     out
 }
 
+/// Spreads (MADs of the rounds) a same-machine slowdown must exceed
+/// ([`noise::Rule::k`]).
+pub const NOISE_K: f64 = 3.0;
+
+/// The rule [`check`] applies on one machine, in words.
+pub fn check_rule(max_regression: f64) -> String {
+    let rule = Rule {
+        k: NOISE_K,
+        min_rel: max_regression / 100.0,
+    };
+    format!(
+        "rule: REGRESSION when the runtime's median time per channel-sample and its time over the scalar baseline's (round by round) both rose {}",
+        rule.describe()
+    )
+}
+
+/// A column's rounds in a saved scenario (`rounds_ns_per_channel`), or
+/// its median alone (`ns_per_channel`) for a report saved without rounds.
+fn saved_rounds(s: &Value, column: &str) -> Option<(Vec<f64>, bool)> {
+    if let Some(r) = s
+        .get("rounds_ns_per_channel")
+        .and_then(|r| r.get(column))
+        .and_then(Value::as_array)
+    {
+        let v: Option<Vec<f64>> = r.iter().map(Value::as_f64).collect();
+        if let Some(v) = v.filter(|v| !v.is_empty()) {
+            return Some((v, true));
+        }
+    }
+    let m = s.get("ns_per_channel")?.get(column)?.as_f64()?;
+    Some((vec![m], false))
+}
+
+/// Runtime over baseline, round by round (both timed back to back).
+fn paired(runtime: &[f64], baseline: &[f64]) -> Vec<f64> {
+    runtime.iter().zip(baseline).map(|(r, b)| r / b).collect()
+}
+
 /// Compare this run with a saved report (`--check FILE` or `--baseline
 /// NAME`). Returns the lines to print and whether everything held.
 ///
 /// - Bytes are deterministic: any growth fails, on any machine.
-/// - Ratios measured in one run (`speedup_vs_baseline`,
-///   `read_limit_fraction`, `speedup_vs_dense`) fail when one fell by more
-///   than `max_regression` percent, but only against a report with this
-///   machine's [`Fingerprint`]: the two sides of a ratio use the memory
-///   system and the vector units differently, so ratios move across CPUs
-///   (an Intel Xeon's `wide` ratio was 299x, an AMD EPYC's 1951x).
-/// - Runtime times are shown against a same-fingerprint report, as
-///   information: wall clock on a shared machine is too noisy to gate on
-///   (the instruction counts of `--icount` are the gate).
+/// - Times are compared only against a report with this machine's
+///   [`Fingerprint`], and by the noise they measured ([`noise::compare`]:
+///   the medians of the rounds must differ by more than [`NOISE_K`] MADs
+///   and by more than `max_regression` percent). A scenario regressed when
+///   its runtime is slower by that rule both in its own time and in its
+///   time over the scalar baseline's, round by round in the same rounds:
+///   a machine that got slower moves the first alone, a noisy baseline
+///   the second alone (issue 30: `--save-baseline X` then `--baseline X`
+///   on one tree reported `wide -35.1%`; the baseline had moved).
+/// - Other ratios (`read_limit_fraction`, `speedup_vs_dense`) are shown as
+///   information; across machines every ratio is (an Intel Xeon's `wide`
+///   ratio was 299x, an AMD EPYC's 1951x).
 pub fn check(
     rows: &[Row],
     saved: &Value,
@@ -618,7 +682,7 @@ pub fn check(
         && *then != now["timing"]
     {
         lines.push(format!(
-            "note: the saved report was timed differently ({then}; now {}): its ratios are less comparable",
+            "note: the saved report was timed differently ({then}; now {}): its times are less comparable",
             now["timing"]
         ));
     }
@@ -641,6 +705,14 @@ pub fn check(
             false
         }
     };
+    if same {
+        lines.push(check_rule(max_regression));
+    }
+    let rule = Rule {
+        k: NOISE_K,
+        min_rel: max_regression / 100.0,
+    };
+    let mut medians_only = false;
     for s in scenarios {
         let Some(name) = s.get("name").and_then(Value::as_str) else {
             continue;
@@ -652,6 +724,35 @@ pub fn check(
             ok = false;
             continue;
         };
+        let times = (
+            saved_rounds(s, "runtime"),
+            saved_rounds(s, "baseline"),
+            row.rounds_of("runtime"),
+            row.rounds_of("baseline"),
+        );
+        if same && let (Some((rt0, full0)), Some((bl0, full1)), Some(rt1), Some(bl1)) = times {
+            medians_only |= !(full0 && full1);
+            let own = noise::compare(&rt0, rt1, rule);
+            let rel = noise::compare(&paired(&rt0, &bl0), &paired(rt1, bl1), rule);
+            let bad = own.slower && rel.slower;
+            ok &= !bad;
+            let why = match (own.slower, rel.slower) {
+                (true, true) => "",
+                (true, false) => "; the baseline slowed alike: the machine, not the runtime",
+                (false, true) => "; the runtime's own time held: the baseline moved",
+                (false, false) => "",
+            };
+            lines.push(format!(
+                "{} {name} runtime: {:.3} -> {:.3} ns per channel-sample ({:+.1}%, MAD {:.3}); over the baseline, round by round: {:+.1}% (MAD {:.1}%){why}",
+                if bad { "REGRESSION" } else { "ok" },
+                own.old,
+                own.new,
+                own.change * 100.0,
+                own.spread,
+                rel.change * 100.0,
+                rel.spread / rel.old * 100.0,
+            ));
+        }
         for (key, now) in [
             ("speedup_vs_baseline", Some(row.speedup_vs_baseline)),
             ("read_limit_fraction", row.read_limit_fraction),
@@ -660,33 +761,11 @@ pub fn check(
             let (Some(then), Some(now)) = (s.get(key).and_then(Value::as_f64), now) else {
                 continue;
             };
-            let change = (now / then - 1.0) * 100.0;
-            let bad = same && change < -max_regression;
-            ok &= !bad;
-            let verdict = match (same, bad) {
-                (false, _) => "info",
-                (true, true) => "REGRESSION",
-                (true, false) => "ok",
-            };
+            if same && key == "speedup_vs_baseline" {
+                continue; // in the runtime's line above
+            }
             lines.push(format!(
-                "{verdict} {name} {key}: {then:.3} -> {now:.3} ({change:+.1}%{})",
-                if same {
-                    format!(", allowed -{max_regression}%")
-                } else {
-                    String::new()
-                }
-            ));
-        }
-        if same
-            && let (Some(then), Some(now)) = (
-                s.get("ns_per_channel")
-                    .and_then(|n| n.get("runtime"))
-                    .and_then(Value::as_f64),
-                row.ns_of("runtime"),
-            )
-        {
-            lines.push(format!(
-                "time {name} runtime: {then:.3} -> {now:.3} ns per channel-sample ({:+.1}%, wall clock: information only)",
+                "info {name} {key}: {then:.3} -> {now:.3} ({:+.1}%)",
                 (now / then - 1.0) * 100.0
             ));
         }
@@ -701,6 +780,11 @@ pub fn check(
             ));
         }
     }
+    if medians_only {
+        lines.push(
+            "note: the saved report has medians but no rounds (saved before rounds were): its times were compared by the threshold alone".into(),
+        );
+    }
     (lines, ok)
 }
 
@@ -708,14 +792,28 @@ pub fn check(
 mod tests {
     use super::*;
 
-    fn row(name: &str, speedup: f64) -> Row {
+    /// 11 rounds around `m`, scattered by 1%, in a fixed order.
+    fn rounds(m: f64) -> Vec<f64> {
+        [0.0, 1.0, -1.0, 0.5, -0.5, 2.0, -2.0, 0.2, -0.2, 3.0, -0.8]
+            .iter()
+            .map(|d| m * (1.0 + 0.01 * d))
+            .collect()
+    }
+
+    /// A scenario whose runtime takes `runtime` ns and baseline `baseline`.
+    fn timed(name: &str, runtime: f64, baseline: f64) -> Row {
         Row {
             name: name.into(),
-            speedup_vs_baseline: speedup,
-            ns: vec![("runtime", 1.0)],
+            speedup_vs_baseline: baseline / runtime,
+            ns: vec![("baseline", baseline), ("runtime", runtime)],
+            rounds: vec![("baseline", rounds(baseline)), ("runtime", rounds(runtime))],
             bytes: 1000,
             ..Row::default()
         }
+    }
+
+    fn row(name: &str, speedup: f64) -> Row {
+        timed(name, 1.0, speedup)
     }
 
     fn saved(rows: &[Row], fp: &Fingerprint) -> Value {
@@ -723,43 +821,82 @@ mod tests {
     }
 
     #[test]
-    fn check_flags_a_fall_beyond_the_allowance_only() {
+    fn check_flags_a_slower_runtime_beyond_the_noise_only() {
         let here = Fingerprint::here();
-        let file = saved(&[row("wide", 100.0), row("sparse", 4.0)], &here);
-        let (_, ok) = check(
-            &[row("wide", 91.0), row("sparse", 4.5)],
-            &file,
-            &here,
-            &Timing::FULL,
-            10.0,
+        let before = [timed("wide", 1.0, 300.0), timed("sparse", 4.0, 16.0)];
+        let file = saved(&before, &here);
+        let check_now = |rows: &[Row]| check(rows, &file, &here, &Timing::FULL, 10.0);
+        // The same tree, the same numbers: nothing to report.
+        let (lines, ok) = check_now(&before);
+        assert!(ok, "{lines:?}");
+        assert!(lines[0].starts_with("rule: "), "{lines:?}");
+        assert!(lines[0].contains("3 MADs of the rounds"), "{lines:?}");
+        // Issue 30: the ratio fell 35% because the baseline got faster; the
+        // runtime held. Not a regression, and the line says why.
+        let (lines, ok) = check_now(&[timed("wide", 1.0, 195.0), timed("sparse", 4.0, 16.0)]);
+        assert!(ok, "{lines:?}");
+        let wide = lines.iter().find(|l| l.contains("wide runtime")).unwrap();
+        assert!(
+            wide.starts_with("ok ") && wide.contains("baseline moved"),
+            "{wide}"
         );
-        assert!(ok);
-        let (lines, ok) = check(
-            &[row("wide", 89.0), row("sparse", 4.5)],
-            &file,
-            &here,
-            &Timing::FULL,
-            10.0,
+        // The whole machine 30% slower: both sides moved, the ratio held.
+        let (lines, ok) = check_now(&[timed("wide", 1.3, 390.0), timed("sparse", 4.0, 16.0)]);
+        assert!(ok, "{lines:?}");
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.contains("the machine, not the runtime"))
         );
+        // The runtime 30% slower, the baseline as it was: a regression.
+        let (lines, ok) = check_now(&[timed("wide", 1.3, 300.0), timed("sparse", 4.0, 16.0)]);
         assert!(!ok);
         assert!(
-            lines[0].starts_with("REGRESSION wide speedup_vs_baseline"),
+            lines
+                .iter()
+                .any(|l| l.starts_with("REGRESSION wide runtime")),
             "{lines:?}"
         );
+        // 8% slower is beyond 1% noise but under the 10% allowed.
+        let (_, ok) = check_now(&[timed("wide", 1.08, 300.0), timed("sparse", 4.0, 16.0)]);
+        assert!(ok);
         // A scenario that disappeared is a failure too.
-        let (_, ok) = check(&[row("wide", 100.0)], &file, &here, &Timing::FULL, 10.0);
+        let (_, ok) = check_now(&[timed("wide", 1.0, 300.0)]);
         assert!(!ok);
         let (_, ok) = check(&[], &serde_json::json!({}), &here, &Timing::FULL, 10.0);
         assert!(!ok);
         // A --quick run against a full one says so.
-        let (lines, _) = check(
-            &[row("wide", 100.0), row("sparse", 4.0)],
+        let (lines, _) = check(&before, &file, &here, &Timing::QUICK, 10.0);
+        assert!(lines[0].contains("timed differently"), "{lines:?}");
+    }
+
+    #[test]
+    fn a_report_saved_without_rounds_is_compared_by_the_threshold_alone() {
+        let here = Fingerprint::here();
+        let mut file = saved(&[timed("wide", 1.0, 300.0)], &here);
+        for s in file["scenarios"].as_array_mut().unwrap() {
+            s.as_object_mut().unwrap().remove("rounds_ns_per_channel");
+        }
+        let (lines, ok) = check(
+            &[timed("wide", 1.0, 300.0)],
             &file,
             &here,
-            &Timing::QUICK,
+            &Timing::FULL,
             10.0,
         );
-        assert!(lines[0].contains("timed differently"), "{lines:?}");
+        assert!(ok, "{lines:?}");
+        assert!(
+            lines.last().unwrap().contains("threshold alone"),
+            "{lines:?}"
+        );
+        let (_, ok) = check(
+            &[timed("wide", 1.2, 300.0)],
+            &file,
+            &here,
+            &Timing::FULL,
+            10.0,
+        );
+        assert!(!ok);
     }
 
     #[test]
@@ -782,6 +919,11 @@ mod tests {
             lines
                 .iter()
                 .any(|l| l.starts_with("info wide speedup_vs_baseline"))
+        );
+        // No times across machines.
+        assert!(
+            !lines.iter().any(|l| l.contains("wide runtime")),
+            "{lines:?}"
         );
         // Bytes still fail.
         let mut bigger = row("wide", 300.0);

@@ -87,8 +87,9 @@ struct PlotArgs {
     /// The SVG to write.
     #[arg(short, long, value_name = "OUT.svg")]
     output: PathBuf,
-    /// A track to draw (repeatable; default: every track if they have at
-    /// most 16 channels, else the first).
+    /// A track to draw (repeatable; default: of each kind, the first
+    /// tracks up to 16 channels). Each kind (vectors, rotations, scalars)
+    /// gets a panel; tracks the mode cannot draw are skipped, and named.
     #[arg(long, value_name = "NAME")]
     track: Vec<String>,
     /// Start of the time range, seconds (default: 15% of the keys' span
@@ -104,11 +105,13 @@ struct PlotArgs {
     /// The length of the velocity (rotations: angular speed, degrees/s).
     #[arg(long, conflicts_with_all = ["path", "components"])]
     speed: bool,
-    /// The 2D path of vector tracks, with keys, tangent handles and inbetweens.
+    /// The 2D path of vector tracks, with keys, tangent handles and
+    /// inbetweens (other tracks are skipped).
     #[arg(long)]
     path: bool,
     /// Rotations: the 4 components instead of angle and axis; with --path,
-    /// the two components to draw (default x,y).
+    /// the two components to draw (default x,y; for a rig, its ground
+    /// plane: x,z when Y is up).
     #[arg(long, value_name = "x,y", num_args = 0..=1, default_missing_value = "")]
     components: Option<String>,
     /// Inbetween dots per segment at equal time steps (default 8 with --path).
@@ -940,11 +943,16 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
     if args.inbetweens.is_some_and(|n| n > 1000) {
         return Err("--inbetweens must be at most 1000".into());
     }
+    let components = match args.components.as_deref() {
+        Some(c) if args.path && !c.is_empty() => Some(tcb_plot::parse_components(c)?),
+        _ => None,
+    };
+    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
+    let (clip, skeleton) = load_any(&args.clip, &options)?;
     let mode = if args.path {
-        let components = match args.components.as_deref() {
-            None | Some("") => [0, 1],
-            Some(c) => tcb_plot::parse_components(c)?,
-        };
+        // A rig's ground plane by default: x,z when Y is up.
+        let components =
+            components.unwrap_or_else(|| skeleton.as_ref().map_or([0, 1], tcb_plot::ground_plane));
         tcb_plot::Mode::Path { components }
     } else if args.velocity {
         tcb_plot::Mode::Velocity
@@ -955,19 +963,10 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
     } else {
         tcb_plot::Mode::Value
     };
-    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
-    let (clip, _) = load_any(&args.clip, &options)?;
     let file = args.clip.file_name().map_or_else(
         || args.clip.display().to_string(),
         |f| f.to_string_lossy().into_owned(),
     );
-    if args.track.is_empty() && clip.channel_count() > 16 {
-        eprintln!(
-            "tcb: plotting '{}' ({} tracks; choose others with --track)",
-            clip.tracks()[0].name,
-            clip.tracks().len()
-        );
-    }
     let plot = tcb_plot::Plot {
         tracks: args.track.clone(),
         from: args.from,
@@ -976,8 +975,11 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
         inbetweens: args.inbetweens,
         ..tcb_plot::Plot::new(file)
     };
-    let svg = tcb_plot::render(&clip, &plot)?;
-    tcb_io::write_atomically(&args.output, svg.as_bytes())?;
+    let drawn = tcb_plot::render_with_notes(&clip, &plot)?;
+    for note in &drawn.notes {
+        eprintln!("tcb: {note}");
+    }
+    tcb_io::write_atomically(&args.output, drawn.svg.as_bytes())?;
     eprintln!("tcb: wrote {}", args.output.display());
     Ok(())
 }

@@ -708,13 +708,9 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
             let _ = std::fs::remove_file(&out);
             let mut args = vec!["plot", input.as_str(), "-o", out.to_str().unwrap()];
             args.extend_from_slice(extra);
-            // Rotations and vectors are drawn apart: plot each kind alone.
+            // Any clip, any kind of track: each kind gets a panel.
             let o = tcb(&args);
-            let err = stderr(&o);
-            if !o.status.success() {
-                assert!(err.contains("separately"), "{input} {extra:?}: {err}");
-                continue;
-            }
+            assert!(o.status.success(), "{input} {extra:?}: {}", stderr(&o));
             let svg = std::fs::read_to_string(&out).unwrap();
             assert!(
                 svg.starts_with("<svg") && svg.contains("time (s)"),
@@ -782,6 +778,55 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn plot_draws_a_panel_per_kind_and_skips_what_path_cannot_draw_in_one_line() {
+    let dir = std::env::temp_dir().join(format!("tcb-cli-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("bounce.svg");
+    let plot = |input: &str, extra: &[&str]| {
+        let _ = std::fs::remove_file(&out);
+        let mut args = vec!["plot", input, "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = tcb(&args);
+        assert!(o.status.success(), "{input} {extra:?}: {}", stderr(&o));
+        (std::fs::read_to_string(&out).unwrap(), stderr(&o))
+    };
+    // bounce.json has a vector, a rotation and a scalar track.
+    let bounce = example("bounce.json");
+    for extra in [&[][..], &["--velocity"], &["--speed"]] {
+        let (svg, err) = plot(&bounce, extra);
+        for panel in ["vector tracks", "rotation tracks", "scalar tracks"] {
+            assert!(svg.contains(panel), "{extra:?}: no {panel}");
+        }
+        assert_eq!(err.lines().count(), 1, "{extra:?}: {err}");
+    }
+    // --path draws the vector track, and names what it skipped in one line.
+    let (svg, err) = plot(&bounce, &["--path"]);
+    assert!(svg.contains("ball.position") && !svg.contains("rotation tracks"));
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(
+        lines[0].starts_with("tcb: --path draws two components (x, y)")
+            && lines[0].ends_with("skipping 'ball.squash' (scalar), 'ball.rotation' (quat)"),
+        "{err}"
+    );
+    assert!(lines[1].starts_with("tcb: wrote "), "{err}");
+    // A Y-up rig's path is drawn on the ground: x and z.
+    let (svg, err) = plot(&data("cmu-01_01.bvh"), &["--path"]);
+    assert!(svg.contains("z (component z)"), "{err}");
+    assert!(err.contains("skipping 31 quat tracks"), "{err}");
+    let (svg, _) = plot(&data("cmu-01_01.bvh"), &["--path", "--components", "x,y"]);
+    assert!(svg.contains("y (component y)"));
+    // A big clip: the first tracks of each kind, said in one line.
+    let (svg, err) = plot(&data("cmu-01_01.bvh"), &[]);
+    assert!(svg.contains("vector tracks") && svg.contains("rotation tracks"));
+    assert!(
+        err.contains("plotting the first 4 of 31 rotation tracks (choose others with --track)"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

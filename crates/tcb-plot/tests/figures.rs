@@ -78,9 +78,15 @@ fn bad_requests_are_one_clear_line() {
         ..base()
     });
     assert!(e.contains("'x' is scalar"), "{e}");
-    let e = try_plot(base());
-    assert!(e.contains("rotations and vectors separately"), "{e}");
-    assert!(!e.contains('\n'));
+    let e = try_plot(tcb_plot::Plot {
+        tracks: vec!["x".into()],
+        mode: tcb_plot::Mode::Components,
+        ..base()
+    });
+    assert_eq!(
+        e,
+        "--components draws rotation tracks; 'x' is scalar (1 component)"
+    );
     assert!(tcb_plot::parse_components("x,x").is_err());
     assert_eq!(tcb_plot::parse_components("x,z").unwrap(), [0, 2]);
 }
