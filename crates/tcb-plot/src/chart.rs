@@ -2,8 +2,8 @@
 //! shaded regions on axes fitted to them, with its legend beside it.
 
 use crate::legend::{self, Entry, Glyph};
+use crate::plot::{PlotError, draw};
 use crate::sample::Point;
-use crate::{PlotError, draw};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -2,7 +2,8 @@
 //! clips committed under `examples/clips/` (`tcb figures -o DIR` writes
 //! them; a test checks they regenerate byte for byte).
 
-use crate::{Mode, Plot, PlotError, render};
+use crate::plot::{Mode, Plot, PlotError};
+use crate::render::render;
 use std::path::Path;
 
 /// One figure: its file name, the clip it comes from (relative to the

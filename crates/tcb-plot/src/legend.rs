@@ -1,7 +1,7 @@
 //! Legends in a column of their own beside the chart, so they never cover
 //! a curve (plotters draws its legend inside the plotting area).
 
-use crate::{PlotError, draw};
+use crate::plot::{PlotError, draw};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -4,9 +4,9 @@
 //! legends alike.
 
 use crate::chart::{Chart, Line, Marks};
+use crate::plot::{MAX_MARKED_KEYS, Mode, NAMES, Plot};
 use crate::sample::{Point, angle_axis, at, handles, sample_times, speed};
 use crate::select::{Kind, Panel};
-use crate::{MAX_MARKED_KEYS, Mode, NAMES, Plot};
 use tcb_core::{NamedTrack, TrackData};
 
 /// A panel's tracks over the figure's time range, and how to mark them.

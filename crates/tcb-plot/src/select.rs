@@ -2,7 +2,7 @@
 //! by default the first of each kind), less those the mode cannot draw,
 //! grouped by kind (vectors, rotations, scalars: one panel each).
 
-use crate::{Mode, NAMES, Plot, PlotError};
+use crate::plot::{Mode, NAMES, Plot, PlotError};
 use tcb_core::{Clip, NamedTrack, TrackKind};
 
 /// The kinds that share a panel: their values share units and a drawing.
