@@ -158,7 +158,8 @@ pub(crate) struct PackCache {
     first: usize,
     /// Per stream lane: its plane slot and this segment's width.
     reads: Vec<LaneRead>,
-    /// This segment's residuals: per plane lane, per key of the segment.
+    /// This segment's residuals, zigzag-coded: per key of the segment, per
+    /// plane lane (a key's row is contiguous, in the group's planes).
     res: Vec<i32>,
     /// Per plane: all ones in lanes predicted by the line through their
     /// last two values (order 2), zeros in lanes predicted by the last.
@@ -221,17 +222,9 @@ impl PackCache {
                 flat
             }
             _ => {
-                // The key's residuals, gathered from each lane's 16.
-                let i = k % SEGMENT_KEYS;
-                for (f, lanes) in flat
-                    .chunks_exact_mut(8)
-                    .zip(self.res.chunks_exact(8 * SEGMENT_KEYS))
-                {
-                    for (x, lane) in f.iter_mut().zip(lanes.chunks_exact(SEGMENT_KEYS)) {
-                        *x = lane[i];
-                    }
-                }
-                flat
+                // The key's row of residuals, unzigzagged below.
+                let row = (k % SEGMENT_KEYS) * 8 * np;
+                &self.res[row..row + 8 * np]
             }
         };
         let ring = (k & 3) * np;
@@ -243,7 +236,8 @@ impl PackCache {
             let x = match in_block {
                 0 => r,
                 1 => *x1 + r,
-                _ => *x1 + ((*x1 - *x0) & *trend) + r,
+                // Unzigzag (widths below 32: the shift's sign bit is 0).
+                _ => *x1 + ((*x1 - *x0) & *trend) + ((r >> 1) ^ (i32x8::ZERO - (r & 1))),
             };
             *x0 = *x1;
             *x1 = x;
@@ -288,15 +282,16 @@ impl PackCache {
         // Rows: the segment's keys after the block's first two.
         let end = (k + SEGMENT_KEYS).min(g.keys);
         let first = if block { 2.min(end - k) } else { 0 };
-        read_segment(s, pos, &self.reads, first..end - k, &mut self.res);
+        read_segment(s, pos, &self.reads, first..end - k, &mut self.res, 8 * g.planes);
     }
 }
 
 /// Each lane's residuals of one segment (contiguous, in the lane's width)
-/// from bit `pos` of `words` into `res`, 16 per plane lane (`rows` of
-/// them: the segment's keys after a block's first two): as many values from
-/// each 64-bit window as it holds. (A function of slices alone, out of
-/// line, so that its loop keeps its pointers in registers.)
+/// from bit `pos` of `words` into `res`, still zigzag-coded, at
+/// `row * stride + slot` for the segment's `rows` (its keys after a
+/// block's first two): as many values from each 64-bit window as it holds.
+/// (A function of slices alone, out of line, so that its loop keeps its
+/// pointers in registers.)
 #[inline(never)]
 fn read_segment(
     words: &[u64],
@@ -304,27 +299,32 @@ fn read_segment(
     reads: &[LaneRead],
     rows: std::ops::Range<usize>,
     res: &mut [i32],
+    stride: usize,
 ) {
+    let count = rows.len();
     for r in reads {
         let (w, slot) = (r.width as usize, r.slot as usize);
-        let Some(lane) = res.get_mut(slot * SEGMENT_KEYS..(slot + 1) * SEGMENT_KEYS) else {
+        let first = rows.start * stride + slot;
+        // Every store below lands in `res` (checked once, not per value).
+        if count == 0 || first + (count - 1) * stride >= res.len() {
             continue;
-        };
-        let Some(dst) = lane.get_mut(rows.clone()) else {
-            continue;
-        };
+        }
+        let lane = &mut res[first..=first + (count - 1) * stride];
         if w == 0 {
-            dst.fill(0);
+            lane.iter_mut().step_by(stride).for_each(|x| *x = 0);
             continue;
         }
         let (per, mask) = (64 / w, (1u64 << w) - 1);
-        for chunk in dst.chunks_mut(per) {
+        let mut at = 0;
+        while at < lane.len() {
             let mut win = window(words, pos);
-            for x in chunk.iter_mut() {
-                *x = unzigzag((win & mask) as u32);
+            let end = (at + per * stride).min(lane.len());
+            while at < end {
+                lane[at] = (win & mask) as i32;
                 win >>= w;
+                at += stride;
+                pos += w;
             }
-            pos += chunk.len() * w;
         }
     }
 }
