@@ -1,36 +1,24 @@
 //! The `tcb` command as a user runs it: output format, options, and every
 //! bad input of the clip-format contract.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn tcb(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tcb"))
-        .args(args)
-        .output()
-        .expect("run tcb")
-}
+use common::{file, scratch, stderr, stdout, tcb};
+use std::path::PathBuf;
 
+/// The bundled example clips' folder.
 fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/clips")
+    common::root().join("examples/clips")
 }
 
+/// A bundled example clip, as an argument.
 fn example(name: &str) -> String {
-    examples().join(name).to_string_lossy().into_owned()
+    file(&format!("examples/clips/{name}"))
 }
 
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).unwrap()
-}
-
+/// `text` written to `name` in this binary's scratch folder.
 fn temp_clip(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tcb-cli-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
+    let path = scratch("cli-test").join(name);
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -515,17 +503,14 @@ fn tcb_beyond_one_is_allowed() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// A file of the repository's `data/`, as an argument.
 fn data(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
+    file(&format!("data/{name}"))
 }
 
 #[test]
 fn import_and_export_round_trip_through_the_command() {
-    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let dir = scratch("cli-test");
     let clip = dir.join("skin.json");
     let o = tcb(&[
         "import",
@@ -561,7 +546,7 @@ fn import_and_export_round_trip_through_the_command() {
 
 #[test]
 fn import_and_export_errors_write_nothing() {
-    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let dir = scratch("cli-test");
     let out = dir.join("never.json");
     let bad = temp_clip(
         "cut.bvh",
@@ -632,7 +617,7 @@ fn import_and_export_errors_write_nothing() {
 
 #[test]
 fn export_renames_tracks_and_prints_one_summary_line() {
-    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let dir = scratch("cli-test");
     let glb = dir.join("bounce-renamed.glb");
     // Refused without renames, with the way out in the message.
     let o = tcb(&[
@@ -693,7 +678,7 @@ fn export_renames_tracks_and_prints_one_summary_line() {
 
 #[test]
 fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
-    let dir = temp_clip("x", "").parent().unwrap().to_path_buf();
+    let dir = scratch("cli-test");
     let out = dir.join("plot.svg");
     let mut inputs: Vec<String> = std::fs::read_dir(examples())
         .unwrap()
@@ -782,8 +767,7 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
 
 #[test]
 fn plot_draws_a_panel_per_kind_and_skips_what_path_cannot_draw_in_one_line() {
-    let dir = std::env::temp_dir().join(format!("tcb-cli-plot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("cli-plot");
     let out = dir.join("bounce.svg");
     let plot = |input: &str, extra: &[&str]| {
         let _ = std::fs::remove_file(&out);
@@ -831,7 +815,7 @@ fn plot_draws_a_panel_per_kind_and_skips_what_path_cannot_draw_in_one_line() {
 
 #[test]
 fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
-    let dir = temp_clip("x", "").parent().unwrap().join("outside-test");
+    let dir = scratch("cli-test").join("outside-test");
     let asset = dir.join("asset");
     std::fs::create_dir_all(&asset).unwrap();
     let times_and_values: Vec<u8> = [0.0f32, 1.0, 0.0, 1.0]
@@ -875,7 +859,7 @@ fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
 
 #[test]
 fn figures_from_a_wrong_root_create_nothing() {
-    let dir = temp_clip("x", "").parent().unwrap().join("never-figures");
+    let dir = scratch("cli-test").join("never-figures");
     let _ = std::fs::remove_dir_all(&dir);
     let o = tcb(&[
         "figures",

@@ -4,14 +4,12 @@
 //! `python3 tools/check/check.py --write-golden`). Tolerance 1e-5 relative
 //! (absolute below 1); quaternions up to sign.
 
+mod common;
+
+use common::{command, root, stderr};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 const TOL: f64 = 1e-5;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 struct Golden {
     clip: String,
@@ -43,7 +41,7 @@ fn read_golden(path: &Path) -> Golden {
 
 fn sample(clip: &str, times: &[f64], scalar: bool) -> (Vec<String>, Vec<Vec<f64>>) {
     let at: Vec<String> = times.iter().map(|t| format!("{t:?}")).collect();
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_tcb"));
+    let mut cmd = command();
     cmd.current_dir(root())
         .args(["sample", clip, "--velocity", "--at"])
         .arg(at.join(","));
@@ -51,12 +49,8 @@ fn sample(clip: &str, times: &[f64], scalar: bool) -> (Vec<String>, Vec<Vec<f64>
         cmd.arg("--scalar");
     }
     let out = cmd.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    parse_csv(&String::from_utf8(out.stdout).unwrap())
+    assert!(out.status.success(), "{}", stderr(&out));
+    parse_csv(&common::stdout(&out))
 }
 
 /// Header and numeric rows of a CSV, skipping `#` comment lines.

@@ -1,32 +1,14 @@
 //! `tcb info` and `tcb bench` as a user runs them.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn tcb(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tcb"))
-        .args(args)
-        .output()
-        .expect("run tcb")
-}
-
-fn file(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(rel)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8(b.to_vec()).unwrap()
-}
+use common::{file, stderr, stdout, tcb};
 
 #[test]
 fn info_names_tracks_grids_and_bytes() {
     let o = tcb(&["info", &file("examples/clips/bounce.json")]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
     assert!(
         out.contains("3 tracks, 8 channels, 10 keys, 0 to 2 s"),
         "{out}"
@@ -47,8 +29,8 @@ fn info_names_tracks_grids_and_bytes() {
     assert!(out.contains("bytes: "));
     // A BVH file, imported on the fly, with its skeleton.
     let o = tcb(&["info", &file("data/cmu-01_01.bvh"), "--rotation", "hermite"]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
     assert!(
         out.contains("32 tracks") && out.contains("skeleton: 38 joints"),
         "{out}"
@@ -69,8 +51,8 @@ fn info_names_tracks_grids_and_bytes() {
         "hermite",
         "--quantize",
     ]);
-    assert!(q.status.success(), "{}", text(&q.stderr));
-    let qout = text(&q.stdout);
+    assert!(q.status.success(), "{}", stderr(&q));
+    let qout = stdout(&q);
     assert_eq!(
         qout.matches("quantization error at most").count(),
         32,
@@ -103,8 +85,8 @@ fn bench_reports_ns_per_joint_bytes_and_flags() {
         "2",
         "--quantize",
     ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
     for want in [
         "build:",
         "RUSTFLAGS=",
@@ -133,11 +115,11 @@ fn bench_and_info_refuse_bad_input() {
     ] {
         let o = tcb(&args);
         assert!(!o.status.success(), "{args:?} succeeded");
-        let err = text(&o.stderr);
+        let err = stderr(&o);
         assert!(
             err.starts_with("tcb: error: ") || err.contains("error:"),
             "{args:?}: {err}"
         );
-        assert!(o.stdout.is_empty(), "{args:?} printed {}", text(&o.stdout));
+        assert!(o.stdout.is_empty(), "{args:?} printed {}", stdout(&o));
     }
 }

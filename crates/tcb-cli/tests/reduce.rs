@@ -1,37 +1,20 @@
 //! `tcb reduce` as a user runs it (`docs/reduce.md`): the summary line, a
 //! result the other commands accept, and bad input that writes nothing.
 
+mod common;
+
+use common::{file, scratch, stderr, stdout, tcb};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn tcb(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tcb"))
-        .args(args)
-        .output()
-        .expect("run tcb")
-}
-
-fn repo(path: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(path)
-        .to_string_lossy()
-        .into_owned()
-}
-
+/// This binary's scratch folder.
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tcb-reduce-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    scratch("reduce-test")
 }
 
 /// The first `frames` frames of the bundled CMU clip, as a BVH file.
 fn short_cmu(frames: usize) -> PathBuf {
-    let text = std::fs::read_to_string(repo("data/cmu-01_01.bvh")).unwrap();
+    let text = std::fs::read_to_string(file("data/cmu-01_01.bvh")).unwrap();
     let (head, motion) = text.split_once("MOTION").unwrap();
     let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
     let _frames = lines.next().unwrap();
@@ -71,7 +54,7 @@ fn reduce_ok(input: &Path, out: &Path, extra: &[&str]) -> Output {
 fn reduce_short(name: &str, extra: &[&str]) -> (PathBuf, Output, [f64; 8]) {
     let out = dir().join(name);
     let o = reduce_ok(&short_cmu(240), &out, extra);
-    let numbers = summary(&String::from_utf8_lossy(&o.stdout), "shell");
+    let numbers = summary(&stdout(&o), "shell");
     (out, o, numbers)
 }
 
@@ -100,7 +83,7 @@ fn summary(stdout: &str, metric: &str) -> [f64; 8] {
 fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     let (out, o, [tracks, k0, k1, v0, v1, b0, b1, e]) =
         reduce_short("short.json", &["--tolerance", "0.05"]);
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     assert_eq!(tracks, 32.0);
     assert_eq!(k0, 32.0 * 240.0);
     assert!(k1 < k0 && v1 < v0 && b1 < b0, "{stdout}");
@@ -135,7 +118,7 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
 #[test]
 fn a_reduction_keeping_most_keys_stays_on_the_grid() {
     let (_, o, [_, _, _, _, _, b0, b1, _]) = reduce_short("short-default.json", &[]);
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     assert!(b1 < b0, "{stdout}");
     assert!(!stderr(&o).contains("more bytes"), "{}", stderr(&o));
 }
@@ -148,7 +131,7 @@ fn a_reduction_keeping_most_keys_stays_on_the_grid() {
 fn a_reduction_that_compiles_larger_says_so() {
     let (_, o, [_, _, _, _, _, b0, b1, _]) =
         reduce_short("short-tight.json", &["--tolerance", "1.087e-4"]);
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     assert!(b1 > b0, "{stdout}");
     let note = format!("compiles to more bytes than the input ({b1} against {b0})");
     assert!(stderr(&o).contains(&note), "{}", stderr(&o));
@@ -167,8 +150,7 @@ fn sample_with(clip: &Path, times: &[f64], extra: &[&str]) -> Vec<Vec<f64>> {
     args.extend(extra);
     let o = tcb(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    String::from_utf8(o.stdout)
-        .unwrap()
+    stdout(&o)
         .lines()
         .skip(1)
         .map(|l| l.split(',').skip(1).map(|x| x.parse().unwrap()).collect())
@@ -199,7 +181,7 @@ fn a_clip_without_skeleton_reduces_by_value() {
         "{}",
         stderr(&o)
     );
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     let [_, k0, k1, v0, v1, ..] = summary(&stdout, "value");
     assert!(k1 < k0 / 4.0 && v1 < v0 / 4.0, "{stdout}");
     // Measured here, by sampling both files at every key time and 3
@@ -239,8 +221,8 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     std::fs::write(&empty, "").unwrap();
     let empty_bvh = dir().join("empty.bvh");
     std::fs::write(&empty_bvh, "").unwrap();
-    let bounce = repo("examples/clips/bounce.json");
-    let bvh = repo("data/cmu-01_01.bvh");
+    let bounce = file("examples/clips/bounce.json");
+    let bvh = file("data/cmu-01_01.bvh");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec![&bounce, "--metric", "shell"],
@@ -319,7 +301,7 @@ fn an_imported_clip_keeps_its_skeleton_and_reduces_by_shell() {
     assert!(from_json.joint("Head_end").is_some());
     let out = dir().join("short-import-reduced.json");
     let o = reduce_ok(&json, &out, &["--tolerance", "0.05"]);
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     let [.., e] = summary(&stdout, "shell");
     assert!(e <= 0.05, "{stdout}");
     // The reduced clip carries the rig on.
@@ -376,7 +358,7 @@ fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
         "0.002",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8(o.stdout.clone()).unwrap();
+    let stdout = stdout(&o);
     let line = stdout.lines().last().unwrap();
     let rest = line
         .strip_prefix("compressed: tracks 32, keys 240, values ")
@@ -401,7 +383,7 @@ fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
     }
     let o = tcb(&["info", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let info = String::from_utf8(o.stdout).unwrap();
+    let info = common::stdout(&o);
     assert!(
         info.contains("bits per value") && info.contains("made by: tcb compress"),
         "{info}"
@@ -416,7 +398,7 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
     let input = short_cmu(40);
     let input = input.to_str().unwrap();
     let out = dir().join("never.tcbc");
-    let uneven = repo("examples/clips/bounce.json");
+    let uneven = file("examples/clips/bounce.json");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![input, "-o", "x.json"], "must end in .tcbc"),
         (

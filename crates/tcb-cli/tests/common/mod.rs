@@ -1,0 +1,46 @@
+//! What the `tcb` command's tests share: running the binary, reading what
+//! it wrote, naming the repository's files and a scratch folder per test
+//! binary.
+
+#![allow(dead_code, reason = "each test binary uses some of these")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `tcb` binary, to set up before running (a working folder, say).
+pub fn command() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tcb"))
+}
+
+/// `tcb ARGS...`, run to the end.
+pub fn tcb(args: &[&str]) -> Output {
+    command().args(args).output().expect("run tcb")
+}
+
+/// What the run wrote to stdout (`tcb` writes UTF-8).
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("stdout is UTF-8")
+}
+
+/// What the run wrote to stderr (`tcb` writes UTF-8).
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("stderr is UTF-8")
+}
+
+/// The repository's root folder.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A file of the repository (`rel` from its root), as an argument.
+pub fn file(rel: &str) -> String {
+    root().join(rel).to_string_lossy().into_owned()
+}
+
+/// A folder of the system's temporary folder, `tcb-NAME-PID`, created: the
+/// process id keeps test binaries running at once apart.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tcb-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
