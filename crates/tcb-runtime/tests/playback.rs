@@ -1,66 +1,120 @@
 //! Playback at the instance: loop, clamp, ping-pong and speed, whatever
-//! the clip's pre/post, against a plain instance sampled at the clip time
-//! worked out here (values equal to the bit; velocities scaled).
+//! the clip's pre/post, against a plain instance sampled at a clip time
+//! worked out by hand for each case (values equal to the bit; velocities
+//! scaled by the rate worked out with it).
 
 use std::sync::Arc;
 use tcb_runtime::{Clip, Instance, Playback};
 
 const BOUNCE: &str = include_str!("../../../examples/clips/bounce.json");
 
-/// The clip time of `t` under `mode` at `speed` over keys `[a, b]`, and
-/// the velocity factor.
-fn expected(mode: Playback, speed: f64, t: f64, (a, b): (f64, f64)) -> (f64, f32) {
-    let t = t * speed;
-    let d = b - a;
-    match mode {
-        Playback::Clip => (t, speed as f32),
-        Playback::Clamp if t < a => (a, 0.0),
-        Playback::Clamp if t > b => (b, 0.0),
-        Playback::Clamp => (t, speed as f32),
-        Playback::Loop => (a + (t - a).rem_euclid(d), speed as f32),
-        Playback::PingPong => {
-            let u = (t - a).rem_euclid(2.0 * d);
-            if u <= d {
-                (a + u, speed as f32)
-            } else {
-                (b - (u - d), -speed as f32)
-            }
-        }
+/// `bounce.json` moved half a second later: keys from t0 = 0.5 to
+/// t1 = 2.5 (d = 2), so that a mapping that forgot t0 shows. The position
+/// oscillates after its last key, so `Playback::Clip` differs from the
+/// other modes past the end.
+const LATE_BOUNCE: &str = r#"{"format": "tcb-clip/1", "name": "late-bounce", "tracks": [
+  {"name": "ball.position", "kind": "vec3", "times": [0.5, 1.0, 1.75, 2.5],
+   "values": [[0, 0, 0], [1, 2, 0], [2, 0, 0], [3, 1, 0]],
+   "keys": [{}, {"tcb": [0.0, -1.0, 0.0]}, {"ease": [0.5, 0.0]}, {}], "post": "oscillate"},
+  {"name": "ball.squash", "kind": "scalar", "times": [0.5, 1.75], "values": [1.0, 0.6]},
+  {"name": "ball.rotation", "kind": "quat", "times": [0.5, 1.0, 1.75, 2.5],
+   "values": [[0, 0, 0, 1], [0, 0, 0.3826834, 0.9238795], [0, 0, 0.7071068, 0.7071068], [0, 0, 1, 0]]}]}"#;
+
+/// 2^100: a huge speed whose products below are exact. It is a multiple
+/// of 4 and its ulp is 2^48, so 2^100 - 0.5 rounds to 2^100, and its
+/// cycles leave remainder 0.
+const HUGE: f64 = (1u128 << 100) as f64;
+
+/// One case: `mode` at `speed`, asked for time `t`, plays the clip at
+/// `clip_time` with velocities times `rate`.
+struct Case {
+    mode: Playback,
+    speed: f64,
+    t: f64,
+    clip_time: f64,
+    rate: f32,
+}
+
+const fn case(mode: Playback, speed: f64, t: f64, clip_time: f64, rate: f32) -> Case {
+    Case {
+        mode,
+        speed,
+        t,
+        clip_time,
+        rate,
     }
 }
 
+/// Over keys [0.5, 2.5]: s = speed * t; Loop plays 0.5 + (s - 0.5) mod 2,
+/// PingPong takes u = (s - 0.5) mod 4 and plays 0.5 + u forwards while
+/// u <= 2, else 0.5 + 4 - u backwards (rate -speed).
+#[rustfmt::skip]
+const CASES: &[Case] = &[
+    // Clip: s itself, the clip's own pre/post outside the keys.
+    case(Playback::Clip, 1.0, 3.0, 3.0, 1.0),        // past the end: post (oscillate)
+    case(Playback::Clip, -0.5, 3.0, -1.5, -0.5),     // s = -1.5, before the first key
+    case(Playback::Clip, 0.0, 7.0, 0.0, 0.0),        // s = 0 whatever t is
+    // Loop.
+    case(Playback::Loop, 1.0, 0.5, 0.5, 1.0),        // at t0
+    case(Playback::Loop, 1.0, 2.25, 2.25, 1.0),      // inside
+    case(Playback::Loop, 1.0, 2.5, 0.5, 1.0),        // at t1: 2 mod 2 = 0, back to t0
+    case(Playback::Loop, 1.0, 2.75, 0.75, 1.0),      // just past t1: 2.25 mod 2 = 0.25
+    case(Playback::Loop, 1.0, 0.25, 2.25, 1.0),      // just before t0: -0.25 mod 2 = 1.75
+    case(Playback::Loop, 1.0, -3.5, 0.5, 1.0),       // -4 mod 2 = 0
+    case(Playback::Loop, 1.0, 1e6 + 0.25, 2.25, 1.0), // 999999.75 mod 2 = 1.75
+    case(Playback::Loop, -1.0, 1.0, 1.0, -1.0),      // s = -1: -1.5 mod 2 = 0.5
+    case(Playback::Loop, 0.0, 5.0, 2.0, 0.0),        // s = 0: -0.5 mod 2 = 1.5
+    case(Playback::Loop, HUGE, 1.0, 0.5, HUGE as f32), // s = 2^100: 2^100 mod 2 = 0
+    case(Playback::Loop, 1.0, f64::INFINITY, 0.5, 0.0), // no cycle: held at t0
+    case(Playback::Loop, 1.0, f64::NAN, 0.5, 0.0),   // likewise
+    // Clamp.
+    case(Playback::Clamp, 1.0, 0.25, 0.5, 0.0),      // before t0: held there, still
+    case(Playback::Clamp, 1.0, 0.5, 0.5, 1.0),       // at t0: moving
+    case(Playback::Clamp, 1.0, 2.5, 2.5, 1.0),       // at t1: moving
+    case(Playback::Clamp, 1.0, 2.75, 2.5, 0.0),      // after t1: held there, still
+    case(Playback::Clamp, -1.0, -1.0, 1.0, -1.0),    // s = 1, backwards
+    case(Playback::Clamp, -1.0, 1.0, 0.5, 0.0),      // s = -1 < t0
+    case(Playback::Clamp, 0.0, 9.0, 0.5, 0.0),       // s = 0 < t0
+    case(Playback::Clamp, HUGE, 2.0 / HUGE, 2.0, HUGE as f32), // s = 2^100 * 2^-99 = 2
+    case(Playback::Clamp, 1.0, f64::INFINITY, 2.5, 0.0),
+    case(Playback::Clamp, 1.0, f64::NEG_INFINITY, 0.5, 0.0),
+    // PingPong.
+    case(Playback::PingPong, 1.0, 0.5, 0.5, 1.0),    // u = 0: at t0, forwards
+    case(Playback::PingPong, 1.0, 1.5, 1.5, 1.0),    // u = 1
+    case(Playback::PingPong, 1.0, 2.5, 2.5, 1.0),    // u = 2: at t1, still forwards
+    case(Playback::PingPong, 1.0, 3.0, 2.0, -1.0),   // u = 2.5: 4.5 - 2.5, backwards
+    case(Playback::PingPong, 1.0, 4.25, 0.75, -1.0), // u = 3.75: 4.5 - 3.75
+    case(Playback::PingPong, 1.0, 4.5, 0.5, 1.0),    // u = 4 mod 4 = 0: forwards again
+    case(Playback::PingPong, 1.0, 0.25, 0.75, -1.0), // u = -0.25 mod 4 = 3.75
+    case(Playback::PingPong, -1.0, -1.5, 1.5, -1.0), // s = 1.5, u = 1: rate = speed
+    case(Playback::PingPong, -1.0, -3.0, 2.0, 1.0),  // s = 3, u = 2.5: rate = -speed
+    case(Playback::PingPong, 2.0, 1.5, 2.0, -2.0),   // s = 3, u = 2.5
+    case(Playback::PingPong, 0.0, 3.0, 1.0, -0.0),   // s = 0, u = -0.5 mod 4 = 3.5
+    case(Playback::PingPong, HUGE, 1.0, 0.5, HUGE as f32), // s = 2^100: u = 0
+    case(Playback::PingPong, 1.0, f64::NEG_INFINITY, 0.5, 0.0), // no cycle: held at t0
+];
+
 #[test]
-fn every_mode_and_speed_matches_the_clip_at_the_mapped_time() {
-    let source = tcb_io::ClipDoc::parse(BOUNCE).unwrap().build().unwrap();
+fn every_mode_and_speed_plays_the_clip_time_worked_out_by_hand() {
+    let source = tcb_io::ClipDoc::parse(LATE_BOUNCE)
+        .unwrap()
+        .build()
+        .unwrap();
     let clip = Arc::new(Clip::compile(&source));
-    let range = clip.time_range().unwrap();
+    assert_eq!(clip.time_range(), Some((0.5, 2.5)));
     let n = source.channel_count();
-    let times: Vec<f64> = (0..400)
-        .map(|i| -3.0 + 0.037 * f64::from(i))
-        .chain([1e6, 1e6 + 0.25, -1e6])
-        .collect();
-    for mode in [
-        Playback::Clip,
-        Playback::Loop,
-        Playback::Clamp,
-        Playback::PingPong,
-    ] {
-        for speed in [1.0, 2.0, -0.5] {
-            let mut played = Instance::new(clip.clone()).with_velocities();
-            played.set_playback(mode, speed).unwrap();
-            assert_eq!(played.playback(), (mode, speed));
-            let mut plain = Instance::new(clip.clone()).with_velocities();
-            let (mut gv, mut gd, mut wv, mut wd) =
-                (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            for &t in &times {
-                let (ct, rate) = expected(mode, speed, t, range);
-                played.sample(t).write_row(&mut gv, Some(&mut gd));
-                plain.sample(ct).write_row(&mut wv, Some(&mut wd));
-                assert_eq!(gv, wv, "{mode:?} x{speed} t={t}: values at clip time {ct}");
-                for (g, w) in gd.iter().zip(&wd) {
-                    assert_eq!(*g, w * rate, "{mode:?} x{speed} t={t}: velocity");
-                }
-            }
+    let (mut gv, mut gd, mut wv, mut wd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    for c in CASES {
+        let what = format!("{:?} x{} t={}", c.mode, c.speed, c.t);
+        let mut played = Instance::new(clip.clone()).with_velocities();
+        played.set_playback(c.mode, c.speed).unwrap();
+        assert_eq!(played.playback(), (c.mode, c.speed));
+        let mut plain = Instance::new(clip.clone()).with_velocities();
+        played.sample(c.t).write_row(&mut gv, Some(&mut gd));
+        plain.sample(c.clip_time).write_row(&mut wv, Some(&mut wd));
+        assert_eq!(gv, wv, "{what}: values at clip time {}", c.clip_time);
+        for (g, w) in gd.iter().zip(&wd) {
+            assert_eq!(*g, w * c.rate, "{what}: velocity at rate {}", c.rate);
         }
     }
 }
