@@ -1,2 +1,2 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| tcb_fuzz::clip_json(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| tcb_fuzz_bodies::clip_json(data));

@@ -1,2 +1,2 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| tcb_fuzz::runtime(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| tcb_fuzz_bodies::runtime(data));

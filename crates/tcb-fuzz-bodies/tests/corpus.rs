@@ -1,12 +1,10 @@
 //! Replays the committed fuzz corpus (`fuzz/corpus/<target>/`: seeds and
 //! every crash found, each kept under a name that says what it found)
-//! through the fuzz targets' own bodies (`fuzz/src/lib.rs`) on stable Rust,
-//! so CI guards the findings without nightly or cargo-fuzz.
-
-#[path = "../../../fuzz/src/lib.rs"]
-mod bodies;
+//! through the fuzz targets' own bodies (this crate) on stable Rust, so CI
+//! guards the findings without nightly or cargo-fuzz.
 
 use std::path::Path;
+use tcb_fuzz_bodies as bodies;
 
 fn replay(target: &str, body: fn(&[u8])) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -1,6 +1,6 @@
-//! The bodies of the fuzz targets, shared by `fuzz_targets/` (cargo-fuzz,
-//! `RUSTC_BOOTSTRAP=1 cargo fuzz run NAME`) and by the corpus replay test
-//! (`crates/tcb-cli/tests/fuzz_corpus.rs`, stable `cargo test`), so the
+//! The bodies of the fuzz targets, shared by `fuzz/fuzz_targets/`
+//! (cargo-fuzz, `RUSTC_BOOTSTRAP=1 cargo fuzz run NAME` in `fuzz/`) and by
+//! the corpus replay test (`tests/corpus.rs`, stable `cargo test`), so the
 //! findings stay guarded without nightly.
 //!
 //! Each body returns quietly on input the library rightly refuses and
