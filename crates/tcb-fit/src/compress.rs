@@ -19,7 +19,9 @@
 //! Nothing is returned that was not measured within the tolerance.
 
 use crate::metric::{self, Measured, Worst};
-use crate::reduce::{Metric, ReduceError, ReduceOptions, Settings, bound_joint, descends, resolve};
+use crate::reduce::{
+    Metric, ReduceError, ReduceOptions, Reference, Settings, bound_joint, descends, resolve,
+};
 use std::sync::Arc;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{Clip, TrackKind};
@@ -110,81 +112,80 @@ pub fn compress(
     let largest: Vec<f64> = (0..clip.tracks().len())
         .map(|t| f64::from(keys.largest(t)).max(1.0))
         .collect();
-    let reference = Arc::new(tcb_runtime::Clip::compile(clip));
-    let rows = metric::play(&reference, &times);
+    let reference = Reference::new(clip, skeleton, &times);
     let budget = Budget::new(clip, skeleton, &settings, &largest);
     let total = 40;
     let mut evaluations = 0usize;
-    let mut measure = |steps: &[f32]| -> Result<(Measured, Packed), ReduceError> {
+    let mut measure = |steps: &[f32]| -> Result<Trial, ReduceError> {
         evaluations += 1;
         progress(evaluations.min(total - 1), total);
-        let source = keys
-            .quantize(steps)
-            .map_err(|e| ReduceError::Option(e.to_string()))?;
-        let packed = Packed::encode_with(&source, block)
-            .map_err(|e| ReduceError::Option(format!("--seek-keys: {e}")))?;
+        let packed = encode(&keys, steps, block)?;
         let compiled = tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
             .map_err(|e| ReduceError::Build(e.to_string()))?;
-        let compiled = Arc::new(compiled);
-        let m = match settings.metric {
-            Metric::Shell => metric::shell_error(
-                skeleton.expect("shell has a skeleton"),
-                &reference,
-                &compiled,
-                &times,
-                settings.shell,
-                settings.tolerance,
-            ),
-            Metric::Value => metric::value_error(
-                clip,
-                &rows,
-                &compiled,
-                &times,
-                settings.tolerance,
-                settings.rotation_tolerance,
-            ),
-        };
-        Ok((m, packed))
+        Ok((reference.measure(&settings, &Arc::new(compiled)), packed))
     };
+    let (measured, mut packed) = search(&budget, &mut measure)?;
+    progress(total, total);
+    packed.note = format!(
+        "tcb compress: metric {}, tolerance {:e}, shell {:e}, seek keys {block}, max error {:e} at {} time {}",
+        settings.metric.name(),
+        settings.tolerance,
+        settings.shell,
+        measured.worst.error,
+        measured.worst.at,
+        measured.worst.time
+    );
+    let bytes = check_written(&packed)?;
+    let values = packed.head().keys * packed.head().lanes();
+    Ok(Compressed {
+        packed,
+        settings,
+        worst: measured.worst,
+        bytes,
+        values,
+        evaluations,
+    })
+}
 
+/// A packed clip and its error as measured.
+type Trial = (Measured, Packed);
+
+/// The clip's keys quantized at `steps` (per track) and packed in blocks of
+/// `block` keys.
+fn encode(keys: &KeyValues, steps: &[f32], block: usize) -> Result<Packed, ReduceError> {
+    let source = keys
+        .quantize(steps)
+        .map_err(|e| ReduceError::Option(e.to_string()))?;
+    Packed::encode_with(&source, block)
+        .map_err(|e| ReduceError::Option(format!("--seek-keys: {e}")))
+}
+
+/// Steps 2 and 3: rounds of bisecting kappa, then rebalancing the tracks'
+/// weights by their slack; the smallest file that held, with what was
+/// measured on it. `measure` packs and measures the clip at per-track
+/// steps.
+fn search(
+    budget: &Budget,
+    measure: &mut dyn FnMut(&[f32]) -> Result<Trial, ReduceError>,
+) -> Result<Trial, ReduceError> {
     // Per track a relative weight (rebalanced below) times kappa.
-    let mut weight = vec![1.0f64; clip.tracks().len()];
+    let mut weight = vec![1.0f64; budget.unit.len()];
     let mut best: Option<(usize, Measured, Packed)> = None;
     for round in 0..4 {
-        // Bisect kappa (log scale) between one that holds and one that does not.
-        let (mut lo, mut hi) = (0.25f64, 64.0f64);
-        let mut last_ok: Option<(Measured, Packed)> = None;
-        let steps_at = |k: f64| budget.steps(k, &weight);
-        let iterations = if round == 0 { 9 } else { 6 };
         // Every round bisects the whole range (later rounds, with weights
         // rebalanced, fewer times).
-        for _ in 0..iterations {
-            let mid = (lo * hi).sqrt();
-            let (m, p) = measure(&steps_at(mid))?;
-            if m.worst.ratio <= 1.0 {
-                lo = mid;
-                last_ok = Some((m, p));
-            } else {
-                hi = mid;
+        let iterations = if round == 0 { 9 } else { 6 };
+        let (m, p) = bisect_kappa(iterations, &|k| budget.steps(k, &weight), measure)?;
+        if m.worst.ratio > 1.0 {
+            // Nothing at this round's weights holds: keep the best.
+            if best.is_some() {
+                break;
             }
+            return Err(ReduceError::CannotMeet {
+                ratio: m.worst.ratio,
+                worst: m.worst,
+            });
         }
-        let (m, p) = match last_ok {
-            Some(x) => x,
-            None => {
-                let (m, p) = measure(&steps_at(lo))?;
-                if m.worst.ratio > 1.0 {
-                    // Nothing at this round's weights holds: keep the best.
-                    if best.is_some() {
-                        break;
-                    }
-                    return Err(ReduceError::CannotMeet {
-                        ratio: m.worst.ratio,
-                        worst: m.worst,
-                    });
-                }
-                (m, p)
-            }
-        };
         let bytes = p.to_bytes().len();
         if best.as_ref().is_none_or(|b| bytes < b.0) {
             best = Some((bytes, m.clone(), p));
@@ -195,40 +196,51 @@ pub fn compress(
             *w *= (1.0 / r.max(0.05)).sqrt().min(4.0);
         }
     }
-    progress(total, total);
-    let (_, measured, mut packed) = best.expect("a round that holds, or an error above");
-    packed.note = format!(
-        "tcb compress: metric {}, tolerance {:e}, shell {:e}, seek keys {block}, max error {:e} at {} time {}",
-        settings.metric.name(),
-        settings.tolerance,
-        settings.shell,
-        measured.worst.error,
-        measured.worst.at,
-        measured.worst.time
-    );
-    // What is written must read back as it is (the checks of a file read
-    // are not the encoder's).
+    let (_, measured, packed) = best.expect("a round that holds, or an error above");
+    Ok((measured, packed))
+}
+
+/// Bisect kappa (log scale, `iterations` times) between one that holds
+/// (0.25 is taken to) and one that does not (64): the last kappa that
+/// held, or, if none did, the clip at 0.25, measured (which may not hold).
+fn bisect_kappa(
+    iterations: usize,
+    steps_at: &dyn Fn(f64) -> Vec<f32>,
+    measure: &mut dyn FnMut(&[f32]) -> Result<Trial, ReduceError>,
+) -> Result<Trial, ReduceError> {
+    let (mut lo, mut hi) = (0.25f64, 64.0f64);
+    let mut last_ok: Option<Trial> = None;
+    for _ in 0..iterations {
+        let mid = (lo * hi).sqrt();
+        let (m, p) = measure(&steps_at(mid))?;
+        if m.worst.ratio <= 1.0 {
+            lo = mid;
+            last_ok = Some((m, p));
+        } else {
+            hi = mid;
+        }
+    }
+    match last_ok {
+        Some(x) => Ok(x),
+        None => measure(&steps_at(lo)),
+    }
+}
+
+/// The file's size, once checked: what is written must read back as it is
+/// (the checks of a file read are not the encoder's), and the runtime
+/// plays its keys as the reference compiles them, bit for bit (a loader
+/// does not decode them all to check it).
+fn check_written(packed: &Packed) -> Result<usize, ReduceError> {
     let file = packed.to_bytes();
-    if Packed::from_bytes(&file).as_ref() != Ok(&packed) {
+    if Packed::from_bytes(&file).as_ref() != Ok(packed) {
         return Err(ReduceError::Build(
             "the packed clip does not read back from its bytes".into(),
         ));
     }
-    // The runtime plays its keys as the reference compiles them, bit for
-    // bit (a loader does not decode them all to check it).
     tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
         .and_then(|c| c.verify_packed())
         .map_err(|e| ReduceError::Build(e.to_string()))?;
-    let bytes = file.len();
-    let values = packed.head().keys * packed.head().lanes();
-    Ok(Compressed {
-        packed,
-        settings,
-        worst: measured.worst,
-        bytes,
-        values,
-        evaluations,
-    })
+    Ok(file.len())
 }
 
 /// Per track: its share of the tolerance in its own units.

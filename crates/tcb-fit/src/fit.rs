@@ -162,80 +162,97 @@ pub fn fit_within(
         cols: series.iter().map(|s| s.dim).sum(),
     };
     let max_keys = max_values / (problem.cols * tangents.numbers_per_component()).max(1);
-    let mut knots = vec![0, n - 1];
-    // Insertion.
-    let mut x = loop {
-        let x = problem.solve(&knots)?;
-        let solved = problem.evaluate(&knots, &x, 0..n);
-        // Spans to split: those with a failing sample, and where a span has
-        // no sample inside, the nearest span on each side that has one (the
-        // least-squares compromise there is what pulls the keys off).
-        let spans = knots.len() - 1;
-        let wide = |k: usize| knots[k + 1] - knots[k] >= 2;
-        let mut split = vec![false; spans];
-        for (k, w) in knots.windows(2).enumerate() {
-            let worst = solved.ratio[w[0]..=w[1]]
-                .iter()
-                .copied()
-                .fold(0.0, f64::max);
-            if worst <= 1.0 && !solved.flipped[k] {
-                continue;
-            }
-            if wide(k) {
-                split[k] = true;
-            } else {
-                if let Some(l) = (0..k).rev().find(|&l| wide(l)) {
-                    split[l] = true;
-                }
-                if let Some(r) = (k + 1..spans).find(|&r| wide(r)) {
-                    split[r] = true;
-                }
-            }
-        }
-        let inserts: Vec<usize> = (0..spans)
-            .filter(|&k| split[k])
-            .map(|k| {
-                // At the worst sample, kept to the middle half of the span:
-                // a key beside a key adds little, and splitting near the
-                // middle halves the span every round.
-                let (a, b) = (knots[k], knots[k + 1]);
-                let quarter = (b - a) / 4;
-                let (lo, hi) = (a + quarter.max(1), b - quarter.max(1));
-                lo + argmax(&solved.ratio[lo..=hi])
-            })
-            .collect();
-        if inserts.is_empty() {
-            if solved.holds() {
-                break x;
-            }
-            return None;
-        }
-        knots.extend(inserts);
-        knots.sort_unstable();
-        if knots.len() > max_keys {
-            return None;
-        }
-    };
-    // Removal: drop each key in turn where refitting the keys around it
-    // (the rest held) keeps every sample they reach within tolerance.
-    let mut k = 1;
-    while k + 1 < knots.len() {
-        // Only the keys around k take part: a slice wide enough that the
-        // rows refitted and checked never reach its ends (unless they are
-        // the track's own ends).
-        let lo = k.saturating_sub(WINDOW + 3);
-        let hi = (k + WINDOW + 3).min(knots.len() - 1);
-        let per = problem.unknowns(1) * problem.cols;
-        match problem.without(&knots[lo..=hi], &x[lo * per..(hi + 1) * per], k - lo) {
-            Some(local) => {
-                knots.remove(k);
-                x.splice(lo * per..(hi + 1) * per, local);
-            }
-            None => k += 1,
-        }
-    }
+    let (mut knots, mut x) = problem.insert_keys(max_keys)?;
+    problem.remove_keys(&mut knots, &mut x);
     let solved = problem.evaluate(&knots, &x, 0..n);
     solved.holds().then(|| problem.finish(&knots, &x))
+}
+
+impl Problem<'_> {
+    /// Insertion: from the two end keys, split the failing spans (in their
+    /// middle half) and solve again until every sample holds. The keys and
+    /// their solution; `None` if the fit cannot hold or needs more than
+    /// `max_keys` keys.
+    fn insert_keys(&self, max_keys: usize) -> Option<(Vec<usize>, Vec<f64>)> {
+        let n = self.times.len();
+        let mut knots = vec![0, n - 1];
+        loop {
+            let x = self.solve(&knots)?;
+            let solved = self.evaluate(&knots, &x, 0..n);
+            let split = spans_to_split(&knots, &solved);
+            let inserts: Vec<usize> = (0..split.len())
+                .filter(|&k| split[k])
+                .map(|k| {
+                    // At the worst sample, kept to the middle half of the span:
+                    // a key beside a key adds little, and splitting near the
+                    // middle halves the span every round.
+                    let (a, b) = (knots[k], knots[k + 1]);
+                    let quarter = (b - a) / 4;
+                    let (lo, hi) = (a + quarter.max(1), b - quarter.max(1));
+                    lo + argmax(&solved.ratio[lo..=hi])
+                })
+                .collect();
+            if inserts.is_empty() {
+                return solved.holds().then_some((knots, x));
+            }
+            knots.extend(inserts);
+            knots.sort_unstable();
+            if knots.len() > max_keys {
+                return None;
+            }
+        }
+    }
+
+    /// Removal: drop each key in turn where refitting the keys around it
+    /// (the rest held) keeps every sample they reach within tolerance.
+    fn remove_keys(&self, knots: &mut Vec<usize>, x: &mut Vec<f64>) {
+        let mut k = 1;
+        while k + 1 < knots.len() {
+            // Only the keys around k take part: a slice wide enough that the
+            // rows refitted and checked never reach its ends (unless they are
+            // the track's own ends).
+            let lo = k.saturating_sub(WINDOW + 3);
+            let hi = (k + WINDOW + 3).min(knots.len() - 1);
+            let per = self.unknowns(1) * self.cols;
+            match self.without(&knots[lo..=hi], &x[lo * per..(hi + 1) * per], k - lo) {
+                Some(local) => {
+                    knots.remove(k);
+                    x.splice(lo * per..(hi + 1) * per, local);
+                }
+                None => k += 1,
+            }
+        }
+    }
+}
+
+/// Per span between `knots`, whether to split it: those with a failing
+/// sample, and where a span has no sample inside, the nearest span on each
+/// side that has one (the least-squares compromise there is what pulls the
+/// keys off).
+fn spans_to_split(knots: &[usize], solved: &Solved) -> Vec<bool> {
+    let spans = knots.len() - 1;
+    let wide = |k: usize| knots[k + 1] - knots[k] >= 2;
+    let mut split = vec![false; spans];
+    for (k, w) in knots.windows(2).enumerate() {
+        let worst = solved.ratio[w[0]..=w[1]]
+            .iter()
+            .copied()
+            .fold(0.0, f64::max);
+        if worst <= 1.0 && !solved.flipped[k] {
+            continue;
+        }
+        if wide(k) {
+            split[k] = true;
+        } else {
+            if let Some(l) = (0..k).rev().find(|&l| wide(l)) {
+                split[l] = true;
+            }
+            if let Some(r) = (k + 1..spans).find(|&r| wide(r)) {
+                split[r] = true;
+            }
+        }
+    }
+    split
 }
 
 /// Keys on each side of a removed one that are refitted.

@@ -43,7 +43,9 @@ use std::str::FromStr;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tcb_core::skeleton::Skeleton;
-use tcb_core::{Clip, Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, TrackKind};
+use tcb_core::{
+    Clip, Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, TrackKind, TrackSettings,
+};
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 
 /// The error measure (`--metric`).
@@ -378,60 +380,133 @@ pub fn reduce(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Reduced, ReduceError> {
     let settings = resolve(options, input.skeleton)?;
-    let Settings {
-        metric,
-        tolerance,
-        shell,
-        rotation_tolerance,
-        ..
-    } = settings;
     let times = metric::check_times(input.clip);
     if times.len() < 2 {
         return Err(ReduceError::Empty);
     }
     // The input is compiled and played once: the reference for the fitter
     // and for every round's measurement.
-    let reference = Arc::new(tcb_runtime::Clip::compile(input.clip));
-    let plan = Plan::new(input, &settings, &times, &reference);
-    let before = counts(input.doc, &reference);
-    let verify = |clip: &Arc<tcb_runtime::Clip>| -> metric::Measured {
-        match metric {
+    let reference = Reference::new(input.clip, input.skeleton, &times);
+    let plan = Plan::new(input, &settings, &reference);
+    let before = counts(input.doc, &reference.compiled);
+    let verify = |clip: &Arc<tcb_runtime::Clip>| reference.measure(&settings, clip);
+    let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
+    let (fitted, attempts) = fit_in_rounds(&plan, &mut cache, &verify, progress)?;
+    let best = put_back_for_bytes(&plan, &cache, fitted, &verify)?;
+    let after = counts(&best.doc, &best.compiled);
+    let kept = (0..best.kept.len())
+        .filter(|&i| best.kept[i])
+        .map(|i| input.clip.tracks()[i].name.clone())
+        .collect();
+    Ok(Reduced {
+        doc: best.doc,
+        clip: best.clip,
+        settings,
+        before,
+        after,
+        worst: best.worst,
+        kept,
+        attempts,
+    })
+}
+
+/// A written clip, built, compiled and measured.
+struct Candidate {
+    doc: ClipDoc,
+    clip: Clip,
+    compiled: Arc<tcb_runtime::Clip>,
+    worst: Worst,
+    /// Per track: kept as it was.
+    kept: Vec<bool>,
+}
+
+/// The input as every candidate is measured against it: compiled once and
+/// played at the check times.
+pub(crate) struct Reference<'a> {
+    /// The input.
+    pub(crate) source: &'a Clip,
+    /// Its rig (`shell`).
+    pub(crate) skeleton: Option<&'a Skeleton>,
+    /// The check times ([`metric::check_times`]).
+    pub(crate) times: &'a [f64],
+    /// The input on the runtime.
+    pub(crate) compiled: Arc<tcb_runtime::Clip>,
+    /// The input played at the check times ([`metric::play`]).
+    pub(crate) rows: Vec<f32>,
+}
+
+impl<'a> Reference<'a> {
+    /// `source` compiled and played at `times`.
+    pub(crate) fn new(source: &'a Clip, skeleton: Option<&'a Skeleton>, times: &'a [f64]) -> Self {
+        let compiled = Arc::new(tcb_runtime::Clip::compile(source));
+        let rows = metric::play(&compiled, times);
+        Reference {
+            source,
+            skeleton,
+            times,
+            compiled,
+            rows,
+        }
+    }
+
+    /// The error of `clip` against the input by `settings`' metric.
+    pub(crate) fn measure(
+        &self,
+        settings: &Settings,
+        clip: &Arc<tcb_runtime::Clip>,
+    ) -> metric::Measured {
+        match settings.metric {
             Metric::Shell => metric::shell_error(
-                input.skeleton.expect("shell has a skeleton"),
-                &reference,
+                self.skeleton.expect("shell has a skeleton"),
+                &self.compiled,
                 clip,
-                &times,
-                shell,
-                tolerance,
+                self.times,
+                settings.shell,
+                settings.tolerance,
             ),
             Metric::Value => metric::value_error(
-                input.clip,
-                &plan.rows,
+                self.source,
+                &self.rows,
                 clip,
-                &times,
-                tolerance,
-                rotation_tolerance,
+                self.times,
+                settings.tolerance,
+                settings.rotation_tolerance,
             ),
         }
-    };
+    }
+}
 
+/// `doc` built and compiled.
+fn build(doc: &ClipDoc) -> Result<(Clip, Arc<tcb_runtime::Clip>), ReduceError> {
+    let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
+    let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
+    Ok((clip, compiled))
+}
+
+/// Steps 3 and 4: rounds of fit, write, build and measure until the clip
+/// holds, each round tightening the groups that moved a joint (or track)
+/// over its tolerance; every round is an [`Attempt`].
+fn fit_in_rounds(
+    plan: &Plan,
+    cache: &mut [Option<(f64, Option<Fit>)>],
+    verify: &dyn Fn(&Arc<tcb_runtime::Clip>) -> metric::Measured,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Candidate, Vec<Attempt>), ReduceError> {
     // Budgets: every group starts loose (κ = 16 for shell, whose bound is
     // loose; 1 for value, which is exact). After each round, the groups
     // that can move a joint (or track) measured over its tolerance are
     // tightened, and only they are fitted again.
-    let start = match metric {
+    let start = match plan.settings.metric {
         Metric::Shell => 16.0,
         Metric::Value => 1.0,
     };
     let units = plan.units();
     let mut scale = vec![start; plan.groups.len()];
-    let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let mut attempts = Vec::new();
     let mut round = 0;
-    let (doc, clip, compiled, worst, kept) = loop {
-        let (doc, kept, fitted) = plan.run(&scale, &mut cache, progress);
-        let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-        let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
+    loop {
+        let (doc, kept, fitted) = plan.run(&scale, cache, progress);
+        let (clip, compiled) = build(&doc)?;
         let measured = verify(&compiled);
         attempts.push(Attempt {
             round,
@@ -441,7 +516,14 @@ pub fn reduce(
             worst: measured.worst.clone(),
         });
         if measured.worst.ratio <= 1.0 {
-            break (doc, clip, compiled, measured.worst, kept);
+            let candidate = Candidate {
+                doc,
+                clip,
+                compiled,
+                worst: measured.worst,
+                kept,
+            };
+            return Ok((candidate, attempts));
         }
         round += 1;
         if round == MAX_ROUNDS {
@@ -450,41 +532,54 @@ pub fn reduce(
                 worst: measured.worst,
             });
         }
-        for (g, units) in units.iter().enumerate() {
-            let over = units.iter().map(|&u| measured.each[u]).fold(0.0, f64::max);
-            if over > 1.0 || over.is_nan() {
-                // Kept at this budget: kept at any smaller one.
-                let all_kept = plan.groups[g].iter().all(|&i| kept[i]);
-                let next = scale[g] / (1.05 * over).powf(STEP);
-                scale[g] = if all_kept || !next.is_finite() || next < MIN_SCALE {
-                    0.0
-                } else {
-                    next
-                };
-            }
+        tighten(plan, &units, &measured, &kept, &mut scale);
+    }
+}
+
+/// New budget scales for the groups whose units (`units[g]`, from
+/// [`Plan::units`]) were measured over their tolerance: r over it takes
+/// `scale / (1.05 r)^STEP`; a group already kept as it was, or tightened
+/// below [`MIN_SCALE`], goes to 0 (kept).
+fn tighten(
+    plan: &Plan,
+    units: &[Vec<usize>],
+    measured: &metric::Measured,
+    kept: &[bool],
+    scale: &mut [f64],
+) {
+    for (g, units) in units.iter().enumerate() {
+        let over = units.iter().map(|&u| measured.each[u]).fold(0.0, f64::max);
+        if over > 1.0 || over.is_nan() {
+            // Kept at this budget: kept at any smaller one.
+            let all_kept = plan.groups[g].iter().all(|&i| kept[i]);
+            let next = scale[g] / (1.05 * over).powf(STEP);
+            scale[g] = if all_kept || !next.is_finite() || next < MIN_SCALE {
+                0.0
+            } else {
+                next
+            };
         }
-    };
-    // Bytes: a fitted track on key times of its own plays as a loose lane,
-    // which holds about twice the bytes per key of a key grid that tracks
-    // share. A fit that keeps most of its keys can so make the clip larger
-    // than keeping the original keys on the input's grid. The fits that
-    // keep the largest share of their keys are put back (exact) in prefixes
-    // of 1, 2, 4, ... tracks (compiled in parallel); the prefix whose
-    // compiled clip is smallest is taken if it is smaller than the fitted
-    // clip and still holds.
-    // Fits of 2 keys stay (docs/reduce.md: "a constant track becomes 2 keys").
-    let mut candidates: Vec<(f64, usize)> = (0..kept.len())
-        .filter(|&i| !kept[i] && doc.tracks[i].times.len() > 2)
-        .map(|i| {
-            let share = doc.tracks[i].times.len() as f64 / input.doc.tracks[i].times.len() as f64;
-            (share, i)
-        })
-        .filter(|&(share, _)| share >= MIN_SHARE)
-        .collect();
-    candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    }
+}
+
+/// Step 5, bytes: a fitted track on key times of its own plays as a loose
+/// lane, which holds about twice the bytes per key of a key grid that
+/// tracks share. A fit that keeps most of its keys can so make the clip
+/// larger than keeping the original keys on the input's grid. The fits
+/// that keep the largest share of their keys are put back (exact) in
+/// prefixes of 1, 2, 4, ... tracks (compiled in parallel); the prefix whose
+/// compiled clip is smallest is taken if it is smaller than `fitted` and
+/// still holds.
+fn put_back_for_bytes(
+    plan: &Plan,
+    cache: &[Option<(f64, Option<Fit>)>],
+    fitted: Candidate,
+    verify: &dyn Fn(&Arc<tcb_runtime::Clip>) -> metric::Measured,
+) -> Result<Candidate, ReduceError> {
+    let candidates = put_back_order(plan, &fitted);
     let revert = |size: usize| {
-        let mut r = vec![false; input.doc.tracks.len()];
-        for &(_, i) in &candidates[..size] {
+        let mut r = vec![false; plan.input.doc.tracks.len()];
+        for &i in &candidates[..size] {
             r[i] = true;
         }
         r
@@ -497,44 +592,49 @@ pub fn reduce(
     let tried: Vec<(usize, usize)> = sizes
         .par_iter()
         .map(|&size| {
-            let (d, _) = plan.write_fits(&cache, &revert(size));
-            let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-            Ok((tcb_runtime::Clip::compile(&c).memory_bytes(), size))
+            let (d, _) = plan.write_fits(cache, &revert(size));
+            let (_, compiled) = build(&d)?;
+            Ok((compiled.memory_bytes(), size))
         })
         .collect::<Result<_, ReduceError>>()?;
     let smallest = tried
         .into_iter()
-        .filter(|&(bytes, _)| bytes < compiled.memory_bytes())
+        .filter(|&(bytes, _)| bytes < fitted.compiled.memory_bytes())
         .min();
-    let (doc, clip, compiled, worst, kept) = match smallest {
-        Some((_, size)) => {
-            let (d, k) = plan.write_fits(&cache, &revert(size));
-            let c = d.build().map_err(|e| ReduceError::Build(e.to_string()))?;
-            let cc = Arc::new(tcb_runtime::Clip::compile(&c));
-            let measured = verify(&cc);
-            if measured.worst.ratio <= 1.0 {
-                (d, c, cc, measured.worst, k)
-            } else {
-                (doc, clip, compiled, worst, kept)
-            }
-        }
-        None => (doc, clip, compiled, worst, kept),
+    let Some((_, size)) = smallest else {
+        return Ok(fitted);
     };
-    let after = counts(&doc, &compiled);
-    let kept = (0..kept.len())
-        .filter(|&i| kept[i])
-        .map(|i| input.clip.tracks()[i].name.clone())
-        .collect();
-    Ok(Reduced {
+    let (doc, kept) = plan.write_fits(cache, &revert(size));
+    let (clip, compiled) = build(&doc)?;
+    let measured = verify(&compiled);
+    if measured.worst.ratio > 1.0 {
+        return Ok(fitted);
+    }
+    Ok(Candidate {
         doc,
         clip,
-        settings,
-        before,
-        after,
-        worst,
+        compiled,
+        worst: measured.worst,
         kept,
-        attempts,
     })
+}
+
+/// The fitted tracks that may be put back on the input's keys, those
+/// keeping the largest share of their keys first: fits of more than 2 keys
+/// (docs/reduce.md: "a constant track becomes 2 keys") keeping at least
+/// [`MIN_SHARE`].
+fn put_back_order(plan: &Plan, fitted: &Candidate) -> Vec<usize> {
+    let (doc, input) = (&fitted.doc, plan.input.doc);
+    let mut candidates: Vec<(f64, usize)> = (0..fitted.kept.len())
+        .filter(|&i| !fitted.kept[i] && doc.tracks[i].times.len() > 2)
+        .map(|i| {
+            let share = doc.tracks[i].times.len() as f64 / input.tracks[i].times.len() as f64;
+            (share, i)
+        })
+        .filter(|&(share, _)| share >= MIN_SHARE)
+        .collect();
+    candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    candidates.into_iter().map(|(_, i)| i).collect()
 }
 
 /// What a track is to the fitter.
@@ -560,81 +660,24 @@ struct Plan<'a> {
     chain: Vec<usize>,
     /// Groups of track indices sharing key times.
     groups: Vec<Vec<usize>>,
-    /// The input played at the check times ([`metric::play`]).
-    rows: Vec<f32>,
 }
 
 impl<'a> Plan<'a> {
-    fn new(
-        input: Input<'a>,
-        settings: &'a Settings,
-        times: &'a [f64],
-        reference: &Arc<tcb_runtime::Clip>,
-    ) -> Self {
-        let rows = metric::play(reference, times);
-        let channels = input.clip.channel_count();
-        let n = times.len();
-        let mut tracks = Vec::new();
-        let mut at = 0;
-        for (doc, track) in input.doc.tracks.iter().zip(input.clip.tracks()) {
-            let kind = track.data.kind();
-            let dim = kind.dim();
-            let (t0, t1) = (track.data.times()[0], *track.data.times().last().unwrap());
-            let first = times.partition_point(|&t| t < t0);
-            let last = times.partition_point(|&t| t <= t1).saturating_sub(1);
-            let (resolved, _) = doc.settings.or(&input.doc.defaults).resolve();
-            let outside_line = |mode: Extrapolation| {
-                matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat)
-            };
-            let joint = match (settings.metric, input.skeleton) {
-                (Metric::Shell, Some(s)) => bound_joint(s, &track.name, kind),
-                _ => None,
-            };
-            let fit_it = last > first
-                && !(first > 0 && outside_line(resolved.pre))
-                && !(last + 1 < n && outside_line(resolved.post))
-                && (settings.metric == Metric::Value || joint.is_some());
-            tracks.push(fit_it.then(|| {
-                let mut samples: Vec<[f64; 4]> = (first..=last)
-                    .map(|i| {
-                        let row = &rows[i * channels + at..i * channels + at + dim];
-                        std::array::from_fn(|c| row.get(c).map_or(0.0, |v| f64::from(*v)))
-                    })
-                    .collect();
-                if kind == TrackKind::Quat {
-                    continuous_rotations(&mut samples);
-                }
-                Prepared {
-                    first,
-                    last,
-                    samples,
-                    joint,
-                }
-            }));
-            at += dim;
-        }
+    fn new(input: Input<'a>, settings: &'a Settings, reference: &'a Reference) -> Self {
+        let (times, rows) = (reference.times, &reference.rows[..]);
+        let tracks = prepare(input, settings, times, rows);
         let (reach, chain) = match input.skeleton {
-            Some(s) if settings.metric == Metric::Shell => {
-                chains(s, &tracks, input.clip, &rows, channels, settings.shell)
-            }
+            Some(s) if settings.metric == Metric::Shell => chains(
+                s,
+                &tracks,
+                input.clip,
+                rows,
+                input.clip.channel_count(),
+                settings.shell,
+            ),
             _ => (Vec::new(), Vec::new()),
         };
-        let mut groups: Vec<(String, usize, usize, Vec<usize>)> = Vec::new();
-        for (i, p) in tracks.iter().enumerate() {
-            let Some(p) = p else { continue };
-            let key = match settings.knots {
-                Knots::Track => input.clip.tracks()[i].name.clone(),
-                Knots::Joint => joint_name(&input.clip.tracks()[i].name).to_owned(),
-                Knots::Clip => String::new(),
-            };
-            match groups
-                .iter_mut()
-                .find(|g| g.0 == key && g.1 == p.first && g.2 == p.last)
-            {
-                Some(g) => g.3.push(i),
-                None => groups.push((key, p.first, p.last, vec![i])),
-            }
-        }
+        let groups = knot_groups(input.clip, settings.knots, &tracks);
         Plan {
             input,
             settings,
@@ -642,8 +685,7 @@ impl<'a> Plan<'a> {
             tracks,
             reach,
             chain,
-            groups: groups.into_iter().map(|g| g.3).collect(),
-            rows,
+            groups,
         }
     }
 
@@ -787,75 +829,17 @@ impl<'a> Plan<'a> {
     fn write(&self, fitted: &[Option<(&Fit, usize)>]) -> (ClipDoc, Vec<bool>) {
         let src = self.input.doc;
         let (base, _) = src.defaults.resolve();
-        let defaults = SettingsDoc {
-            tangent_rule: Some(TangentRule::Adjusted),
-            ends: Some(Ends::Copy),
-            match_speed: Some(false),
-            continuity_fade: Some(false),
-            tcb: Some([0.0; 3]),
-            pre: Some(base.pre),
-            post: Some(base.post),
-            rotation: Some(RotationMode::Hermite),
-            hemisphere: None,
-        };
+        let defaults = reduced_defaults(&base);
         let mut tracks = Vec::new();
         let mut kept = vec![false; src.tracks.len()];
         for (i, doc) in src.tracks.iter().enumerate() {
-            let (resolved, tcb) = doc.settings.or(&src.defaults).resolve();
-            let reduced = fitted[i].map(|(f, s)| {
-                let p = self.tracks[i].as_ref().expect("fitted");
-                let times = f.knots.iter().map(|&k| self.times[p.first + k]).collect();
-                let to_f32 = |v: &[f64; 4]| v.map(|c| c as f32);
-                let values = f.values[s].iter().map(to_f32).collect();
-                let keys = match f.mode {
-                    Tangents::Explicit => f.tangents[s]
-                        .iter()
-                        .map(|g| KeyDoc {
-                            tangent_in: Some(to_f32(g)),
-                            tangent_out: Some(to_f32(g)),
-                            ..KeyDoc::default()
-                        })
-                        .collect(),
-                    _ => Vec::new(),
-                };
-                TrackDoc {
-                    name: doc.name.clone(),
-                    kind: doc.kind,
-                    times,
-                    values,
-                    keys,
-                    settings: SettingsDoc {
-                        pre: Some(resolved.pre).filter(|m| *m != base.pre),
-                        post: Some(resolved.post).filter(|m| *m != base.post),
-                        // Fitted to a curve that keeps its keys as written:
-                        // so do the fitted keys.
-                        hemisphere: (doc.kind == TrackKind::Quat
-                            && resolved.hemisphere == Hemisphere::Keep)
-                            .then_some(Hemisphere::Keep),
-                        ..SettingsDoc::default()
-                    },
-                }
-            });
+            let (resolved, _) = doc.settings.or(&src.defaults).resolve();
+            let reduced = fitted[i].map(|(f, s)| self.fitted_track(i, f, s, &resolved, &base));
             match reduced {
                 Some(t) if stored_values(&t) < stored_values(doc) => tracks.push(t),
                 _ => {
                     kept[i] = true;
-                    // The original, with every setting it had stated against the new defaults.
-                    let full = SettingsDoc {
-                        tangent_rule: Some(resolved.tangent_rule),
-                        ends: Some(resolved.ends),
-                        match_speed: Some(resolved.match_speed),
-                        continuity_fade: Some(resolved.continuity_fade),
-                        tcb: Some(tcb.to_array()),
-                        pre: Some(resolved.pre),
-                        post: Some(resolved.post),
-                        rotation: (doc.kind == TrackKind::Quat).then_some(resolved.rotation),
-                        hemisphere: (doc.kind == TrackKind::Quat).then_some(resolved.hemisphere),
-                    };
-                    tracks.push(TrackDoc {
-                        settings: only_different(&full, &defaults),
-                        ..doc.clone()
-                    });
+                    tracks.push(kept_track(doc, &src.defaults, &defaults));
                 }
             }
         }
@@ -869,6 +853,166 @@ impl<'a> Plan<'a> {
             kept,
         )
     }
+
+    /// Track `i` as `fit` wrote it (its track number `slot` in the fit's
+    /// group): the fitted keys, and only the settings that differ from the
+    /// reduced clip's defaults (`base`, the input's, for pre and post).
+    fn fitted_track(
+        &self,
+        i: usize,
+        fit: &Fit,
+        slot: usize,
+        resolved: &TrackSettings,
+        base: &TrackSettings,
+    ) -> TrackDoc {
+        let doc = &self.input.doc.tracks[i];
+        let p = self.tracks[i].as_ref().expect("fitted");
+        let times = fit.knots.iter().map(|&k| self.times[p.first + k]).collect();
+        let to_f32 = |v: &[f64; 4]| v.map(|c| c as f32);
+        let values = fit.values[slot].iter().map(to_f32).collect();
+        let keys = match fit.mode {
+            Tangents::Explicit => fit.tangents[slot]
+                .iter()
+                .map(|g| KeyDoc {
+                    tangent_in: Some(to_f32(g)),
+                    tangent_out: Some(to_f32(g)),
+                    ..KeyDoc::default()
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        TrackDoc {
+            name: doc.name.clone(),
+            kind: doc.kind,
+            times,
+            values,
+            keys,
+            settings: SettingsDoc {
+                pre: Some(resolved.pre).filter(|m| *m != base.pre),
+                post: Some(resolved.post).filter(|m| *m != base.post),
+                // Fitted to a curve that keeps its keys as written:
+                // so do the fitted keys.
+                hemisphere: (doc.kind == TrackKind::Quat
+                    && resolved.hemisphere == Hemisphere::Keep)
+                    .then_some(Hemisphere::Keep),
+                ..SettingsDoc::default()
+            },
+        }
+    }
+}
+
+/// The reduced clip's defaults: what the fitter's curves are (`adjusted`,
+/// `copy` ends, tcb 0, `hermite` rotations), with the input's pre and post.
+fn reduced_defaults(base: &TrackSettings) -> SettingsDoc {
+    SettingsDoc {
+        tangent_rule: Some(TangentRule::Adjusted),
+        ends: Some(Ends::Copy),
+        match_speed: Some(false),
+        continuity_fade: Some(false),
+        tcb: Some([0.0; 3]),
+        pre: Some(base.pre),
+        post: Some(base.post),
+        rotation: Some(RotationMode::Hermite),
+        hemisphere: None,
+    }
+}
+
+/// The input's track `doc` as it was, with every setting it had (under
+/// `input_defaults`) stated against the reduced clip's `defaults`.
+fn kept_track(doc: &TrackDoc, input_defaults: &SettingsDoc, defaults: &SettingsDoc) -> TrackDoc {
+    let (resolved, tcb) = doc.settings.or(input_defaults).resolve();
+    let full = SettingsDoc {
+        tangent_rule: Some(resolved.tangent_rule),
+        ends: Some(resolved.ends),
+        match_speed: Some(resolved.match_speed),
+        continuity_fade: Some(resolved.continuity_fade),
+        tcb: Some(tcb.to_array()),
+        pre: Some(resolved.pre),
+        post: Some(resolved.post),
+        rotation: (doc.kind == TrackKind::Quat).then_some(resolved.rotation),
+        hemisphere: (doc.kind == TrackKind::Quat).then_some(resolved.hemisphere),
+    };
+    TrackDoc {
+        settings: only_different(&full, defaults),
+        ..doc.clone()
+    }
+}
+
+/// Per track: what the fitter takes (its span of check times and its
+/// samples in `rows`, the input played there), or `None` where the track
+/// is kept as it is: its `linear` or `offset-repeat` extrapolation is
+/// checked outside its keys, it spans fewer than 2 check times, or no
+/// joint uses it (under `shell`).
+fn prepare(
+    input: Input,
+    settings: &Settings,
+    times: &[f64],
+    rows: &[f32],
+) -> Vec<Option<Prepared>> {
+    let channels = input.clip.channel_count();
+    let n = times.len();
+    let mut tracks = Vec::new();
+    let mut at = 0;
+    for (doc, track) in input.doc.tracks.iter().zip(input.clip.tracks()) {
+        let kind = track.data.kind();
+        let dim = kind.dim();
+        let (t0, t1) = (track.data.times()[0], *track.data.times().last().unwrap());
+        let first = times.partition_point(|&t| t < t0);
+        let last = times.partition_point(|&t| t <= t1).saturating_sub(1);
+        let (resolved, _) = doc.settings.or(&input.doc.defaults).resolve();
+        let outside_line = |mode: Extrapolation| {
+            matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat)
+        };
+        let joint = match (settings.metric, input.skeleton) {
+            (Metric::Shell, Some(s)) => bound_joint(s, &track.name, kind),
+            _ => None,
+        };
+        let fit_it = last > first
+            && !(first > 0 && outside_line(resolved.pre))
+            && !(last + 1 < n && outside_line(resolved.post))
+            && (settings.metric == Metric::Value || joint.is_some());
+        tracks.push(fit_it.then(|| {
+            let mut samples: Vec<[f64; 4]> = (first..=last)
+                .map(|i| {
+                    let row = &rows[i * channels + at..i * channels + at + dim];
+                    std::array::from_fn(|c| row.get(c).map_or(0.0, |v| f64::from(*v)))
+                })
+                .collect();
+            if kind == TrackKind::Quat {
+                continuous_rotations(&mut samples);
+            }
+            Prepared {
+                first,
+                last,
+                samples,
+                joint,
+            }
+        }));
+        at += dim;
+    }
+    tracks
+}
+
+/// The fitted tracks in groups that share key times: by `knots` (the
+/// track, its joint, or the whole clip) and the same span of check times.
+fn knot_groups(clip: &Clip, knots: Knots, tracks: &[Option<Prepared>]) -> Vec<Vec<usize>> {
+    let mut groups: Vec<(String, usize, usize, Vec<usize>)> = Vec::new();
+    for (i, p) in tracks.iter().enumerate() {
+        let Some(p) = p else { continue };
+        let key = match knots {
+            Knots::Track => clip.tracks()[i].name.clone(),
+            Knots::Joint => joint_name(&clip.tracks()[i].name).to_owned(),
+            Knots::Clip => String::new(),
+        };
+        match groups
+            .iter_mut()
+            .find(|g| g.0 == key && g.1 == p.first && g.2 == p.last)
+        {
+            Some(g) => g.3.push(i),
+            None => groups.push((key, p.first, p.last, vec![i])),
+        }
+    }
+    groups.into_iter().map(|g| g.3).collect()
 }
 
 /// The fields of `full` that differ from `defaults`.
