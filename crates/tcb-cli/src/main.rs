@@ -488,11 +488,7 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
         )
         .into());
     }
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        return Err(format!("{}: no such directory", dir.display()).into());
-    }
+    output_folder_exists(&args.output)?;
     let started = std::time::Instant::now();
     // A BVH's rotations are samples: played as `hermite`, the way a packed
     // clip plays them, unless asked otherwise.
@@ -512,17 +508,7 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     let c = with_progress("tcb: measuring {bar:30} {pos}/{len} clips", |progress| {
         tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, progress)
     })?;
-    let s = &c.settings;
-    match s.metric {
-        tcb_fit::Metric::Shell => eprintln!(
-            "tcb: metric shell, tolerance {:e}, shell {:e} (rest-pose height {})",
-            s.tolerance, s.shell, s.height
-        ),
-        tcb_fit::Metric::Value => eprintln!(
-            "tcb: metric value, tolerance {:e}, rotation tolerance {} degrees",
-            s.tolerance, s.rotation_tolerance
-        ),
-    }
+    eprintln!("tcb: {}", metric_line(&c.settings));
     let bytes = c.packed.to_bytes();
     tcb_io::write_atomically(&args.output, &bytes)?;
     eprintln!(
@@ -533,6 +519,59 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     );
     println!("{}", c.summary_line());
     Ok(())
+}
+
+/// The output's folder exists: found out before the work, not after it.
+fn output_folder_exists(output: &std::path::Path) -> Result<(), BoxError> {
+    match output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => Err(format!("{}: no such directory", dir.display()).into()),
+        _ => Ok(()),
+    }
+}
+
+/// The metric and its tolerances, as `tcb reduce` and `tcb compress` print
+/// them.
+fn metric_line(s: &tcb_fit::reduce::Settings) -> String {
+    match s.metric {
+        tcb_fit::Metric::Shell => format!(
+            "metric shell, tolerance {:e}, shell {:e} (rest-pose height {})",
+            s.tolerance, s.shell, s.height
+        ),
+        tcb_fit::Metric::Value => format!(
+            "metric value, tolerance {:e}, rotation tolerance {} degrees",
+            s.tolerance, s.rotation_tolerance
+        ),
+    }
+}
+
+/// On stderr: the settings `tcb reduce` worked with, each round's fits and
+/// error, and the tracks kept as they were.
+fn report_rounds(reduced: &tcb_fit::Reduced) {
+    let s = &reduced.settings;
+    eprintln!(
+        "tcb: {}, knots {}, tangents {}",
+        metric_line(s),
+        s.knots.name(),
+        s.tangents.name()
+    );
+    for a in &reduced.attempts {
+        eprintln!(
+            "tcb: round {}: {} groups fitted, values {}, error {:.3} of the tolerance ({} at {} s)",
+            a.round + 1,
+            a.fitted,
+            a.values,
+            a.ratio,
+            a.worst.at,
+            a.worst.time
+        );
+    }
+    if !reduced.kept.is_empty() {
+        eprintln!(
+            "tcb: {} tracks kept as they were: {}",
+            reduced.kept.len(),
+            reduced.kept.join(", ")
+        );
+    }
 }
 
 /// `work` with a progress bar on stderr (drawn only on a terminal) that it
@@ -583,12 +622,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     if extension(&args.output) != "json" {
         return Err(format!("{}: the output must end in .json", args.output.display()).into());
     }
-    // Found out before the work, not after it.
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        return Err(format!("{}: no such directory", dir.display()).into());
-    }
+    output_folder_exists(&args.output)?;
     let started = std::time::Instant::now();
     let import = import_options(&args.input, args.rotation, args.animation.as_ref())?;
     let loaded = tcb_io::load_with(&args.input, &import)?;
@@ -609,42 +643,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     let reduced = with_progress("tcb: fitting {bar:30} {pos}/{len} groups", |progress| {
         tcb_fit::reduce(input, &options, progress)
     })?;
-    let s = &reduced.settings;
-    match s.metric {
-        tcb_fit::Metric::Shell => eprintln!(
-            "tcb: metric shell, tolerance {:e}, shell {:e} (rest-pose height {}), knots {}, tangents {}",
-            s.tolerance,
-            s.shell,
-            s.height,
-            s.knots.name(),
-            s.tangents.name()
-        ),
-        tcb_fit::Metric::Value => eprintln!(
-            "tcb: metric value, tolerance {:e}, rotation tolerance {} degrees, knots {}, tangents {}",
-            s.tolerance,
-            s.rotation_tolerance,
-            s.knots.name(),
-            s.tangents.name()
-        ),
-    }
-    for a in &reduced.attempts {
-        eprintln!(
-            "tcb: round {}: {} groups fitted, values {}, error {:.3} of the tolerance ({} at {} s)",
-            a.round + 1,
-            a.fitted,
-            a.values,
-            a.ratio,
-            a.worst.at,
-            a.worst.time
-        );
-    }
-    if !reduced.kept.is_empty() {
-        eprintln!(
-            "tcb: {} tracks kept as they were: {}",
-            reduced.kept.len(),
-            reduced.kept.join(", ")
-        );
-    }
+    report_rounds(&reduced);
     tcb_io::write_clip_doc(&reduced.doc, &args.output)?;
     eprintln!(
         "tcb: wrote {} in {:.2} s",
@@ -700,53 +699,8 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
         }
         None => writeln!(out, "skeleton: none")?,
     }
-    writeln!(out, "tracks:")?;
-    writeln!(
-        out,
-        "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
-        "name", "kind", "keys", "first", "last"
-    )?;
-    for (t, id) in clip.tracks().iter().zip(runtime.layout().ids()) {
-        let times = t.data.times();
-        let (mode, settings) = match &t.data {
-            tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
-            tcb_core::TrackData::Scalar(v) => ("-", v.settings()),
-            tcb_core::TrackData::Vec2(v) => ("-", v.settings()),
-            tcb_core::TrackData::Vec3(v) => ("-", v.settings()),
-            tcb_core::TrackData::Vec4(v) => ("-", v.settings()),
-        };
-        writeln!(
-            out,
-            "  {:<32} {:<6} {:>6} {:>12} {:>12}  {mode} {}/{}",
-            t.name,
-            t.data.kind().name(),
-            times.len(),
-            times[0],
-            times[times.len() - 1],
-            settings.pre.name(),
-            settings.post.name()
-        )?;
-        if args.quantize {
-            let e = runtime.quantization_error(id).unwrap_or(0.0);
-            writeln!(out, "    quantization error at most {e:e}")?;
-        }
-    }
-    writeln!(
-        out,
-        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation segment(s) evaluated exactly (f64 squad; {} of them only when velocities are sampled)",
-        stats.grids.len(),
-        stats.loose_vector_tracks,
-        stats.loose_rotation_tracks,
-        stats.exact_segments,
-        stats.exact_for_velocity_only
-    )?;
-    for (i, g) in stats.grids.iter().enumerate() {
-        writeln!(
-            out,
-            "  grid {i}: {} keys ({} with incoming tangents stored apart), {} vector channels, {} rotations",
-            g.keys, g.keys_with_own_incoming, g.vector_channels, g.rotations
-        )?;
-    }
+    write_tracks(&mut out, clip, &runtime, args.quantize)?;
+    write_runtime_stats(&mut out, &stats)?;
     writeln!(
         out,
         "bytes: {} compiled (no copy of the source kept), {} read per frame inside the keys",
@@ -794,6 +748,95 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
             &packed.note
         }
     )?;
+    write_packed_tracks(&mut out, head)?;
+    writeln!(
+        out,
+        "stored: {values} values in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",
+        packed.stream_bits(),
+        packed.stream_bits() as f64 / values.max(1) as f64,
+        8.0 * file as f64 / values.max(1) as f64
+    )?;
+    writeln!(
+        out,
+        "bytes: {} compiled ({} of them the packed stream and its tables)",
+        mb(runtime.memory_bytes()),
+        packed.stream_bytes()
+    )?;
+    write_load(&mut out, &args.clip, &runtime)?;
+    io::stdout().lock().write_all(out.as_bytes())?;
+    Ok(())
+}
+
+/// `tcb info`'s table of tracks: kind, keys, time range, rotation mode,
+/// pre/post and, with `quantize`, each track's quantization error.
+fn write_tracks(
+    out: &mut String,
+    clip: &Clip,
+    runtime: &tcb_runtime::Clip,
+    quantize: bool,
+) -> Result<(), BoxError> {
+    use std::fmt::Write as _;
+    writeln!(out, "tracks:")?;
+    writeln!(
+        out,
+        "  {:<32} {:<6} {:>6} {:>12} {:>12}  rotation pre/post",
+        "name", "kind", "keys", "first", "last"
+    )?;
+    for (t, id) in clip.tracks().iter().zip(runtime.layout().ids()) {
+        let times = t.data.times();
+        let (mode, settings) = match &t.data {
+            tcb_core::TrackData::Quat(r) => (r.settings().rotation.name(), r.settings()),
+            tcb_core::TrackData::Scalar(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec2(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec3(v) => ("-", v.settings()),
+            tcb_core::TrackData::Vec4(v) => ("-", v.settings()),
+        };
+        writeln!(
+            out,
+            "  {:<32} {:<6} {:>6} {:>12} {:>12}  {mode} {}/{}",
+            t.name,
+            t.data.kind().name(),
+            times.len(),
+            times[0],
+            times[times.len() - 1],
+            settings.pre.name(),
+            settings.post.name()
+        )?;
+        if quantize {
+            let e = runtime.quantization_error(id).unwrap_or(0.0);
+            writeln!(out, "    quantization error at most {e:e}")?;
+        }
+    }
+    Ok(())
+}
+
+/// `tcb info`'s account of the compiled clip: key grids, loose lanes,
+/// exact segments and bytes.
+fn write_runtime_stats(out: &mut String, stats: &tcb_runtime::ClipStats) -> Result<(), BoxError> {
+    use std::fmt::Write as _;
+    writeln!(
+        out,
+        "runtime: {} shared key grid(s), {} loose vector track(s), {} loose rotation(s), {} rotation segment(s) evaluated exactly (f64 squad; {} of them only when velocities are sampled)",
+        stats.grids.len(),
+        stats.loose_vector_tracks,
+        stats.loose_rotation_tracks,
+        stats.exact_segments,
+        stats.exact_for_velocity_only
+    )?;
+    for (i, g) in stats.grids.iter().enumerate() {
+        writeln!(
+            out,
+            "  grid {i}: {} keys ({} with incoming tangents stored apart), {} vector channels, {} rotations",
+            g.keys, g.keys_with_own_incoming, g.vector_channels, g.rotations
+        )?;
+    }
+    Ok(())
+}
+
+/// `tcb info`'s table of a `.tcbc` file's tracks: kind, stored components
+/// and quantization step.
+fn write_packed_tracks(out: &mut String, head: &tcb_runtime::PackSource) -> Result<(), BoxError> {
+    use std::fmt::Write as _;
     writeln!(out, "tracks:")?;
     writeln!(
         out,
@@ -810,23 +853,20 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
             t.step
         )?;
     }
-    writeln!(
-        out,
-        "stored: {values} values in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",
-        packed.stream_bits(),
-        packed.stream_bits() as f64 / values.max(1) as f64,
-        8.0 * file as f64 / values.max(1) as f64
-    )?;
-    writeln!(
-        out,
-        "bytes: {} compiled ({} of them the packed stream and its tables)",
-        mb(runtime.memory_bytes()),
-        packed.stream_bytes()
-    )?;
-    // What a game pays to load it: `Clip::from_bytes` (the file's checks,
-    // the end blocks decoded, a reference of the end keys compiled),
-    // fastest of 3; then the check of every key against the reference.
-    let bytes = std::fs::read(&args.clip)?;
+    Ok(())
+}
+
+/// What a game pays to load the `.tcbc` file at `path`: `Clip::from_bytes`
+/// (the file's checks, the end blocks decoded, a reference of the end keys
+/// compiled), fastest of 3; then the check of every key of `runtime`
+/// against the reference.
+fn write_load(
+    out: &mut String,
+    path: &std::path::Path,
+    runtime: &tcb_runtime::Clip,
+) -> Result<(), BoxError> {
+    use std::fmt::Write as _;
+    let bytes = std::fs::read(path)?;
     let load = (0..3)
         .map(|_| {
             let t = std::time::Instant::now();
@@ -843,13 +883,12 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
     let t = std::time::Instant::now();
     runtime
         .verify_packed()
-        .map_err(|e| format!("{}: {e}", args.clip.display()))?;
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     writeln!(
         out,
         "verified: every key's controls are the reference's, bit for bit ({:.1} ms)",
         t.elapsed().as_secs_f64() * 1e3
     )?;
-    io::stdout().lock().write_all(out.as_bytes())?;
     Ok(())
 }
 
