@@ -190,7 +190,8 @@ impl BaselineTrack {
         }
     }
 
-    /// Write this track's values; returns how many.
+    /// Write this track's values; returns how many. Kept whole: it is the
+    /// timed scalar baseline, and every `x baseline` ratio is its time.
     fn sample(&self, time: f64, out: &mut [f32]) -> usize {
         let dim = match &self.shape {
             Shape::Curve { dim, .. } => *dim,

@@ -143,50 +143,8 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         return Err("--icount-max-growth must be a number >= 0".into());
     }
     let saved = read_json(args.icount_check.as_deref())?;
-    // The bundled scenarios, or with --clip the user's files, each named by
-    // its file stem as the report names it.
     let scratch = std::env::temp_dir().join(format!("tcb-icount-{}", std::process::id()));
-    let jobs: Vec<(String, Option<PathBuf>)> = if args.clip.is_empty() {
-        let names: Vec<&str> = match &args.only {
-            Some(o) => o.split(',').map(str::trim).collect(),
-            None => icount::names(),
-        };
-        if let Some(bad) = names.iter().find(|n| !icount::names().contains(n)) {
-            return Err(format!(
-                "--only {bad}: not counted (one of {})",
-                icount::names().join(", ")
-            )
-            .into());
-        }
-        let mut jobs = Vec::new();
-        for n in names {
-            let clip = if n == "character-reduced" {
-                // Reduced here, natively; counted from the written clip.
-                let doc = scenarios::reduced_doc(&args.bvh)?;
-                std::fs::create_dir_all(&scratch)?;
-                let path = scratch.join("character-reduced.json");
-                tcb_io::write_clip_doc(&doc, &path)?;
-                Some(path)
-            } else if n.starts_with("character-compressed") {
-                // Compressed here too (a search of clips measured); counted
-                // from the written .tcbc, which the counted process loads.
-                let packed = scenarios::compress_cmu(&args.bvh, n.ends_with("acl"))?;
-                std::fs::create_dir_all(&scratch)?;
-                let path = scratch.join(format!("{n}.tcbc"));
-                tcb_io::write_atomically(&path, &packed.to_bytes())?;
-                Some(path)
-            } else {
-                None
-            };
-            jobs.push((n.to_string(), clip));
-        }
-        jobs
-    } else {
-        args.clip
-            .iter()
-            .map(|p| Ok((scenarios::file(p)?.name, Some(p.clone()))))
-            .collect::<Result<_, tcb_io::Error>>()?
-    };
+    let jobs = icount_jobs(args, &scratch)?;
     let exe = std::env::current_exe()?;
     let mut counts = std::collections::BTreeMap::new();
     println!("tcb-bench --icount: instructions of one runtime pass under callgrind");
@@ -232,37 +190,85 @@ instruction counts against the saved ones:"
     Ok(ok)
 }
 
+/// A scenario `--icount` counts, by name, and the clip file its pass
+/// loads (none for the bundled scenarios built from the BVH).
+type Job = (String, Option<PathBuf>);
+
+/// What `--icount` counts: the bundled scenarios (`--only` of them), or
+/// with `--clip` the user's files, each named by its file stem as the
+/// report names it, with the clip file the counted process loads (the
+/// reduced and compressed scenarios are made here, into `scratch`).
+fn icount_jobs(
+    args: &Args,
+    scratch: &std::path::Path,
+) -> Result<Vec<Job>, Box<dyn std::error::Error>> {
+    if !args.clip.is_empty() {
+        return Ok(args
+            .clip
+            .iter()
+            .map(|p| Ok((scenarios::file(p)?.name, Some(p.clone()))))
+            .collect::<Result<_, tcb_io::Error>>()?);
+    }
+    let names: Vec<&str> = match &args.only {
+        Some(o) => o.split(',').map(str::trim).collect(),
+        None => icount::names(),
+    };
+    if let Some(bad) = names.iter().find(|n| !icount::names().contains(n)) {
+        return Err(format!(
+            "--only {bad}: not counted (one of {})",
+            icount::names().join(", ")
+        )
+        .into());
+    }
+    let mut jobs = Vec::new();
+    for n in names {
+        let clip = if n == "character-reduced" {
+            // Reduced here, natively; counted from the written clip.
+            let doc = scenarios::reduced_doc(&args.bvh)?;
+            std::fs::create_dir_all(scratch)?;
+            let path = scratch.join("character-reduced.json");
+            tcb_io::write_clip_doc(&doc, &path)?;
+            Some(path)
+        } else if n.starts_with("character-compressed") {
+            // Compressed here too (a search of clips measured); counted
+            // from the written .tcbc, which the counted process loads.
+            let packed = scenarios::compress_cmu(&args.bvh, n.ends_with("acl"))?;
+            std::fs::create_dir_all(scratch)?;
+            let path = scratch.join(format!("{n}.tcbc"));
+            tcb_io::write_atomically(&path, &packed.to_bytes())?;
+            Some(path)
+        } else {
+            None
+        };
+        jobs.push((n.to_string(), clip));
+    }
+    Ok(jobs)
+}
+
+/// `--icount-pass NAME` (hidden): the one runtime pass that `--icount`
+/// counts, run inside callgrind.
+fn run_pass(args: &Args, name: &str) -> Result<bool, Box<dyn std::error::Error>> {
+    if icount::EXTRA.contains(&name) {
+        icount::run_extra(name, &args.bvh)?;
+        return Ok(true);
+    }
+    let s = match args.clip.first() {
+        Some(p) => vec![scenarios::file(p)?],
+        None => scenarios::named(&args.bvh, |n| n == name)?,
+    };
+    let s = s.first().ok_or_else(|| format!("no scenario {name}"))?;
+    icount::run_pass(s);
+    Ok(true)
+}
+
 fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if let Some(name) = &args.icount_pass {
-        if icount::EXTRA.contains(&name.as_str()) {
-            icount::run_extra(name, &args.bvh)?;
-            return Ok(true);
-        }
-        let s = match args.clip.first() {
-            Some(p) => vec![scenarios::file(p)?],
-            None => scenarios::named(&args.bvh, |n| n == name)?,
-        };
-        let s = s.first().ok_or_else(|| format!("no scenario {name}"))?;
-        icount::run_pass(s);
-        return Ok(true);
+        return run_pass(args, name);
     }
     if args.icount {
         return run_icount(args);
     }
-    let mut timing = if args.quick {
-        report::Timing::QUICK
-    } else {
-        report::Timing::FULL
-    };
-    if let Some(r) = args.rounds {
-        timing.rounds = r;
-    }
-    if let Some(ms) = args.slice_ms {
-        timing.slice = Duration::from_millis(ms.max(1));
-    }
-    if args.max_regression.is_nan() || args.max_regression < 0.0 || timing.rounds == 0 {
-        return Err("--max-regression must be >= 0 and --rounds > 0".into());
-    }
+    let timing = timing(args)?;
     // Find and read the saved report first: a bad name or file should fail
     // before a minute of timing.
     let save = args
@@ -270,21 +276,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         .as_deref()
         .map(baseline_path)
         .transpose()?;
-    let compare = match (&args.check, &args.baseline) {
-        (Some(p), _) => Some(p.clone()),
-        (None, Some(name)) => {
-            let p = baseline_path(name)?;
-            if !p.exists() {
-                return Err(format!(
-                    "no baseline '{name}' ({}): save one first with --save-baseline {name}",
-                    p.display()
-                )
-                .into());
-            }
-            Some(p)
-        }
-        (None, None) => None,
-    };
+    let compare = compared_report(args)?;
     let saved = read_json(compare.as_deref())?;
     // And the markdown file, for the same reason.
     let markdown_doc = match &args.markdown {
@@ -299,19 +291,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         eprintln!("tcb-bench: warning: a debug build; numbers mean little (use --release)");
     }
     let load = markdown::load_average();
-    let names: Option<Vec<&str>> = args
-        .only
-        .as_ref()
-        .map(|o| o.split(',').map(str::trim).collect());
-    if let Some(names) = &names
-        && let Some(bad) = names.iter().find(|n| !scenarios::NAMES.contains(n))
-    {
-        return Err(format!(
-            "--only {bad}: no such scenario (one of {})",
-            scenarios::NAMES.join(", ")
-        )
-        .into());
-    }
+    let names = only_names(args)?;
     let all = if args.clip.is_empty() {
         scenarios::named(&args.bvh, |n| names.as_ref().is_none_or(|w| w.contains(&n)))?
     } else {
@@ -323,19 +303,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     let mut rows: Vec<_> = all.iter().map(|s| report::measure(s, &timing)).collect();
     report::relate(&mut rows);
     let here = report::Fingerprint::here();
-    print!("{}", report::table(&rows, &here, &timing));
-    let goals = report::goals(&rows);
-    if !goals.is_empty() {
-        println!("\ngoals (the README's \"Goals\"):");
-        for (line, met) in goals {
-            println!("  {} {line}", if met { "met    " } else { "not yet" });
-        }
-    }
-    if args.quick {
-        println!(
-            "\nThis was --quick; run without it for the full report (11 rounds of 20 ms, every frame)."
-        );
-    }
+    print_report(args, &rows, &here, &timing);
     let doc = report::to_json(&rows, &here, &timing);
     let text = serde_json::to_string_pretty(&doc)? + "\n";
     for path in args.json.iter().chain(&save) {
@@ -345,13 +313,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         tcb_io::write_atomically(path, text.as_bytes())?;
     }
     if let Some(path) = &args.markdown {
-        let argv: Vec<String> = std::env::args().skip(1).collect();
-        let command = markdown::command(
-            env!("TCB_BENCH_RUSTFLAGS"),
-            env!("TCB_BENCH_PROFILE"),
-            &argv,
-        );
-        let table = markdown::table(&rows, &here, &timing, &command, &report::today(), load);
+        let table = markdown_table(&rows, &here, &timing, load);
         let doc = markdown::update(markdown_doc.as_deref(), &table, &path.display().to_string())?;
         tcb_io::write_atomically(path, doc.as_bytes())?;
         println!(
@@ -365,23 +327,132 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     }
     let mut ok = true;
     if let (Some(saved), Some(path)) = (&saved, &compare) {
-        // With --only, scenarios left out are not missing.
-        let mut saved = saved.clone();
-        if names.is_some()
-            && let Some(s) = saved.get_mut("scenarios").and_then(|s| s.as_array_mut())
-        {
-            s.retain(|x| {
-                x.get("name")
-                    .and_then(|n| n.as_str())
-                    .is_some_and(|n| rows.iter().any(|r| r.name == n))
-            });
-        }
-        let (lines, held) = report::check(&rows, &saved, &here, &timing, args.max_regression);
-        println!("\nagainst {}:", path.display());
-        for l in lines {
-            println!("  {l}");
-        }
-        ok = held;
+        ok = check_saved(args, saved, path, names.is_some(), &rows, &here, &timing);
     }
     Ok(ok)
+}
+
+/// This machine's table for `--markdown`, with the command that made it.
+fn markdown_table(
+    rows: &[report::Row],
+    here: &report::Fingerprint,
+    timing: &report::Timing,
+    load: Option<f64>,
+) -> String {
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    let command = markdown::command(
+        env!("TCB_BENCH_RUSTFLAGS"),
+        env!("TCB_BENCH_PROFILE"),
+        &argv,
+    );
+    markdown::table(rows, here, timing, &command, &report::today(), load)
+}
+
+/// `--check` or `--baseline`: this run against the `saved` report (read
+/// from `path`; with `--only`, its other scenarios are not missing), the
+/// lines printed; whether everything held.
+fn check_saved(
+    args: &Args,
+    saved: &serde_json::Value,
+    path: &std::path::Path,
+    only: bool,
+    rows: &[report::Row],
+    here: &report::Fingerprint,
+    timing: &report::Timing,
+) -> bool {
+    let mut saved = saved.clone();
+    if only && let Some(s) = saved.get_mut("scenarios").and_then(|s| s.as_array_mut()) {
+        s.retain(|x| {
+            x.get("name")
+                .and_then(|n| n.as_str())
+                .is_some_and(|n| rows.iter().any(|r| r.name == n))
+        });
+    }
+    let (lines, held) = report::check(rows, &saved, here, timing, args.max_regression);
+    println!("\nagainst {}:", path.display());
+    for l in lines {
+        println!("  {l}");
+    }
+    held
+}
+
+/// The rounds and slices of timing: `--quick` or the full report, with
+/// `--rounds` and `--slice-ms` over them.
+fn timing(args: &Args) -> Result<report::Timing, Box<dyn std::error::Error>> {
+    let mut timing = if args.quick {
+        report::Timing::QUICK
+    } else {
+        report::Timing::FULL
+    };
+    if let Some(r) = args.rounds {
+        timing.rounds = r;
+    }
+    if let Some(ms) = args.slice_ms {
+        timing.slice = Duration::from_millis(ms.max(1));
+    }
+    if args.max_regression.is_nan() || args.max_regression < 0.0 || timing.rounds == 0 {
+        return Err("--max-regression must be >= 0 and --rounds > 0".into());
+    }
+    Ok(timing)
+}
+
+/// The saved report to compare with: `--check PATH`, or `--baseline NAME`
+/// (which must have been saved).
+fn compared_report(args: &Args) -> Result<Option<PathBuf>, Box<dyn std::error::Error>> {
+    Ok(match (&args.check, &args.baseline) {
+        (Some(p), _) => Some(p.clone()),
+        (None, Some(name)) => {
+            let p = baseline_path(name)?;
+            if !p.exists() {
+                return Err(format!(
+                    "no baseline '{name}' ({}): save one first with --save-baseline {name}",
+                    p.display()
+                )
+                .into());
+            }
+            Some(p)
+        }
+        (None, None) => None,
+    })
+}
+
+/// The scenarios `--only` names, each checked to be one.
+fn only_names(args: &Args) -> Result<Option<Vec<&str>>, Box<dyn std::error::Error>> {
+    let names: Option<Vec<&str>> = args
+        .only
+        .as_ref()
+        .map(|o| o.split(',').map(str::trim).collect());
+    if let Some(names) = &names
+        && let Some(bad) = names.iter().find(|n| !scenarios::NAMES.contains(n))
+    {
+        return Err(format!(
+            "--only {bad}: no such scenario (one of {})",
+            scenarios::NAMES.join(", ")
+        )
+        .into());
+    }
+    Ok(names)
+}
+
+/// The report on stdout: the table, the README's goals met or not, and a
+/// word after `--quick`.
+fn print_report(
+    args: &Args,
+    rows: &[report::Row],
+    here: &report::Fingerprint,
+    timing: &report::Timing,
+) {
+    print!("{}", report::table(rows, here, timing));
+    let goals = report::goals(rows);
+    if !goals.is_empty() {
+        println!("\ngoals (the README's \"Goals\"):");
+        for (line, met) in goals {
+            println!("  {} {line}", if met { "met    " } else { "not yet" });
+        }
+    }
+    if args.quick {
+        println!(
+            "\nThis was --quick; run without it for the full report (11 rounds of 20 ms, every frame)."
+        );
+    }
 }

@@ -240,6 +240,30 @@ pub fn measure(s: &Scenario, timing: &Timing) -> Row {
             s.name
         );
     }
+    let mut subjects = subjects(s, timing);
+    let secs = rounds_seconds(&mut subjects, timing.rounds, timing.slice);
+    for (sub, t) in subjects.iter().zip(&secs) {
+        let ns: Vec<f64> = t.iter().map(|t| t * 1e9 / sub.samples).collect();
+        row.ns.push((sub.name, noise::median(&ns)));
+        row.rounds.push((sub.name, ns));
+    }
+    let rt = row.ns_of("runtime").expect("always timed");
+    row.speedup_vs_baseline = row.ns_of("baseline").expect("always timed") / rt;
+    row.speedup_vs_splines = row.ns_of("splines").map(|x| x / rt);
+    row.read_limit_fraction = row.ns_of("read_limit").map(|x| x / rt);
+    row.parallel_speedup = row.ns_of("runtime_parallel").map(|x| rt / x);
+    row.threads_speedup = row.ns_of("threads").map(|x| rt / x);
+    row.ns_per_joint = s.joints.map(|j| rt * s.channels() as f64 / j as f64);
+    row.ns.retain(|(n, _)| *n != "read_limit");
+    row.rounds.retain(|(n, _)| *n != "read_limit");
+    row
+}
+
+/// What is timed on `s`, each with the channel-samples one pass takes: the
+/// scalar baseline (on the reference's subset of times and phases) and the
+/// runtime always; rayon and plain threads on a parallel scenario, the
+/// splines crate where it is a peer, and the read limit where asked.
+fn subjects<'a>(s: &'a Scenario, timing: &Timing) -> Vec<Subject<'a>> {
     let all = s.channel_samples();
     let (times, phases) = s.reference_subset(timing.reference_samples);
     let thinned = (times.len() * phases.len() * s.channels()) as f64;
@@ -282,22 +306,7 @@ pub fn measure(s: &Scenario, timing: &Timing) -> Row {
             run: Box::new(s.read_pass()),
         });
     }
-    let secs = rounds_seconds(&mut subjects, timing.rounds, timing.slice);
-    for (sub, t) in subjects.iter().zip(&secs) {
-        let ns: Vec<f64> = t.iter().map(|t| t * 1e9 / sub.samples).collect();
-        row.ns.push((sub.name, noise::median(&ns)));
-        row.rounds.push((sub.name, ns));
-    }
-    let rt = row.ns_of("runtime").expect("always timed");
-    row.speedup_vs_baseline = row.ns_of("baseline").expect("always timed") / rt;
-    row.speedup_vs_splines = row.ns_of("splines").map(|x| x / rt);
-    row.read_limit_fraction = row.ns_of("read_limit").map(|x| x / rt);
-    row.parallel_speedup = row.ns_of("runtime_parallel").map(|x| rt / x);
-    row.threads_speedup = row.ns_of("threads").map(|x| rt / x);
-    row.ns_per_joint = s.joints.map(|j| rt * s.channels() as f64 / j as f64);
-    row.ns.retain(|(n, _)| *n != "read_limit");
-    row.rounds.retain(|(n, _)| *n != "read_limit");
-    row
+    subjects
 }
 
 /// Ratios between rows: `character-reduced` against `character-hermite`.
@@ -466,8 +475,26 @@ ns/joint: runtime nanoseconds per animated joint per frame. MB: the compiled cli
 /// The project's published goals (the README's *Goals*), each with what
 /// was measured: `(line, met)`.
 pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
-    let get = |n: &str| rows.iter().find(|r| r.name == n);
     let mut out = Vec::new();
+    wide_goals(rows, &mut out);
+    character_goals(rows, &mut out);
+    compressed_goals(rows, &mut out);
+    scaling_goals(rows, &mut out);
+    for r in rows {
+        if let Some(x) = r.speedup_vs_splines {
+            out.push((
+                format!("{}: {x:.1}x the splines crate (goal: at least 20x)", r.name),
+                x >= 20.0,
+            ));
+        }
+    }
+    out
+}
+
+/// The goals of `wide`: its speed over the baseline (4x on a default
+/// build, 8x with AVX2) and its share of the read limit.
+fn wide_goals(rows: &[Row], out: &mut Vec<(String, bool)>) {
+    let get = |n: &str| rows.iter().find(|r| r.name == n);
     let native = cfg!(target_feature = "avx2");
     if let Some(w) = get("wide") {
         let need = if native { 8.0 } else { 4.0 };
@@ -488,6 +515,12 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
             ));
         }
     }
+}
+
+/// The goals of the CMU character: time per joint, bytes dense and
+/// quantized, and the reduced clip's time and bytes.
+fn character_goals(rows: &[Row], out: &mut Vec<(String, bool)>) {
+    let get = |n: &str| rows.iter().find(|r| r.name == n);
     for (n, limit) in [("character-hermite", 2.5), ("character-squad", 3.0)] {
         if let Some(j) = get(n).and_then(|r| r.ns_per_joint) {
             out.push((
@@ -526,6 +559,12 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
             j <= 1.5,
         ));
     }
+}
+
+/// The goals of the compressed CMU clips: bytes against ACL's, time
+/// against the dense clip's.
+fn compressed_goals(rows: &[Row], out: &mut Vec<(String, bool)>) {
+    let get = |n: &str| rows.iter().find(|r| r.name == n);
     for (n, what) in [
         ("character-compressed", "the default tolerance"),
         ("character-compressed-acl", "ACL's target"),
@@ -554,6 +593,12 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
             ));
         }
     }
+}
+
+/// The goals of cost as clips change shape: seeking against playing
+/// forward, a crowd on rayon, sparse tracks against `wide`.
+fn scaling_goals(rows: &[Row], out: &mut Vec<(String, bool)>) {
+    let get = |n: &str| rows.iter().find(|r| r.name == n);
     if let (Some(s), Some(c)) = (get("seek"), get("character-hermite")) {
         let (a, b) = (
             s.ns_of("runtime").unwrap_or(f64::NAN),
@@ -597,15 +642,6 @@ pub fn goals(rows: &[Row]) -> Vec<(String, bool)> {
             ));
         }
     }
-    for r in rows {
-        if let Some(x) = r.speedup_vs_splines {
-            out.push((
-                format!("{}: {x:.1}x the splines crate (goal: at least 20x)", r.name),
-                x >= 20.0,
-            ));
-        }
-    }
-    out
 }
 
 /// Spreads (MADs of the rounds) a same-machine slowdown must exceed
@@ -677,6 +713,45 @@ pub fn check(
             false,
         );
     };
+    let same = comparable(saved, here, timing, max_regression, &mut lines);
+    let rule = Rule {
+        k: NOISE_K,
+        min_rel: max_regression / 100.0,
+    };
+    let mut medians_only = false;
+    for s in scenarios {
+        let Some(name) = s.get("name").and_then(Value::as_str) else {
+            continue;
+        };
+        let Some(row) = rows.iter().find(|r| r.name == name) else {
+            lines.push(format!(
+                "MISSING {name}: in the saved report but not measured"
+            ));
+            ok = false;
+            continue;
+        };
+        let (held, rounds) = check_scenario(s, name, row, same, rule, &mut lines);
+        ok &= held;
+        medians_only |= !rounds;
+    }
+    if medians_only {
+        lines.push(
+            "note: the saved report has medians but no rounds (saved before rounds were): its times were compared by the threshold alone".into(),
+        );
+    }
+    (lines, ok)
+}
+
+/// Whether this run's times may be compared with the `saved` report's:
+/// saved on this machine and build ([`Fingerprint`]). Notes why not, and a
+/// different timing, in `lines`; when they may, the rule that applies.
+fn comparable(
+    saved: &Value,
+    here: &Fingerprint,
+    timing: &Timing,
+    max_regression: f64,
+    lines: &mut Vec<String>,
+) -> bool {
     let now = to_json(&[], here, timing);
     if let Some(then) = saved.get("timing")
         && *then != now["timing"]
@@ -708,84 +783,80 @@ pub fn check(
     if same {
         lines.push(check_rule(max_regression));
     }
-    let rule = Rule {
-        k: NOISE_K,
-        min_rel: max_regression / 100.0,
-    };
-    let mut medians_only = false;
-    for s in scenarios {
-        let Some(name) = s.get("name").and_then(Value::as_str) else {
+    same
+}
+
+/// [`check`] of one saved scenario `s` (named `name`) against this run's
+/// `row`, its lines pushed to `lines`: the runtime's time by `rule` where
+/// the machine is the `same`, other ratios as information, bytes always.
+/// Whether it held, and whether the saved report had rounds (not medians
+/// alone).
+fn check_scenario(
+    s: &Value,
+    name: &str,
+    row: &Row,
+    same: bool,
+    rule: Rule,
+    lines: &mut Vec<String>,
+) -> (bool, bool) {
+    let mut ok = true;
+    let mut rounds = true;
+    let times = (
+        saved_rounds(s, "runtime"),
+        saved_rounds(s, "baseline"),
+        row.rounds_of("runtime"),
+        row.rounds_of("baseline"),
+    );
+    if same && let (Some((rt0, full0)), Some((bl0, full1)), Some(rt1), Some(bl1)) = times {
+        rounds = full0 && full1;
+        let own = noise::compare(&rt0, rt1, rule);
+        let rel = noise::compare(&paired(&rt0, &bl0), &paired(rt1, bl1), rule);
+        let bad = own.slower && rel.slower;
+        ok &= !bad;
+        let why = match (own.slower, rel.slower) {
+            (true, true) => "",
+            (true, false) => "; the baseline slowed alike: the machine, not the runtime",
+            (false, true) => "; the runtime's own time held: the baseline moved",
+            (false, false) => "",
+        };
+        lines.push(format!(
+            "{} {name} runtime: {:.3} -> {:.3} ns per channel-sample ({:+.1}%, MAD {:.3}); over the baseline, round by round: {:+.1}% (MAD {:.1}%){why}",
+            if bad { "REGRESSION" } else { "ok" },
+            own.old,
+            own.new,
+            own.change * 100.0,
+            own.spread,
+            rel.change * 100.0,
+            rel.spread / rel.old * 100.0,
+        ));
+    }
+    for (key, now) in [
+        ("speedup_vs_baseline", Some(row.speedup_vs_baseline)),
+        ("read_limit_fraction", row.read_limit_fraction),
+        ("speedup_vs_dense", row.speedup_vs_dense),
+    ] {
+        let (Some(then), Some(now)) = (s.get(key).and_then(Value::as_f64), now) else {
             continue;
         };
-        let Some(row) = rows.iter().find(|r| r.name == name) else {
-            lines.push(format!(
-                "MISSING {name}: in the saved report but not measured"
-            ));
-            ok = false;
-            continue;
-        };
-        let times = (
-            saved_rounds(s, "runtime"),
-            saved_rounds(s, "baseline"),
-            row.rounds_of("runtime"),
-            row.rounds_of("baseline"),
-        );
-        if same && let (Some((rt0, full0)), Some((bl0, full1)), Some(rt1), Some(bl1)) = times {
-            medians_only |= !(full0 && full1);
-            let own = noise::compare(&rt0, rt1, rule);
-            let rel = noise::compare(&paired(&rt0, &bl0), &paired(rt1, bl1), rule);
-            let bad = own.slower && rel.slower;
-            ok &= !bad;
-            let why = match (own.slower, rel.slower) {
-                (true, true) => "",
-                (true, false) => "; the baseline slowed alike: the machine, not the runtime",
-                (false, true) => "; the runtime's own time held: the baseline moved",
-                (false, false) => "",
-            };
-            lines.push(format!(
-                "{} {name} runtime: {:.3} -> {:.3} ns per channel-sample ({:+.1}%, MAD {:.3}); over the baseline, round by round: {:+.1}% (MAD {:.1}%){why}",
-                if bad { "REGRESSION" } else { "ok" },
-                own.old,
-                own.new,
-                own.change * 100.0,
-                own.spread,
-                rel.change * 100.0,
-                rel.spread / rel.old * 100.0,
-            ));
+        if same && key == "speedup_vs_baseline" {
+            continue; // in the runtime's line above
         }
-        for (key, now) in [
-            ("speedup_vs_baseline", Some(row.speedup_vs_baseline)),
-            ("read_limit_fraction", row.read_limit_fraction),
-            ("speedup_vs_dense", row.speedup_vs_dense),
-        ] {
-            let (Some(then), Some(now)) = (s.get(key).and_then(Value::as_f64), now) else {
-                continue;
-            };
-            if same && key == "speedup_vs_baseline" {
-                continue; // in the runtime's line above
-            }
-            lines.push(format!(
-                "info {name} {key}: {then:.3} -> {now:.3} ({:+.1}%)",
-                (now / then - 1.0) * 100.0
-            ));
-        }
-        // Memory is deterministic: any growth is a change to look at.
-        if let Some(then) = s.get("bytes").and_then(Value::as_u64) {
-            let now = row.bytes as u64;
-            let bad = now > then;
-            ok &= !bad;
-            lines.push(format!(
-                "{} {name} bytes: {then} -> {now}",
-                if bad { "REGRESSION" } else { "ok" }
-            ));
-        }
+        lines.push(format!(
+            "info {name} {key}: {then:.3} -> {now:.3} ({:+.1}%)",
+            (now / then - 1.0) * 100.0
+        ));
     }
-    if medians_only {
-        lines.push(
-            "note: the saved report has medians but no rounds (saved before rounds were): its times were compared by the threshold alone".into(),
-        );
+    // Memory is deterministic: any growth is a change to look at.
+    if let Some(then) = s.get("bytes").and_then(Value::as_u64) {
+        let now = row.bytes as u64;
+        let bad = now > then;
+        ok &= !bad;
+        lines.push(format!(
+            "{} {name} bytes: {then} -> {now}",
+            if bad { "REGRESSION" } else { "ok" }
+        ));
     }
-    (lines, ok)
+    (ok, rounds)
 }
 
 #[cfg(test)]
