@@ -362,6 +362,18 @@ fn extension(path: &std::path::Path) -> String {
         .unwrap_or_default()
 }
 
+/// `path` loaded (BVH, glTF or clip JSON) with the import options of
+/// `rotation` and `animation`, its warnings printed.
+fn load_input(
+    path: &std::path::Path,
+    rotation: Option<tcb_core::RotationMode>,
+    animation: Option<&String>,
+) -> Result<tcb_io::Loaded, BoxError> {
+    let loaded = tcb_io::load_with(path, &import_options(path, rotation, animation)?)?;
+    warn(&loaded.warnings);
+    Ok(loaded)
+}
+
 /// Import options for `file`, refusing the ones its format does not take.
 fn import_options(
     file: &std::path::Path,
@@ -398,9 +410,7 @@ fn import(args: &ImportArgs) -> Result<(), BoxError> {
         )
         .into());
     }
-    let options = import_options(&args.file, args.rotation, args.animation.as_ref())?;
-    let loaded = tcb_io::load_with(&args.file, &options)?;
-    warn(&loaded.warnings);
+    let loaded = load_input(&args.file, args.rotation, args.animation.as_ref())?;
     tcb_io::write_clip_doc(&loaded.doc, &args.output)?;
     let keys: usize = loaded.doc.tracks.iter().map(|t| t.times.len()).sum();
     let (a, b) = loaded.clip.time_range().unwrap_or((0.0, 0.0));
@@ -495,9 +505,7 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
     let rotation = args
         .rotation
         .or((extension(&args.input) == "bvh").then_some(tcb_core::RotationMode::Hermite));
-    let import = import_options(&args.input, rotation, args.animation.as_ref())?;
-    let loaded = tcb_io::load_with(&args.input, &import)?;
-    warn(&loaded.warnings);
+    let loaded = load_input(&args.input, rotation, args.animation.as_ref())?;
     let options = tcb_fit::CompressOptions {
         tolerance: args.error.tolerance,
         shell: args.error.shell,
@@ -624,9 +632,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     }
     output_folder_exists(&args.output)?;
     let started = std::time::Instant::now();
-    let import = import_options(&args.input, args.rotation, args.animation.as_ref())?;
-    let loaded = tcb_io::load_with(&args.input, &import)?;
-    warn(&loaded.warnings);
+    let loaded = load_input(&args.input, args.rotation, args.animation.as_ref())?;
     let options = tcb_fit::ReduceOptions {
         tolerance: args.error.tolerance,
         shell: args.error.shell,
@@ -671,9 +677,7 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     if extension(&args.clip) == "tcbc" {
         return info_tcbc(args);
     }
-    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
-    let loaded = tcb_io::load_with(&args.clip, &options)?;
-    warn(&loaded.warnings);
+    let loaded = load_input(&args.clip, args.rotation, args.animation.as_ref())?;
     let clip = &loaded.clip;
     let options = tcb_runtime::CompileOptions::default().quantize(args.quantize);
     let runtime = tcb_runtime::Clip::compile_with(clip, &options);

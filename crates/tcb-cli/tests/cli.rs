@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{file, scratch, stderr, stdout, tcb};
+use common::{file, scratch, stderr, stderr_has, stdout, tcb};
 use std::path::PathBuf;
 
 /// The bundled example clips' folder.
@@ -519,7 +519,7 @@ fn import_and_export_round_trip_through_the_command() {
         clip.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("1 tracks, 12 keys"), "{}", stderr(&o));
+    stderr_has(&o, "1 tracks, 12 keys");
     let glb = dir.join("skin.glb");
     let o = tcb(&[
         "export",
@@ -529,11 +529,7 @@ fn import_and_export_round_trip_through_the_command() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     // LINEAR slerp goes back as LINEAR, exactly.
-    assert!(
-        stderr(&o).contains("1 exact, 0 resampled"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "1 exact, 0 resampled");
     let a = tcb(&["sample", clip.to_str().unwrap(), "--fps", "7"]);
     let b = tcb(&["sample", glb.to_str().unwrap(), "--fps", "7"]);
     for (x, y) in stdout(&a).lines().zip(stdout(&b).lines()).skip(1) {
@@ -570,11 +566,7 @@ fn import_and_export_errors_write_nothing() {
         "--rotation",
         "hermite",
     ]);
-    assert!(
-        stderr(&o).contains("--rotation is for BVH files"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "--rotation is for BVH files");
     let o = tcb(&[
         "import",
         &data("simple_skin.gltf"),
@@ -583,11 +575,7 @@ fn import_and_export_errors_write_nothing() {
         "--animation",
         "walk",
     ]);
-    assert!(
-        stderr(&o).contains("no animation 'walk' (the file has: 0)"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "no animation 'walk' (the file has: 0)");
     assert!(!out.exists());
     let glb = dir.join("never.glb");
     let o = tcb(&[
@@ -596,11 +584,7 @@ fn import_and_export_errors_write_nothing() {
         "-o",
         glb.to_str().unwrap(),
     ]);
-    assert!(
-        stderr(&o).contains("track 'ball.position' (vec3) has no glTF target"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "track 'ball.position' (vec3) has no glTF target");
     assert!(!glb.exists());
     let o = tcb(&[
         "export",
@@ -608,11 +592,7 @@ fn import_and_export_errors_write_nothing() {
         "-o",
         dir.join("x.fbx").to_str().unwrap(),
     ]);
-    assert!(
-        stderr(&o).contains("must end in .glb or .gltf"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "must end in .glb or .gltf");
 }
 
 #[test]
@@ -627,11 +607,7 @@ fn export_renames_tracks_and_prints_one_summary_line() {
         glb.to_str().unwrap(),
     ]);
     assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("--rename 'ball.position=ball.translation'"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "--rename 'ball.position=ball.translation'");
     assert!(!glb.exists());
     let o = tcb(&[
         "export",
@@ -758,11 +734,7 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
         "-o",
         dir.join("x.png").to_str().unwrap(),
     ]);
-    assert!(
-        stderr(&o).contains("the output must end in .svg"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "the output must end in .svg");
 }
 
 #[test]
@@ -869,6 +841,6 @@ fn figures_from_a_wrong_root_create_nothing() {
         "/no/such/repo",
     ]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("tension.json"), "{}", stderr(&o));
+    stderr_has(&o, "tension.json");
     assert!(!dir.exists());
 }

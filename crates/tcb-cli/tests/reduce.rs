@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{file, scratch, stderr, stdout, tcb};
+use common::{file, scratch, stderr, stderr_has, stdout, tcb};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -89,11 +89,7 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     assert!(k1 < k0 && v1 < v0 && b1 < b0, "{stdout}");
     assert!(e <= 0.05, "{stdout}");
     assert!(!stderr(&o).contains("note:"), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("metric shell, tolerance 5e-2"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "metric shell, tolerance 5e-2");
     for args in [
         vec!["sample", out.to_str().unwrap(), "--at", "0.5,1"],
         vec![
@@ -134,7 +130,7 @@ fn a_reduction_that_compiles_larger_says_so() {
     let stdout = stdout(&o);
     assert!(b1 > b0, "{stdout}");
     let note = format!("compiles to more bytes than the input ({b1} against {b0})");
-    assert!(stderr(&o).contains(&note), "{}", stderr(&o));
+    stderr_has(&o, &note);
 }
 
 /// `tcb sample --at` of `clip` at `times`: one row of numbers per time.
@@ -176,10 +172,9 @@ fn a_clip_without_skeleton_reduces_by_value() {
     std::fs::write(&input, text).unwrap();
     let out = dir().join("dense-smooth-reduced.json");
     let o = reduce_ok(&input, &out, &[]);
-    assert!(
-        stderr(&o).contains("metric value, tolerance 1e-4, rotation tolerance 0.01 degrees"),
-        "{}",
-        stderr(&o)
+    stderr_has(
+        &o,
+        "metric value, tolerance 1e-4, rotation tolerance 0.01 degrees",
     );
     let stdout = stdout(&o);
     let [_, k0, k1, v0, v1, ..] = summary(&stdout, "value");
@@ -271,17 +266,9 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
         "-o",
         dir().join("x.csv").to_str().unwrap(),
     ]);
-    assert!(
-        stderr(&o).contains("the output must end in .json"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "the output must end in .json");
     let o = tcb(&["reduce", &bounce, "-o", "/nonexistent-tcb-dir/x.json"]);
-    assert!(
-        stderr(&o).contains("/nonexistent-tcb-dir: no such directory"),
-        "{}",
-        stderr(&o)
-    );
+    stderr_has(&o, "/nonexistent-tcb-dir: no such directory");
 }
 
 #[test]
@@ -446,12 +433,12 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
     let bad = dir().join("bad.tcbc");
     std::fs::write(&bad, &bytes).unwrap();
     let o = tcb(&["info", "missing.tcbc"]);
-    assert!(stderr(&o).contains("missing.tcbc: "), "{}", stderr(&o));
+    stderr_has(&o, "missing.tcbc: ");
     for args in [vec!["sample", "--at", "0"], vec!["info"]] {
         let mut all = args.clone();
         all.insert(1, bad.to_str().unwrap());
         let o = tcb(&all);
         assert!(!o.status.success());
-        assert!(stderr(&o).contains("checksum mismatch"), "{}", stderr(&o));
+        stderr_has(&o, "checksum mismatch");
     }
 }

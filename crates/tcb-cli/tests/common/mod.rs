@@ -44,3 +44,11 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+/// Asserts that what the run wrote to stderr holds `text` (showing all of
+/// it if not).
+#[track_caller]
+pub fn stderr_has(o: &Output, text: &str) {
+    let err = stderr(o);
+    assert!(err.contains(text), "{err}");
+}
