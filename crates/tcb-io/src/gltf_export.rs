@@ -127,7 +127,7 @@ enum Shape {
 
 /// Hermite on one component over `[0, 1]` with time-unit tangents and span `d`.
 fn hermite(p0: f32, p1: f32, m0: f32, m1: f32, d: f32, u: f32) -> f32 {
-    let h = tcb_core::basis::hermite_basis(u);
+    let h = tcb_core::simd::basis::hermite_basis(u);
     h[0] * p0 + h[1] * p1 + h[2] * m0 * d + h[3] * m1 * d
 }
 
