@@ -10,6 +10,10 @@
 //! [`crate::RotationTrack`] and [`crate::Clip`] sample, and
 //! [`crate::rotation`] has slerp, squad and quaternion log and exp on
 //! `glam` types.
+//!
+//! ```compile_fail
+//! use tcb_core::lane::Lane; // not at the crate's root: `tcb_core::simd::lane`
+//! ```
 
 pub mod basis;
 pub mod extrapolate;
