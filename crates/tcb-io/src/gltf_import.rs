@@ -355,7 +355,11 @@ fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
                 parent: parent[i].map(|p| slot[p]),
                 rest: Transform {
                     translation: Vec3::from_array(t),
-                    rotation: Quat::from_array(r),
+                    // A zero rotation is left as it is: the reader refuses it.
+                    rotation: match Quat::from_array(r) {
+                        q if q.length_squared() == 0.0 => q,
+                        q => crate::skeleton_json::unit_rotation(q),
+                    },
                     scale: Vec3::from_array(s),
                 },
             }
