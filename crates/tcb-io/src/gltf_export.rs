@@ -24,6 +24,13 @@
 //! 8 points per piece; the error reached is reported per track. glTF holds
 //! the end values outside the keys, so other `pre`/`post` modes are
 //! reported as notes. The document is built with the `gltf-json` types.
+//!
+//! glTF's key times are f32. Times beyond f32's range, and distinct times
+//! that are one f32, are refused (the file would not read back). Where
+//! f32 moves a key (0.1 s is not an f32; at 1e6 s, f32 steps by 1/16 s),
+//! the track is not exact: it is read back as `tcb import` reads it and
+//! measured against the clip, and that error is reported
+//! ([`TrackExport::time_rounding`]).
 
 use crate::Error;
 use gltf::json;
@@ -32,16 +39,44 @@ use json::animation::Interpolation;
 use json::validation::{Checked, USize64};
 use std::path::Path;
 use tcb_core::skeleton::Skeleton;
-use tcb_core::{Extrapolation, Interp, Track, TrackData, Value as TcbValue};
+use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value as TcbValue};
 
 /// How one track was written.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackExport {
     /// The track.
     pub name: String,
-    /// `None` when exact; else the largest difference from the reference
-    /// measured on the resampled curve (relative to max(1, |value|)).
+    /// `None` when the curve is written as it is; else the largest
+    /// difference from the reference measured on the resampled curve
+    /// (relative to max(1, |value|)).
     pub resampled_error: Option<f64>,
+    /// `None` when every time written is the track's own (an f32); else
+    /// what rounding them to glTF's f32 key times did.
+    pub time_rounding: Option<TimeRounding>,
+}
+
+impl TrackExport {
+    /// `None` when exact; else the largest difference from the reference
+    /// (relative to max(1, |value|)) that a reader of the export gets,
+    /// resampling and f32 key times included.
+    pub fn error(&self) -> Option<f64> {
+        match (self.resampled_error, self.time_rounding) {
+            (None, None) => None,
+            (e, r) => Some(e.unwrap_or(0.0).max(r.map_or(0.0, |r| r.error))),
+        }
+    }
+}
+
+/// What glTF's f32 key times did to a track whose times are not all f32s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeRounding {
+    /// The largest distance a key (or a resampled knot) moved, seconds.
+    pub largest_shift: f64,
+    /// The largest difference from the reference (relative to max(1,
+    /// |value|)) of the track as `tcb import` reads the export back,
+    /// measured at the keys, the stored times and 7 points between each
+    /// two of them, widened to bound the difference between the points.
+    pub error: f64,
 }
 
 /// What [`export`] did.
@@ -54,17 +89,21 @@ pub struct ExportReport {
 }
 
 impl ExportReport {
-    /// The largest resampling error (0 when everything is exact).
+    /// The largest error of a track ([`TrackExport::error`]; 0 when
+    /// everything is exact).
     pub fn max_error(&self) -> f64 {
         self.tracks
             .iter()
-            .filter_map(|t| t.resampled_error)
+            .filter_map(TrackExport::error)
             .fold(0.0, f64::max)
     }
 }
 
 /// One sampler's data.
 struct Sampler {
+    /// The times the curve was built on.
+    source_times: Vec<f64>,
+    /// Those times as glTF stores them.
     times: Vec<f32>,
     interpolation: Interpolation,
     /// Output elements (for CUBICSPLINE: in, value, out per key).
@@ -160,6 +199,12 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
             let knots: Vec<f64> = (0..=pieces)
                 .map(|j| a + (b - a) * j as f64 / pieces as f64)
                 .collect();
+            // glTF stores the knots as f32: finer pieces than f32 tells
+            // apart would be keys at one time (the keys themselves are
+            // apart in f32, `check_times`).
+            if pieces > 1 && knots.windows(2).any(|w| w[0] as f32 >= w[1] as f32) {
+                break;
+            }
             // (value, in tangent, out tangent) at each knot. The in tangent at
             // b is the left derivative; its out tangent is replaced by the
             // next segment's first knot (and at the last key the reference's
@@ -243,6 +288,7 @@ fn cubic_sampler(c: &Cubic, kind: AccessorType) -> Sampler {
         output.extend_from_slice(&c.tout[k]);
     }
     Sampler {
+        source_times: c.times.clone(),
         times: c.times.iter().map(|&t| t as f32).collect(),
         interpolation: Interpolation::CubicSpline,
         output,
@@ -435,11 +481,8 @@ pub fn export(
             }
             continue;
         }
-        let (sampler, err) = track_sampler(&t.data, max_error);
-        report.tracks.push(TrackExport {
-            name: t.name.clone(),
-            resampled_error: err,
-        });
+        let (sampler, track) = export_track(&t.name, &t.data, max_error)?;
+        report.tracks.push(track);
         channels.push((ni, path, sampler));
     }
     for (ni, mut list) in weights {
@@ -450,10 +493,13 @@ pub fn export(
                 nodes[ni].name
             )));
         }
-        let per: Vec<(Sampler, Option<f64>)> = list
+        let per: Vec<(Sampler, TrackExport)> = list
             .iter()
-            .map(|(_, ti)| track_sampler(&clip.tracks()[*ti].data, max_error))
-            .collect();
+            .map(|(_, ti)| {
+                let t = &clip.tracks()[*ti];
+                export_track(&t.name, &t.data, max_error)
+            })
+            .collect::<Result<_, _>>()?;
         if per
             .iter()
             .any(|(s, _)| s.times != per[0].0.times || s.interpolation != per[0].0.interpolation)
@@ -463,12 +509,7 @@ pub fn export(
                 nodes[ni].name
             )));
         }
-        for ((_, ti), (_, e)) in list.iter().zip(&per) {
-            report.tracks.push(TrackExport {
-                name: clip.tracks()[*ti].name.clone(),
-                resampled_error: *e,
-            });
-        }
+        report.tracks.extend(per.iter().map(|p| p.1.clone()));
         nodes[ni].morphs = list.len();
         channels.push((
             ni,
@@ -476,8 +517,189 @@ pub fn export(
             merge(&per.iter().map(|p| &p.0).collect::<Vec<_>>()),
         ));
     }
+    report
+        .notes
+        .extend(time_rounding_note(&report.tracks, max_error));
     let bytes = write(clip.name(), &nodes, &channels, binary)?;
     Ok((bytes, report))
+}
+
+/// One note for the tracks that glTF's f32 key times put further off than
+/// `max_error` where their curve (exact, or resampled) is within it: why,
+/// and what to do.
+fn time_rounding_note(tracks: &[TrackExport], max_error: f64) -> Option<String> {
+    let over: Vec<(&str, TimeRounding)> = tracks
+        .iter()
+        .filter(|t| t.resampled_error.unwrap_or(0.0) <= max_error)
+        .filter_map(|t| t.time_rounding.map(|r| (t.name.as_str(), r)))
+        .filter(|(_, r)| r.error > max_error)
+        .collect();
+    let shift = over
+        .iter()
+        .map(|(_, r)| r.largest_shift)
+        .fold(0.0, f64::max);
+    let (name, worst) = over
+        .iter()
+        .max_by(|a, b| a.1.error.total_cmp(&b.1.error))
+        .map(|(n, r)| (*n, r.error))?;
+    let what = match over.len() {
+        1 => format!(
+            "track '{name}': glTF's f32 key times move its keys by up to {shift:.2e} s, which puts it {worst:e} off the clip"
+        ),
+        n => format!(
+            "{n} tracks: glTF's f32 key times move their keys by up to {shift:.2e} s, which puts them up to {worst:e} off the clip (in '{name}')"
+        ),
+    };
+    Some(format!(
+        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: shift the clip's times toward 0, or accept it with a larger max error)"
+    ))
+}
+
+/// Track `name`'s sampler and report: its times checked against glTF's
+/// f32 key times (`check_times`), and, where f32 moves them, the track
+/// read back as `tcb import` reads it and measured (`time_rounding`).
+fn export_track(
+    name: &str,
+    data: &TrackData,
+    max_error: f64,
+) -> Result<(Sampler, TrackExport), Error> {
+    check_times(name, data.times())?;
+    let (sampler, resampled_error) = track_sampler(data, max_error);
+    let time_rounding = time_rounding(data, &sampler).map_err(|e| {
+        Error::import(format!(
+            "track '{name}': its glTF keys would not read back ({e}); the clip's tangents are too large for f32 where glTF's times put its keys"
+        ))
+    })?;
+    let track = TrackExport {
+        name: name.to_string(),
+        resampled_error,
+        time_rounding,
+    };
+    Ok((sampler, track))
+}
+
+/// `t` in seconds as a message writes it (`1e39`, not 40 digits).
+fn seconds(t: f64) -> String {
+    if t != 0.0 && !(1e-4..1e16).contains(&t.abs()) {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
+/// Refuses key times glTF cannot store: beyond f32's range, or two
+/// distinct times that are one f32 (the export would not read back).
+fn check_times(name: &str, times: &[f64]) -> Result<(), Error> {
+    for (k, &t) in times.iter().enumerate() {
+        if !(t as f32).is_finite() {
+            return Err(Error::import(format!(
+                "track '{name}': key {k} is at {} s, beyond glTF's key times (f32, at most {:e} s); scale or shift the clip's times into that range before exporting",
+                seconds(t),
+                f32::MAX
+            )));
+        }
+        if k > 0 && times[k - 1] as f32 == t as f32 {
+            let at = t as f32;
+            let step = f64::from(at.next_up()) - f64::from(at);
+            return Err(Error::import(format!(
+                "track '{name}': keys {} and {k} (at {} and {} s) are one time in glTF's f32 key times ({} s apart at that time); shift the clip's times toward 0, or space those keys further apart, before exporting",
+                k - 1,
+                seconds(times[k - 1]),
+                seconds(t),
+                seconds(step)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `None` when glTF's f32 times are `sampler`'s own; else how far they
+/// move, and how far the track `tcb import` reads back is from `data`
+/// (an error when it cannot be built).
+fn time_rounding(
+    data: &TrackData,
+    sampler: &Sampler,
+) -> Result<Option<TimeRounding>, tcb_core::TrackError> {
+    let largest_shift = sampler
+        .source_times
+        .iter()
+        .zip(&sampler.times)
+        .map(|(&t, &f)| (f64::from(f) - t).abs())
+        .fold(0.0, f64::max);
+    if largest_shift == 0.0 {
+        return Ok(None);
+    }
+    let back = read_back(data.kind(), sampler)?;
+    Ok(Some(TimeRounding {
+        largest_shift,
+        error: read_back_error(data, &back),
+    }))
+}
+
+/// `sampler` as `tcb import` reads it: its f32 times, its output, the
+/// importer's own conversion (`gltf_import::sampler_track`).
+fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::TrackError> {
+    let times = sampler.times.iter().map(|&t| f64::from(t)).collect();
+    let dim = kind.dim();
+    let per_key = if sampler.interpolation == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
+    let value = |k: usize, e: usize| {
+        let at = (k * per_key + e) * dim;
+        let mut v = [0.0; 4];
+        v[..dim].copy_from_slice(&sampler.output[at..at + dim]);
+        v
+    };
+    crate::gltf_import::sampler_track(String::new(), kind, times, sampler.interpolation, value)
+        .build(&crate::SettingsDoc::default())
+}
+
+/// How much more than its largest value at 9 evenly spaced points a cubic
+/// can reach between them: with `h = 1/8` of the interval, Markov's
+/// inequality bounds the second derivative by `96 max|p|`, so linear
+/// interpolation misses by at most `12 h² max|p|`, and
+/// `max|p| <= max|p(x_i)| / (1 - 12/64) = 1.23 max|p(x_i)|`.
+const BETWEEN_POINTS: f64 = 1.25;
+
+/// The largest difference between `data` and `back` (relative to max(1,
+/// |value|), rotations up to sign) at the keys of both and 7 points
+/// between each two, `data` held at its end values outside its keys as
+/// glTF holds them; times [`BETWEEN_POINTS`], so that it bounds the
+/// difference between the points too.
+fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
+    let dim = data.kind().dim();
+    let rotation = data.kind() == TrackKind::Quat;
+    let own = data.times();
+    let (first, last) = (own[0], own[own.len() - 1]);
+    let mut times: Vec<f64> = own.iter().chain(back.times()).copied().collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let (mut want, mut got) = ([0.0f32; 4], [0.0f32; 4]);
+    let mut worst = 0.0f64;
+    let mut at = |t: f64| {
+        data.sample_into(t.clamp(first, last), &mut want[..dim], None);
+        back.sample_into(t, &mut got[..dim], None);
+        let diff = |s: f32| {
+            (0..dim)
+                .map(|c| f64::from((want[c] - s * got[c]).abs() / want[c].abs().max(1.0)))
+                .fold(0.0, f64::max)
+        };
+        let e = if rotation {
+            diff(1.0).min(diff(-1.0))
+        } else {
+            diff(1.0)
+        };
+        worst = worst.max(e);
+    };
+    for w in times.windows(2) {
+        for i in 0..8 {
+            at(w[0] + (w[1] - w[0]) * f64::from(i) / 8.0);
+        }
+    }
+    at(times[times.len() - 1]);
+    worst * BETWEEN_POINTS
 }
 
 fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
@@ -514,6 +736,7 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
                 output.extend_from_slice(&v);
             }
             let sampler = Sampler {
+                source_times: data.times().to_vec(),
                 times: data.times().iter().map(|&t| t as f32).collect(),
                 interpolation: if shape == Shape::Step {
                     Interpolation::Step
@@ -557,6 +780,7 @@ fn merge(samplers: &[&Sampler]) -> Sampler {
         }
     }
     Sampler {
+        source_times: samplers[0].source_times.clone(),
         times: samplers[0].times.clone(),
         interpolation: samplers[0].interpolation,
         output,

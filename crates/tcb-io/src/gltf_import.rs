@@ -217,37 +217,6 @@ pub fn import_with(
                 v[..dim].copy_from_slice(&out[row * dim..(row + 1) * dim]);
                 v
             };
-            let value_e = if per_key == 3 { 1 } else { 0 };
-            let mut values: Vec<[f32; 4]> = (0..times.len()).map(|k| value(k, value_e)).collect();
-            let mut keys: Vec<KeyDoc> = (0..times.len())
-                .map(|k| match interp {
-                    Interpolation::Linear => KeyDoc {
-                        interp: Some(Interp::Linear),
-                        ..KeyDoc::default()
-                    },
-                    Interpolation::Step => KeyDoc {
-                        interp: Some(Interp::Step),
-                        ..KeyDoc::default()
-                    },
-                    Interpolation::CubicSpline => KeyDoc {
-                        tangent_in: Some(value(k, 0)),
-                        tangent_out: Some(value(k, 2)),
-                        ..KeyDoc::default()
-                    },
-                })
-                .collect();
-            let mut times = times.clone();
-            if times.len() == 1 {
-                // A constant: a clip track needs two keys.
-                times.push(times[0] + 1.0);
-                values.push(values[0]);
-                keys.push(keys[0].clone());
-                keys[0].interp = Some(Interp::Step);
-                warnings.push(format!(
-                    "{node}.{suffix}: one key; held as a constant (second key at {} s)",
-                    times[1]
-                ));
-            }
             let name = if kind == TrackKind::Scalar {
                 format!("{node}.weights.{target_index}")
             } else {
@@ -256,21 +225,19 @@ pub fn import_with(
             if tracks.iter().any(|t: &TrackDoc| t.name == name) {
                 return Err(what(format!("a second channel animates '{name}'")));
             }
-            let mut settings = SettingsDoc::default();
-            if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
-                // Viewers interpolate the stored components as they are,
-                // sign changes and all (clip-format.md).
-                settings.rotation = Some(RotationMode::Hermite);
-                settings.hemisphere = Some(Hemisphere::Keep);
+            let mut track = sampler_track(name, kind, times.clone(), interp, value);
+            if track.times.len() == 1 {
+                // A constant: a clip track needs two keys.
+                track.times.push(track.times[0] + 1.0);
+                track.values.push(track.values[0]);
+                track.keys.push(track.keys[0].clone());
+                track.keys[0].interp = Some(Interp::Step);
+                warnings.push(format!(
+                    "{node}.{suffix}: one key; held as a constant (second key at {} s)",
+                    track.times[1]
+                ));
             }
-            tracks.push(TrackDoc {
-                name,
-                kind,
-                times,
-                values,
-                keys,
-                settings,
-            });
+            tracks.push(track);
         }
     }
     Ok(GltfImport {
@@ -283,6 +250,57 @@ pub fn import_with(
         skeleton,
         warnings,
     })
+}
+
+/// One glTF sampler's keys as a clip track, as `tcb import` reads them:
+/// `value(k, e)` is element `e` of key `k` (CUBICSPLINE: 0 in-tangent, 1
+/// value, 2 out-tangent; otherwise 0 the value). `LINEAR` and `STEP` become
+/// `interp` keys, `CUBICSPLINE` explicit tangents (rotations `hermite`,
+/// `keep`, as viewers interpolate the stored components, clip-format.md).
+/// The glTF export reads its own samplers back through this.
+pub(crate) fn sampler_track(
+    name: String,
+    kind: TrackKind,
+    times: Vec<f64>,
+    interp: Interpolation,
+    value: impl Fn(usize, usize) -> [f32; 4],
+) -> TrackDoc {
+    let value_e = if interp == Interpolation::CubicSpline {
+        1
+    } else {
+        0
+    };
+    let values = (0..times.len()).map(|k| value(k, value_e)).collect();
+    let keys = (0..times.len())
+        .map(|k| match interp {
+            Interpolation::Linear => KeyDoc {
+                interp: Some(Interp::Linear),
+                ..KeyDoc::default()
+            },
+            Interpolation::Step => KeyDoc {
+                interp: Some(Interp::Step),
+                ..KeyDoc::default()
+            },
+            Interpolation::CubicSpline => KeyDoc {
+                tangent_in: Some(value(k, 0)),
+                tangent_out: Some(value(k, 2)),
+                ..KeyDoc::default()
+            },
+        })
+        .collect();
+    let mut settings = SettingsDoc::default();
+    if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
+        settings.rotation = Some(RotationMode::Hermite);
+        settings.hemisphere = Some(Hemisphere::Keep);
+    }
+    TrackDoc {
+        name,
+        kind,
+        times,
+        values,
+        keys,
+        settings,
+    }
 }
 
 fn describe(a: &gltf::Animation) -> String {
