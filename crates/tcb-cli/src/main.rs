@@ -482,18 +482,8 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         report.tracks.len() - inexact.len(),
     );
     if report.max_error() > args.max_error {
-        let resampling = report
-            .tracks
-            .iter()
-            .filter_map(|t| t.resampled_error)
-            .fold(0.0, f64::max);
-        let why = if resampling > args.max_error {
-            "a step inside a curve track cannot be followed by a cubic"
-        } else {
-            "as `tcb import` reads the export back, glTF's f32 key times included"
-        };
         eprintln!(
-            "tcb: warning: max error {:e} is above --max-error {:e} ({why})",
+            "tcb: warning: max error {:e} is above --max-error {:e}, as `tcb import` reads the export back",
             report.max_error(),
             args.max_error
         );

@@ -47,8 +47,10 @@ pub struct TrackExport {
     /// The track.
     pub name: String,
     /// `None` when the curve is written as it is; else the largest
-    /// difference from the reference measured on the resampled curve
-    /// (relative to max(1, |value|)).
+    /// difference from the reference (relative to max(1, |value|)) of the
+    /// resampled curve as `tcb import` reads the export back, measured as
+    /// [`TimeRounding::error`] is (and no less than the resampling's own
+    /// measure).
     pub resampled_error: Option<f64>,
     /// `None` when every time written is the track's own (an f32); else
     /// what rounding them to glTF's f32 key times did.
@@ -255,7 +257,7 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
             if better {
                 best = Some((knots, at, err));
             }
-            if err <= max_error {
+            if err * BETWEEN_POINTS <= max_error {
                 break;
             }
             pieces *= 2;
@@ -442,6 +444,8 @@ pub fn export(
         .unwrap_or_default();
     // (node, path, sampler)
     let mut channels: Vec<(usize, &'static str, Sampler)> = Vec::new();
+    // The resampling's own measure of each track in `report.tracks`.
+    let mut fits: Vec<Option<f64>> = Vec::new();
     // Weight tracks per node: (target index, track index).
     let mut weights: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
     for (ti, t) in clip.tracks().iter().enumerate() {
@@ -481,9 +485,10 @@ pub fn export(
             }
             continue;
         }
-        let (sampler, track) = export_track(&t.name, &t.data, max_error)?;
-        report.tracks.push(track);
-        channels.push((ni, path, sampler));
+        let w = export_track(&t.name, &t.data, max_error)?;
+        report.tracks.push(w.report);
+        fits.push(w.fit);
+        channels.push((ni, path, w.sampler));
     }
     for (ni, mut list) in weights {
         list.sort();
@@ -493,45 +498,72 @@ pub fn export(
                 nodes[ni].name
             )));
         }
-        let per: Vec<(Sampler, TrackExport)> = list
+        let per: Vec<Written> = list
             .iter()
             .map(|(_, ti)| {
                 let t = &clip.tracks()[*ti];
                 export_track(&t.name, &t.data, max_error)
             })
             .collect::<Result<_, _>>()?;
-        if per
-            .iter()
-            .any(|(s, _)| s.times != per[0].0.times || s.interpolation != per[0].0.interpolation)
-        {
+        let first = &per[0].sampler;
+        if per.iter().any(|w| {
+            w.sampler.times != first.times || w.sampler.interpolation != first.interpolation
+        }) {
             return Err(Error::import(format!(
                 "node '{}': glTF stores all morph weights of a node in one sampler; its weight tracks need the same key times and the same exactness (all exact or all resampled the same way)",
                 nodes[ni].name
             )));
         }
-        report.tracks.extend(per.iter().map(|p| p.1.clone()));
+        report.tracks.extend(per.iter().map(|w| w.report.clone()));
+        fits.extend(per.iter().map(|w| w.fit));
         nodes[ni].morphs = list.len();
         channels.push((
             ni,
             "weights",
-            merge(&per.iter().map(|p| &p.0).collect::<Vec<_>>()),
+            merge(&per.iter().map(|w| &w.sampler).collect::<Vec<_>>()),
         ));
     }
     report
         .notes
-        .extend(time_rounding_note(&report.tracks, max_error));
+        .extend(resampling_note(&report.tracks, &fits, max_error));
+    report
+        .notes
+        .extend(time_rounding_note(&report.tracks, &fits, max_error));
     let bytes = write(clip.name(), &nodes, &channels, binary)?;
     Ok((bytes, report))
 }
 
+/// One note for the tracks whose resampling stopped above `max_error`
+/// by its own measure (`fits`, one per track).
+fn resampling_note(tracks: &[TrackExport], fits: &[Option<f64>], max_error: f64) -> Option<String> {
+    let over: Vec<(&str, f64)> = tracks
+        .iter()
+        .zip(fits)
+        .filter_map(|(t, f)| f.filter(|f| *f > max_error).map(|f| (t.name.as_str(), f)))
+        .collect();
+    let (name, worst) = over.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let what = match over.len() {
+        1 => format!("track '{name}': resampled to {worst:e} at best"),
+        n => format!("{n} tracks: resampled to up to {worst:e} at best (in '{name}')"),
+    };
+    Some(format!(
+        "{what}, above the max error {max_error:e} (a step inside a curve track cannot be followed by a cubic)"
+    ))
+}
+
 /// One note for the tracks that glTF's f32 key times put further off than
-/// `max_error` where their curve (exact, or resampled) is within it: why,
-/// and what to do.
-fn time_rounding_note(tracks: &[TrackExport], max_error: f64) -> Option<String> {
+/// `max_error` where their curve (exact, or resampled by its own measure,
+/// `fits`) is within it: why, and what to do.
+fn time_rounding_note(
+    tracks: &[TrackExport],
+    fits: &[Option<f64>],
+    max_error: f64,
+) -> Option<String> {
     let over: Vec<(&str, TimeRounding)> = tracks
         .iter()
-        .filter(|t| t.resampled_error.unwrap_or(0.0) <= max_error)
-        .filter_map(|t| t.time_rounding.map(|r| (t.name.as_str(), r)))
+        .zip(fits)
+        .filter(|(_, f)| f.unwrap_or(0.0) <= max_error)
+        .filter_map(|(t, _)| t.time_rounding.map(|r| (t.name.as_str(), r)))
         .filter(|(_, r)| r.error > max_error)
         .collect();
     let shift = over
@@ -555,27 +587,49 @@ fn time_rounding_note(tracks: &[TrackExport], max_error: f64) -> Option<String> 
     ))
 }
 
+/// One track as written.
+struct Written {
+    sampler: Sampler,
+    report: TrackExport,
+    /// The resampling's own measure (`None`: written as it is).
+    fit: Option<f64>,
+}
+
 /// Track `name`'s sampler and report: its times checked against glTF's
-/// f32 key times (`check_times`), and, where f32 moves them, the track
-/// read back as `tcb import` reads it and measured (`time_rounding`).
-fn export_track(
-    name: &str,
-    data: &TrackData,
-    max_error: f64,
-) -> Result<(Sampler, TrackExport), Error> {
+/// f32 key times (`check_times`), and, where it is resampled or f32 moves
+/// its times, the track read back as `tcb import` reads it and measured.
+fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written, Error> {
     check_times(name, data.times())?;
-    let (sampler, resampled_error) = track_sampler(data, max_error);
-    let time_rounding = time_rounding(data, &sampler).map_err(|e| {
-        Error::import(format!(
-            "track '{name}': its glTF keys would not read back ({e}); the clip's tangents are too large for f32 where glTF's times put its keys"
-        ))
-    })?;
-    let track = TrackExport {
-        name: name.to_string(),
-        resampled_error,
-        time_rounding,
+    let (sampler, fit) = track_sampler(data, max_error);
+    let largest_shift = sampler
+        .source_times
+        .iter()
+        .zip(&sampler.times)
+        .map(|(&t, &f)| (f64::from(f) - t).abs())
+        .fold(0.0, f64::max);
+    let measured = if fit.is_some() || largest_shift > 0.0 {
+        let back = read_back(data.kind(), &sampler).map_err(|e| {
+            Error::import(format!(
+                "track '{name}': its glTF keys would not read back ({e})"
+            ))
+        })?;
+        read_back_error(data, &back)
+    } else {
+        0.0
     };
-    Ok((sampler, track))
+    let report = TrackExport {
+        name: name.to_string(),
+        resampled_error: fit.map(|f| f.max(measured)),
+        time_rounding: (largest_shift > 0.0).then_some(TimeRounding {
+            largest_shift,
+            error: measured,
+        }),
+    };
+    Ok(Written {
+        sampler,
+        report,
+        fit,
+    })
 }
 
 /// `t` in seconds as a message writes it (`1e39`, not 40 digits).
@@ -611,29 +665,6 @@ fn check_times(name: &str, times: &[f64]) -> Result<(), Error> {
         }
     }
     Ok(())
-}
-
-/// `None` when glTF's f32 times are `sampler`'s own; else how far they
-/// move, and how far the track `tcb import` reads back is from `data`
-/// (an error when it cannot be built).
-fn time_rounding(
-    data: &TrackData,
-    sampler: &Sampler,
-) -> Result<Option<TimeRounding>, tcb_core::TrackError> {
-    let largest_shift = sampler
-        .source_times
-        .iter()
-        .zip(&sampler.times)
-        .map(|(&t, &f)| (f64::from(f) - t).abs())
-        .fold(0.0, f64::max);
-    if largest_shift == 0.0 {
-        return Ok(None);
-    }
-    let back = read_back(data.kind(), sampler)?;
-    Ok(Some(TimeRounding {
-        largest_shift,
-        error: read_back_error(data, &back),
-    }))
 }
 
 /// `sampler` as `tcb import` reads it: its f32 times, its output, the

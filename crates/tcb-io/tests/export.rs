@@ -429,3 +429,32 @@ fn only_f32_key_times_are_exact() {
     assert!(reported < 1e-5, "{reported}");
     assert!(report.notes.is_empty(), "{:?}", report.notes);
 }
+
+/// A squad rotation on keys one f32 step apart (1/16 s at 1e6 s): its
+/// resampling cannot split them (the pieces' knots would be one f32
+/// time), so it keeps whole segments, reads back, and says how far off.
+#[test]
+fn resampling_does_not_split_below_f32_time_steps() {
+    let clip = tcb_io::ClipDoc::parse(
+        r#"{"format": "tcb-clip/1", "tracks": [{"name": "a.rotation", "kind": "quat",
+          "times": [1000000, 1000000.0625, 1000000.125],
+          "values": [[0, 0, 0, 1], [0, 0, 0.7071068, 0.7071068], [0.5, 0.5, 0.5, 0.5]]}]}"#,
+    )
+    .unwrap()
+    .build()
+    .unwrap();
+    let (bytes, report) = export(&clip, None, Container::Glb, &Default::default()).unwrap();
+    let back = import(&bytes, None, None, "rt")
+        .unwrap()
+        .doc
+        .build()
+        .unwrap();
+    assert_eq!(back.key_times(), clip.key_times());
+    let reported = report.tracks[0].error().unwrap();
+    let worst = compare(
+        &clip,
+        &back,
+        (0..=64).map(|i| 1e6 + 0.125 * f64::from(i) / 64.0),
+    )[0];
+    assert!(worst <= reported, "{worst} > {reported}");
+}
