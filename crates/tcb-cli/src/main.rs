@@ -1003,7 +1003,7 @@ fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
         .collect::<Result<Vec<_>, tcb_plot::PlotError>>()?;
     std::fs::create_dir_all(&args.output).map_err(|e| format!("{}: {e}", args.output.display()))?;
     for (name, svg) in &all {
-        tcb_io::write_atomically(&args.output.join(name), svg.as_bytes())?;
+        tcb_io::write_atomically(args.output.join(name), svg.as_bytes())?;
     }
     eprintln!(
         "tcb: wrote {} figures to {}",

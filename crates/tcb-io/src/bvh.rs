@@ -373,7 +373,11 @@ impl Bvh {
         Ok(())
     }
 
-    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation = `OFFSET`.
+    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation =
+    /// `OFFSET`, indexed as [`Self::channels`] and [`Self::local`] index
+    /// them. [`crate::load`] and [`Self::to_clip_doc`] give
+    /// [`Self::skeleton_with_end_sites`] instead: these joints at the same
+    /// indices, then a leaf joint per End Site.
     pub fn skeleton(&self) -> &Skeleton {
         &self.skeleton
     }
@@ -528,7 +532,9 @@ impl Bvh {
     /// The skeleton with each End Site as a leaf joint named
     /// `<parent>_end` (clip-format.md), so that tools composing the rig
     /// reach the ends of its chains (`<parent>_end2`, ... when a joint has
-    /// several, or the name is taken).
+    /// several, or the name is taken): [`Self::skeleton`]'s joints at the
+    /// same indices, then the End Sites in file order. What [`crate::load`]
+    /// gives.
     pub fn skeleton_with_end_sites(&self) -> Skeleton {
         let mut out = self.skeleton.clone();
         let mut names: std::collections::HashSet<String> =

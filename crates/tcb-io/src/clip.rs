@@ -189,19 +189,20 @@ pub struct ClipDoc {
 /// Read, parse and build the clip at `path`.
 ///
 /// ```no_run
-/// let clip = tcb_io::load_clip("examples/clips/bounce.json".as_ref())?;
+/// let clip = tcb_io::load_clip("examples/clips/bounce.json")?;
 /// println!("{} channels", clip.channel_count());
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
-pub fn load_clip(path: &Path) -> Result<Clip, Error> {
+pub fn load_clip(path: impl AsRef<Path>) -> Result<Clip, Error> {
+    let path = path.as_ref();
     let doc = read_clip_doc(path)?;
     doc.build().map_err(|e| e.in_file(path))
 }
 
 /// Read and parse the clip file at `path` without building it (files
 /// above [`crate::DEFAULT_MAX_FILE_BYTES`] are refused unread).
-pub fn read_clip_doc(path: &Path) -> Result<ClipDoc, Error> {
-    read_clip_doc_limited(path, crate::DEFAULT_MAX_FILE_BYTES)
+pub fn read_clip_doc(path: impl AsRef<Path>) -> Result<ClipDoc, Error> {
+    read_clip_doc_limited(path.as_ref(), crate::DEFAULT_MAX_FILE_BYTES)
 }
 
 /// [`read_clip_doc`] with its own file size limit.
@@ -212,7 +213,7 @@ pub(crate) fn read_clip_doc_limited(path: &Path, limit: u64) -> Result<ClipDoc, 
 
 /// Write `doc` to `path`: to a temporary file beside it, then renamed over
 /// it, so that a failure leaves no half-written clip.
-pub fn write_clip_doc(doc: &ClipDoc, path: &Path) -> Result<(), Error> {
+pub fn write_clip_doc(doc: &ClipDoc, path: impl AsRef<Path>) -> Result<(), Error> {
     crate::write_atomically(path, doc.to_json().as_bytes())
 }
 

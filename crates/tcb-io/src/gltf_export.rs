@@ -404,8 +404,9 @@ pub enum Container {
 
 impl Container {
     /// `.glb` for a path ending in `glb` (any case), else `.gltf`.
-    pub fn for_path(path: &Path) -> Container {
+    pub fn for_path(path: impl AsRef<Path>) -> Container {
         if path
+            .as_ref()
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
         {
@@ -1047,9 +1048,10 @@ fn write(
 pub fn export_file(
     clip: &tcb_core::Clip,
     skeleton: Option<&Skeleton>,
-    path: &Path,
+    path: impl AsRef<Path>,
     options: &ExportOptions,
 ) -> Result<ExportReport, Error> {
+    let path = path.as_ref();
     let (bytes, report) =
         export(clip, skeleton, Container::for_path(path), options).map_err(|e| e.in_file(path))?;
     crate::write_atomically(path, &bytes)?;

@@ -88,7 +88,8 @@ fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
 
 /// Import animation `animation` (a name or an index; the first when `None`)
 /// from glTF or GLB bytes. `base` is the directory external buffers are
-/// relative to (`None`: external buffers are an error).
+/// relative to (`None`: external buffers are an error; an `Option<&Path>`
+/// rather than a generic path, so that `None` needs no type).
 pub fn import(
     bytes: &[u8],
     base: Option<&Path>,

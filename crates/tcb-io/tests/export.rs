@@ -120,7 +120,7 @@ fn cmu_hermite_round_trips_as_it_is_and_within_its_report() {
         rotation: tcb_core::RotationMode::Hermite,
         ..Default::default()
     };
-    let clip = tcb_io::load_with(path.as_ref(), &options).unwrap().clip;
+    let clip = tcb_io::load_with(path, &options).unwrap().clip;
     let (back, report) = round_trip(&clip, Container::Glb, 1e-5);
     // Every curve is written as it is; the frame times (k * 0.0083333) are
     // not f32s, and glTF's f32 times move them (at 22.9 s, by up to 1e-6
@@ -210,7 +210,7 @@ fn what_gltf_cannot_hold_is_reported_or_refused() {
 /// Import, export with the skeleton, import again: the same joints (by
 /// name), parents, rest transforms and motion.
 fn hierarchy_round_trips(path: &str) {
-    let first = tcb_io::load(path.as_ref()).unwrap();
+    let first = tcb_io::load(path).unwrap();
     let skeleton = first.skeleton.clone().expect("importers fill the skeleton");
     let (bytes, _) = export(
         &first.clip,

@@ -129,7 +129,7 @@ fn hand_picked_numbers_read_back_bit_for_bit() {
 #[test]
 fn an_imported_capture_reads_back_bit_for_bit() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
-    let loaded = tcb_io::load(path.as_ref()).unwrap();
+    let loaded = tcb_io::load(path).unwrap();
     assert_reads_back(&loaded.doc);
 }
 

@@ -831,7 +831,7 @@ impl Clip {
     /// # /*
     /// let path = "data/cmu-01_01.bvh"; // from the repository's root
     /// # */
-    /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
+    /// let source = tcb_io::load(path).unwrap().clip;
     /// let plain = tcb_runtime::Clip::compile(&source);
     /// let options = tcb_runtime::CompileOptions { quantize: true, ..Default::default() };
     /// let small = tcb_runtime::Clip::compile_with(&source, &options);
