@@ -122,6 +122,7 @@ struct Cubic {
     tout: Vec<Vec<f32>>,
 }
 
+/// A track's own keys and tangents as glTF CUBICSPLINE keys (time-unit tangents over the f32 spans).
 fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
     let times = t.times().to_vec();
     let n = times.len();
@@ -144,6 +145,7 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
     }
 }
 
+/// How glTF can hold a vector track: STEP, its own cubic, or resampled.
 fn exact_shape<V: TcbValue>(t: &Track<V>) -> Shape {
     let segs = t.segments();
     if segs.iter().all(|s| s.interp == Interp::Step) {
@@ -177,92 +179,22 @@ type Knot = (Vec<f32>, Vec<f32>, Vec<f32>);
 
 /// Resample `data` (dim components) as a cubic within `max_error`.
 fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
-    let dim = data.kind().dim();
-    let rotation = matches!(data, TrackData::Quat(_));
-    let keys = data.times().to_vec();
-    let sample = |t: f64| {
-        let (mut v, mut d) = (vec![0.0f32; dim], vec![0.0f32; dim]);
-        data.sample_into(t, &mut v, Some(&mut d));
-        (v, d)
+    let reference = Reference {
+        data,
+        dim: data.kind().dim(),
+        rotation: matches!(data, TrackData::Quat(_)),
     };
-    let (v0, d0) = sample(keys[0]);
+    let keys = data.times();
+    let (v0, d0) = reference.sample(keys[0]);
     let mut out = Cubic {
         times: vec![keys[0]],
         values: vec![v0],
-        tin: vec![vec![0.0; dim]],
+        tin: vec![vec![0.0; reference.dim]],
         tout: vec![d0],
     };
     let mut worst = 0.0f64;
     for k in 0..keys.len() - 1 {
-        let (a, b) = (keys[k], keys[k + 1]);
-        let mut best: Option<(Vec<f64>, Vec<Knot>, f64)> = None;
-        let mut pieces = 1;
-        while pieces <= 64 {
-            let knots: Vec<f64> = (0..=pieces)
-                .map(|j| a + (b - a) * j as f64 / pieces as f64)
-                .collect();
-            // glTF stores the knots as f32: finer pieces than f32 tells
-            // apart would be keys at one time (the keys themselves are
-            // apart in f32, `check_times`).
-            if pieces > 1 && knots.windows(2).any(|w| w[0] as f32 >= w[1] as f32) {
-                break;
-            }
-            // (value, in tangent, out tangent) at each knot. The in tangent at
-            // b is the left derivative; its out tangent is replaced by the
-            // next segment's first knot (and at the last key the reference's
-            // velocity is already the left derivative).
-            let at: Vec<_> = knots
-                .iter()
-                .enumerate()
-                .map(|(j, &t)| {
-                    let (v, d) = sample(t);
-                    let din = if j == pieces {
-                        sample(b - (b - a) * 1e-7).1
-                    } else {
-                        d.clone()
-                    };
-                    (v, din, d)
-                })
-                .collect();
-            let mut err = 0.0f64;
-            for j in 0..pieces {
-                let d = (knots[j + 1] - knots[j]) as f32;
-                for i in 1..8 {
-                    let u = i as f32 / 8.0;
-                    let t = knots[j] + f64::from(u) * (knots[j + 1] - knots[j]);
-                    let mut got: Vec<f32> = (0..dim)
-                        .map(|c| {
-                            hermite(at[j].0[c], at[j + 1].0[c], at[j].2[c], at[j + 1].1[c], d, u)
-                        })
-                        .collect();
-                    if rotation {
-                        let l = got.iter().map(|x| x * x).sum::<f32>().sqrt();
-                        got.iter_mut().for_each(|x| *x /= l);
-                    }
-                    let want = sample(t).0;
-                    let diff = |s: f32| {
-                        want.iter()
-                            .zip(&got)
-                            .map(|(w, g)| f64::from((w - s * g).abs() / w.abs().max(1.0)))
-                            .fold(0.0, f64::max)
-                    };
-                    err = err.max(if rotation {
-                        diff(1.0).min(diff(-1.0))
-                    } else {
-                        diff(1.0)
-                    });
-                }
-            }
-            let better = best.as_ref().is_none_or(|b| err < b.2);
-            if better {
-                best = Some((knots, at, err));
-            }
-            if err * BETWEEN_POINTS <= max_error {
-                break;
-            }
-            pieces *= 2;
-        }
-        let (knots, at, err) = best.expect("at least one try");
+        let (knots, at, err) = reference.fit_segment(keys[k], keys[k + 1], max_error);
         worst = worst.max(err);
         // The knot at `a` is already there: set its out tangent, add the rest.
         let last = out.times.len() - 1;
@@ -281,6 +213,112 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
     (out, worst)
 }
 
+/// The track [`resample`] follows.
+struct Reference<'a> {
+    data: &'a TrackData,
+    dim: usize,
+    rotation: bool,
+}
+
+impl Reference<'_> {
+    /// Value and velocity at `t`.
+    fn sample(&self, t: f64) -> (Vec<f32>, Vec<f32>) {
+        let (mut v, mut d) = (vec![0.0f32; self.dim], vec![0.0f32; self.dim]);
+        self.data.sample_into(t, &mut v, Some(&mut d));
+        (v, d)
+    }
+
+    /// Segment `[a, b]` split into 1, 2, 4, ... 64 equal pieces until the
+    /// cubic through the knots is within `max_error` (bounded between the
+    /// measured points): the knots, their samples and the error, of the
+    /// best try.
+    fn fit_segment(&self, a: f64, b: f64, max_error: f64) -> (Vec<f64>, Vec<Knot>, f64) {
+        let mut best: Option<(Vec<f64>, Vec<Knot>, f64)> = None;
+        let mut pieces = 1;
+        while pieces <= 64 {
+            let knots: Vec<f64> = (0..=pieces)
+                .map(|j| a + (b - a) * j as f64 / pieces as f64)
+                .collect();
+            // glTF stores the knots as f32: finer pieces than f32 tells
+            // apart would be keys at one time (the keys themselves are
+            // apart in f32, `check_times`).
+            if pieces > 1 && knots.windows(2).any(|w| w[0] as f32 >= w[1] as f32) {
+                break;
+            }
+            let at = self.knot_samples(&knots, a, b);
+            let err = self.pieces_error(&knots, &at);
+            if best.as_ref().is_none_or(|b| err < b.2) {
+                best = Some((knots, at, err));
+            }
+            if err * BETWEEN_POINTS <= max_error {
+                break;
+            }
+            pieces *= 2;
+        }
+        best.expect("at least one try")
+    }
+
+    /// (value, in tangent, out tangent) at each knot of `[a, b]`. The in
+    /// tangent at b is the left derivative; its out tangent is replaced by
+    /// the next segment's first knot (and at the last key the reference's
+    /// velocity is already the left derivative).
+    fn knot_samples(&self, knots: &[f64], a: f64, b: f64) -> Vec<Knot> {
+        let last = knots.len() - 1;
+        knots
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| {
+                let (v, d) = self.sample(t);
+                let din = if j == last {
+                    self.sample(b - (b - a) * 1e-7).1
+                } else {
+                    d.clone()
+                };
+                (v, din, d)
+            })
+            .collect()
+    }
+
+    /// The largest difference between the reference and the cubic pieces
+    /// through `at`, at 7 points inside each piece.
+    fn pieces_error(&self, knots: &[f64], at: &[Knot]) -> f64 {
+        let mut err = 0.0f64;
+        for j in 0..knots.len() - 1 {
+            let d = (knots[j + 1] - knots[j]) as f32;
+            for i in 1..8 {
+                let u = i as f32 / 8.0;
+                let t = knots[j] + f64::from(u) * (knots[j + 1] - knots[j]);
+                let mut got: Vec<f32> = (0..self.dim)
+                    .map(|c| hermite(at[j].0[c], at[j + 1].0[c], at[j].2[c], at[j + 1].1[c], d, u))
+                    .collect();
+                if self.rotation {
+                    let l = got.iter().map(|x| x * x).sum::<f32>().sqrt();
+                    got.iter_mut().for_each(|x| *x /= l);
+                }
+                err = err.max(difference(&self.sample(t).0, &got, self.rotation));
+            }
+        }
+        err
+    }
+}
+
+/// `got` against `want` relative to max(1, |value|), rotations up to sign:
+/// the error [`resample`] and the read-back check measure.
+fn difference(want: &[f32], got: &[f32], rotation: bool) -> f64 {
+    let diff = |s: f32| {
+        want.iter()
+            .zip(got)
+            .map(|(w, g)| f64::from((w - s * g).abs() / w.abs().max(1.0)))
+            .fold(0.0, f64::max)
+    };
+    if rotation {
+        diff(1.0).min(diff(-1.0))
+    } else {
+        diff(1.0)
+    }
+}
+
+/// A CUBICSPLINE sampler of `c`: in-tangent, value, out-tangent per key.
 fn cubic_sampler(c: &Cubic, kind: AccessorType) -> Sampler {
     let width = c.values[0].len();
     let mut output = Vec::with_capacity(c.times.len() * width * 3);
@@ -426,59 +464,16 @@ pub fn export(
     container: Container,
     options: &ExportOptions,
 ) -> Result<(Vec<u8>, ExportReport), Error> {
-    let binary = container == Container::Glb;
     let max_error = options.max_error;
     let track_names = renamed(clip, &options.rename)?;
-    let mut report = ExportReport::default();
-    let mut nodes: Vec<NodeOut> = skeleton
-        .map(|s| {
-            s.joints
-                .iter()
-                .map(|j| NodeOut {
-                    name: j.name.clone(),
-                    parent: j.parent,
-                    rest: Some(j.rest),
-                    morphs: 0,
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    // (node, path, sampler)
-    let mut channels: Vec<(usize, &'static str, Sampler)> = Vec::new();
-    // The resampling's own measure of each track in `report.tracks`.
-    let mut fits: Vec<Option<f64>> = Vec::new();
-    // Weight tracks per node: (target index, track index).
+    let mut scene = Scene::of(skeleton);
+    let mut notes = Vec::new();
+    // Weight tracks per node: (node, [(target index, track index)]).
     let mut weights: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
     for (ti, t) in clip.tracks().iter().enumerate() {
         let (node, path, morph) = target(&track_names[ti], &t.data).map_err(Error::import)?;
-        let ni = match nodes.iter().position(|n| n.name == node) {
-            Some(i) => i,
-            None => {
-                nodes.push(NodeOut {
-                    name: node,
-                    parent: None,
-                    rest: None,
-                    morphs: 0,
-                });
-                nodes.len() - 1
-            }
-        };
-        let (pre, post) = match &t.data {
-            TrackData::Quat(r) => (r.settings().pre, r.settings().post),
-            TrackData::Scalar(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec2(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec3(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec4(x) => (x.settings().pre, x.settings().post),
-        };
-        for (side, mode) in [("pre", pre), ("post", post)] {
-            if mode != Extrapolation::Constant {
-                report.notes.push(format!(
-                    "track '{}': {side} '{}' is not expressible; glTF holds the end value",
-                    t.name,
-                    mode.name()
-                ));
-            }
-        }
+        let ni = scene.node(node);
+        notes.extend(extrapolation_notes(&t.name, &t.data));
         if path == "weights" {
             match weights.iter_mut().find(|w| w.0 == ni) {
                 Some(w) => w.1.push((morph, ti)),
@@ -486,17 +481,97 @@ pub fn export(
             }
             continue;
         }
-        let w = export_track(&t.name, &t.data, max_error)?;
-        report.tracks.push(w.report);
-        fits.push(w.fit);
-        channels.push((ni, path, w.sampler));
+        scene.add(ni, path, export_track(&t.name, &t.data, max_error)?);
     }
-    for (ni, mut list) in weights {
+    for (ni, list) in weights {
+        scene.add_weights(clip, ni, list, max_error)?;
+    }
+    notes.extend(resampling_note(&scene.tracks, &scene.fits, max_error));
+    notes.extend(time_rounding_note(&scene.tracks, &scene.fits, max_error));
+    let bytes = write(
+        clip.name(),
+        &scene.nodes,
+        &scene.channels,
+        container == Container::Glb,
+    )?;
+    let report = ExportReport {
+        tracks: scene.tracks,
+        notes,
+    };
+    Ok((bytes, report))
+}
+
+/// What [`export`] builds: the nodes, the channels, and per track its
+/// report and the resampling's own measure.
+struct Scene {
+    nodes: Vec<NodeOut>,
+    /// (node, path, sampler)
+    channels: Vec<(usize, &'static str, Sampler)>,
+    tracks: Vec<TrackExport>,
+    fits: Vec<Option<f64>>,
+}
+
+impl Scene {
+    /// The skeleton's joints as nodes (none without one).
+    fn of(skeleton: Option<&Skeleton>) -> Scene {
+        let nodes = skeleton
+            .map(|s| {
+                s.joints
+                    .iter()
+                    .map(|j| NodeOut {
+                        name: j.name.clone(),
+                        parent: j.parent,
+                        rest: Some(j.rest),
+                        morphs: 0,
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        Scene {
+            nodes,
+            channels: Vec::new(),
+            tracks: Vec::new(),
+            fits: Vec::new(),
+        }
+    }
+
+    /// The node named `name`, a new root node if there is none.
+    fn node(&mut self, name: String) -> usize {
+        match self.nodes.iter().position(|n| n.name == name) {
+            Some(i) => i,
+            None => {
+                self.nodes.push(NodeOut {
+                    name,
+                    parent: None,
+                    rest: None,
+                    morphs: 0,
+                });
+                self.nodes.len() - 1
+            }
+        }
+    }
+
+    /// A written track as the channel `path` of node `ni`.
+    fn add(&mut self, ni: usize, path: &'static str, w: Written) {
+        self.tracks.push(w.report);
+        self.fits.push(w.fit);
+        self.channels.push((ni, path, w.sampler));
+    }
+
+    /// Node `ni`'s weight tracks `list` ((target index, track index)) as
+    /// one channel of a mesh with that many morph targets.
+    fn add_weights(
+        &mut self,
+        clip: &tcb_core::Clip,
+        ni: usize,
+        mut list: Vec<(usize, usize)>,
+        max_error: f64,
+    ) -> Result<(), Error> {
         list.sort();
         if list.iter().enumerate().any(|(i, (m, _))| *m != i) {
             return Err(Error::import(format!(
                 "node '{}': weight tracks must be numbered 0, 1, 2, ... without gaps or repeats",
-                nodes[ni].name
+                self.nodes[ni].name
             )));
         }
         let per: Vec<Written> = list
@@ -512,26 +587,37 @@ pub fn export(
         }) {
             return Err(Error::import(format!(
                 "node '{}': glTF stores all morph weights of a node in one sampler; its weight tracks need the same key times and the same exactness (all exact or all resampled the same way)",
-                nodes[ni].name
+                self.nodes[ni].name
             )));
         }
-        report.tracks.extend(per.iter().map(|w| w.report.clone()));
-        fits.extend(per.iter().map(|w| w.fit));
-        nodes[ni].morphs = list.len();
-        channels.push((
-            ni,
-            "weights",
-            merge(&per.iter().map(|w| &w.sampler).collect::<Vec<_>>()),
-        ));
+        self.tracks.extend(per.iter().map(|w| w.report.clone()));
+        self.fits.extend(per.iter().map(|w| w.fit));
+        self.nodes[ni].morphs = list.len();
+        let merged = merge(&per.iter().map(|w| &w.sampler).collect::<Vec<_>>());
+        self.channels.push((ni, "weights", merged));
+        Ok(())
     }
-    report
-        .notes
-        .extend(resampling_note(&report.tracks, &fits, max_error));
-    report
-        .notes
-        .extend(time_rounding_note(&report.tracks, &fits, max_error));
-    let bytes = write(clip.name(), &nodes, &channels, binary)?;
-    Ok((bytes, report))
+}
+
+/// Notes for `pre`/`post` modes glTF cannot hold (it holds the end values).
+fn extrapolation_notes(name: &str, data: &TrackData) -> Vec<String> {
+    let (pre, post) = match data {
+        TrackData::Quat(r) => (r.settings().pre, r.settings().post),
+        TrackData::Scalar(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec2(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec3(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec4(x) => (x.settings().pre, x.settings().post),
+    };
+    [("pre", pre), ("post", post)]
+        .into_iter()
+        .filter(|(_, mode)| *mode != Extrapolation::Constant)
+        .map(|(side, mode)| {
+            format!(
+                "track '{name}': {side} '{}' is not expressible; glTF holds the end value",
+                mode.name()
+            )
+        })
+        .collect()
 }
 
 /// One note for the tracks whose resampling stopped above `max_error`
@@ -713,17 +799,7 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let mut at = |t: f64| {
         data.sample_into(t.clamp(first, last), &mut want[..dim], None);
         back.sample_into(t, &mut got[..dim], None);
-        let diff = |s: f32| {
-            (0..dim)
-                .map(|c| f64::from((want[c] - s * got[c]).abs() / want[c].abs().max(1.0)))
-                .fold(0.0, f64::max)
-        };
-        let e = if rotation {
-            diff(1.0).min(diff(-1.0))
-        } else {
-            diff(1.0)
-        };
-        worst = worst.max(e);
+        worst = worst.max(difference(&want[..dim], &got[..dim], rotation));
     };
     for w in times.windows(2) {
         for i in 0..8 {
@@ -734,6 +810,7 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     worst * BETWEEN_POINTS
 }
 
+/// The sampler of `data` in the shape glTF can hold, and the resampling's own error (`None`: written as it is).
 fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
     let kind = match data.kind().dim() {
         1 => AccessorType::Scalar,
@@ -797,6 +874,7 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
     }
 }
 
+/// One sampler of several morph targets' samplers (same times), outputs interleaved per element.
 fn merge(samplers: &[&Sampler]) -> Sampler {
     let targets = samplers.len();
     let per_key = if samplers[0].interpolation == Interpolation::CubicSpline {
@@ -915,13 +993,13 @@ impl Builder {
     }
 }
 
+/// The glTF (or GLB) file of `nodes` and one animation `name` of `channels`.
 fn write(
     name: &str,
     nodes: &[NodeOut],
     channels: &[(usize, &'static str, Sampler)],
     binary: bool,
 ) -> Result<Vec<u8>, Error> {
-    use json::accessor::Type;
     let mut b = Builder {
         root: json::Root {
             asset: json::Asset {
@@ -932,115 +1010,139 @@ fn write(
         },
         bin: Vec::new(),
     };
-    let mut samplers = Vec::new();
-    let mut anim_channels = Vec::new();
-    for (node, path, s) in channels {
-        let input = b.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
-        let count = s.output.len() / s.kind.multiplicity();
-        let output = b.accessor(&s.output, count, s.kind, false, false);
-        samplers.push(json::animation::Sampler {
-            extensions: None,
-            extras: Default::default(),
-            input,
-            interpolation: Checked::Valid(s.interpolation),
-            output,
-        });
-        let property = match *path {
-            "translation" => json::animation::Property::Translation,
-            "rotation" => json::animation::Property::Rotation,
-            "scale" => json::animation::Property::Scale,
-            _ => json::animation::Property::MorphTargetWeights,
-        };
-        anim_channels.push(json::animation::Channel {
-            sampler: json::Index::new(samplers.len() as u32 - 1),
-            target: json::animation::Target {
+    // Accessors are numbered as they are pushed: the animation's first,
+    // then the morph meshes'.
+    b.animation(name, channels);
+    b.nodes(nodes);
+    b.finish(binary)
+}
+
+impl Builder {
+    /// The animation `name`: a sampler (input and output accessors) and a
+    /// channel per entry of `channels`.
+    fn animation(&mut self, name: &str, channels: &[(usize, &'static str, Sampler)]) {
+        use json::accessor::Type;
+        let mut samplers = Vec::new();
+        let mut anim_channels = Vec::new();
+        for (node, path, s) in channels {
+            let input = self.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
+            let count = s.output.len() / s.kind.multiplicity();
+            let output = self.accessor(&s.output, count, s.kind, false, false);
+            samplers.push(json::animation::Sampler {
                 extensions: None,
                 extras: Default::default(),
-                node: json::Index::new(*node as u32),
-                path: Checked::Valid(property),
-            },
+                input,
+                interpolation: Checked::Valid(s.interpolation),
+                output,
+            });
+            let property = match *path {
+                "translation" => json::animation::Property::Translation,
+                "rotation" => json::animation::Property::Rotation,
+                "scale" => json::animation::Property::Scale,
+                _ => json::animation::Property::MorphTargetWeights,
+            };
+            anim_channels.push(json::animation::Channel {
+                sampler: json::Index::new(samplers.len() as u32 - 1),
+                target: json::animation::Target {
+                    extensions: None,
+                    extras: Default::default(),
+                    node: json::Index::new(*node as u32),
+                    path: Checked::Valid(property),
+                },
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+        self.root.push(json::Animation {
             extensions: None,
             extras: Default::default(),
+            channels: anim_channels,
+            name: Some(name.to_string()),
+            samplers,
         });
     }
-    let meshes: Vec<Option<json::Index<json::Mesh>>> = nodes
-        .iter()
-        .map(|n| (n.morphs > 0).then(|| b.morph_mesh(n.morphs)))
-        .collect();
-    let mut roots = Vec::new();
-    let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); nodes.len()];
-    for (i, n) in nodes.iter().enumerate() {
-        match n.parent {
-            Some(p) => children[p].push(json::Index::new(i as u32)),
-            None => roots.push(json::Index::new(i as u32)),
+
+    /// The nodes (children, rest transforms without their identity parts,
+    /// a morph mesh where weights are animated) and the scene of their roots.
+    fn nodes(&mut self, nodes: &[NodeOut]) {
+        let meshes: Vec<Option<json::Index<json::Mesh>>> = nodes
+            .iter()
+            .map(|n| (n.morphs > 0).then(|| self.morph_mesh(n.morphs)))
+            .collect();
+        let mut roots = Vec::new();
+        let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); nodes.len()];
+        for (i, n) in nodes.iter().enumerate() {
+            match n.parent {
+                Some(p) => children[p].push(json::Index::new(i as u32)),
+                None => roots.push(json::Index::new(i as u32)),
+            }
         }
+        for (i, n) in nodes.iter().enumerate() {
+            let rest = n.rest.unwrap_or_default();
+            let node = json::Node {
+                name: Some(n.name.clone()),
+                children: (!children[i].is_empty()).then(|| children[i].clone()),
+                mesh: meshes[i],
+                // Identity parts are left out, as glTF writers do.
+                translation: (rest.translation != glam::Vec3::ZERO)
+                    .then(|| <[f32; 3]>::from(rest.translation)),
+                rotation: (rest.rotation != glam::Quat::IDENTITY).then(|| {
+                    json::scene::UnitQuaternion(<[f32; 4]>::from(rest.rotation.normalize()))
+                }),
+                scale: (rest.scale != glam::Vec3::ONE).then(|| <[f32; 3]>::from(rest.scale)),
+                ..Default::default()
+            };
+            self.root.push(node);
+        }
+        let scene = self.root.push(json::Scene {
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            nodes: roots,
+        });
+        self.root.scene = Some(scene);
     }
-    for (i, n) in nodes.iter().enumerate() {
-        let rest = n.rest.unwrap_or_default();
-        let node = json::Node {
-            name: Some(n.name.clone()),
-            children: (!children[i].is_empty()).then(|| children[i].clone()),
-            mesh: meshes[i],
-            // Identity parts are left out, as glTF writers do.
-            translation: (rest.translation != glam::Vec3::ZERO)
-                .then(|| <[f32; 3]>::from(rest.translation)),
-            rotation: (rest.rotation != glam::Quat::IDENTITY)
-                .then(|| json::scene::UnitQuaternion(<[f32; 4]>::from(rest.rotation.normalize()))),
-            scale: (rest.scale != glam::Vec3::ONE).then(|| <[f32; 3]>::from(rest.scale)),
-            ..Default::default()
+
+    /// The file: the buffer padded to 4 bytes, then GLB chunks or a
+    /// `.gltf` with the buffer as a data URI.
+    fn finish(mut self, binary: bool) -> Result<Vec<u8>, Error> {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let too_big = || Error::import("the export is larger than glTF's 4 GiB limit");
+        let mut buffer = json::Buffer {
+            byte_length: USize64::from(self.bin.len()),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
         };
-        b.root.push(node);
-    }
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        nodes: roots,
-    });
-    b.root.scene = Some(scene);
-    b.root.push(json::Animation {
-        extensions: None,
-        extras: Default::default(),
-        channels: anim_channels,
-        name: Some(name.to_string()),
-        samplers,
-    });
-    while !b.bin.len().is_multiple_of(4) {
-        b.bin.push(0);
-    }
-    let too_big = || Error::import("the export is larger than glTF's 4 GiB limit");
-    let mut buffer = json::Buffer {
-        byte_length: USize64::from(b.bin.len()),
-        name: None,
-        uri: None,
-        extensions: None,
-        extras: Default::default(),
-    };
-    let serialize = |e: serde_json::Error| Error::import(format!("writing the glTF JSON: {e}"));
-    if binary {
-        b.root.push(buffer);
-        let json_bytes = b.root.to_vec().map_err(serialize)?;
-        let length = 12 + 8 + json_bytes.len().next_multiple_of(4) + 8 + b.bin.len();
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: u32::try_from(length).map_err(|_| too_big())?,
-            },
-            json: json_bytes.into(),
-            bin: Some(b.bin.into()),
-        };
-        glb.to_vec()
-            .map_err(|e| Error::import(format!("writing the GLB: {e}")))
-    } else {
-        buffer.uri = Some(format!(
-            "data:application/octet-stream;base64,{}",
-            crate::gltf_import::base64_encode(&b.bin)
-        ));
-        b.root.push(buffer);
-        let mut text = b.root.to_vec_pretty().map_err(serialize)?;
-        text.push(b'\n');
-        Ok(text)
+        let serialize = |e: serde_json::Error| Error::import(format!("writing the glTF JSON: {e}"));
+        if binary {
+            self.root.push(buffer);
+            let json_bytes = self.root.to_vec().map_err(serialize)?;
+            let length = 12 + 8 + json_bytes.len().next_multiple_of(4) + 8 + self.bin.len();
+            let glb = gltf::binary::Glb {
+                header: gltf::binary::Header {
+                    magic: *b"glTF",
+                    version: 2,
+                    length: u32::try_from(length).map_err(|_| too_big())?,
+                },
+                json: json_bytes.into(),
+                bin: Some(self.bin.into()),
+            };
+            glb.to_vec()
+                .map_err(|e| Error::import(format!("writing the GLB: {e}")))
+        } else {
+            buffer.uri = Some(format!(
+                "data:application/octet-stream;base64,{}",
+                crate::gltf_import::base64_encode(&self.bin)
+            ));
+            self.root.push(buffer);
+            let mut text = self.root.to_vec_pretty().map_err(serialize)?;
+            text.push(b'\n');
+            Ok(text)
+        }
     }
 }
 
