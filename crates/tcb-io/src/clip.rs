@@ -10,6 +10,11 @@
 //! may carry for the user's own data, as in glTF. Errors name the track
 //! and the key: serde_path_to_error says where in the document an error
 //! is, and [`ClipDoc::parse`] turns that path into a [`Location`].
+//!
+//! A clip written reads back bit for bit: numbers are read as the nearest
+//! f64 (serde_json's `float_roundtrip`) and written in their shortest
+//! round-trip form, f32 values as f32 unless that form would round twice
+//! to another f32 (one positive f32 does: then its f64 form).
 
 use crate::error::{Error, ErrorKind, Location};
 use serde::de::{self, IgnoredAny};
@@ -184,19 +189,20 @@ pub struct ClipDoc {
 /// Read, parse and build the clip at `path`.
 ///
 /// ```no_run
-/// let clip = tcb_io::load_clip("examples/clips/bounce.json".as_ref())?;
+/// let clip = tcb_io::load_clip("examples/clips/bounce.json")?;
 /// println!("{} channels", clip.channel_count());
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
-pub fn load_clip(path: &Path) -> Result<Clip, Error> {
+pub fn load_clip(path: impl AsRef<Path>) -> Result<Clip, Error> {
+    let path = path.as_ref();
     let doc = read_clip_doc(path)?;
     doc.build().map_err(|e| e.in_file(path))
 }
 
 /// Read and parse the clip file at `path` without building it (files
 /// above [`crate::DEFAULT_MAX_FILE_BYTES`] are refused unread).
-pub fn read_clip_doc(path: &Path) -> Result<ClipDoc, Error> {
-    read_clip_doc_limited(path, crate::DEFAULT_MAX_FILE_BYTES)
+pub fn read_clip_doc(path: impl AsRef<Path>) -> Result<ClipDoc, Error> {
+    read_clip_doc_limited(path.as_ref(), crate::DEFAULT_MAX_FILE_BYTES)
 }
 
 /// [`read_clip_doc`] with its own file size limit.
@@ -207,7 +213,7 @@ pub(crate) fn read_clip_doc_limited(path: &Path, limit: u64) -> Result<ClipDoc, 
 
 /// Write `doc` to `path`: to a temporary file beside it, then renamed over
 /// it, so that a failure leaves no half-written clip.
-pub fn write_clip_doc(doc: &ClipDoc, path: &Path) -> Result<(), Error> {
+pub fn write_clip_doc(doc: &ClipDoc, path: impl AsRef<Path>) -> Result<(), Error> {
     crate::write_atomically(path, doc.to_json().as_bytes())
 }
 
@@ -963,6 +969,15 @@ impl serde_json::ser::Formatter for ClipFormatter {
     fn write_f32<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f32) -> std::io::Result<()> {
         self.number.clear();
         serde_json::ser::CompactFormatter.write_f32(&mut self.number, x)?;
+        if !reads_back_as_f32(&self.number, x) {
+            // The reader takes a number as the nearest f64, then rounds
+            // it to f32: that rounds twice, and for one f32 in 2^31
+            // (`7.038531e-26`, found by trying every f32) the shortest
+            // decimal lands on the midpoint of two f32s and rounds to the
+            // other. The f32's own value, written as an f64, is exact.
+            self.number.clear();
+            serde_json::ser::CompactFormatter.write_f64(&mut self.number, f64::from(x))?;
+        }
         self.write_number(w)
     }
     fn write_f64<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f64) -> std::io::Result<()> {
@@ -970,6 +985,15 @@ impl serde_json::ser::Formatter for ClipFormatter {
         serde_json::ser::CompactFormatter.write_f64(&mut self.number, x)?;
         self.write_number(w)
     }
+}
+
+/// Whether `text`, read as the clip reader reads an f32 (the nearest f64,
+/// then rounded to f32), gives `x` back bit for bit.
+fn reads_back_as_f32(text: &[u8], x: f32) -> bool {
+    std::str::from_utf8(text)
+        .ok()
+        .and_then(|t| t.parse::<f64>().ok())
+        .is_some_and(|y| (y as f32).to_bits() == x.to_bits())
 }
 
 impl ClipFormatter {

@@ -113,7 +113,8 @@ pub struct Loaded {
     /// The clip, built and validated.
     pub clip: tcb_core::Clip,
     /// The joint hierarchy: the clip's `skeleton` (BVH and glTF imports
-    /// fill it; BVH End Sites are leaf joints `<parent>_end`).
+    /// fill it; BVH End Sites are leaf joints `<parent>_end` after the
+    /// joints, [`bvh::Bvh::skeleton_with_end_sites`]).
     pub skeleton: Option<Skeleton>,
     /// Things that were read but look wrong, for the user to see.
     pub warnings: Vec<String>,
@@ -127,17 +128,22 @@ pub struct Loaded {
 /// # /*
 /// let path = "data/cmu-01_01.bvh"; // from the repository's root
 /// # */
-/// let loaded = tcb_io::load(path.as_ref())?;
+/// let loaded = tcb_io::load(path)?; // a &str, String, &Path or PathBuf
 /// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31 + 7); // joints and End Sites
 /// assert_eq!(loaded.clip.tracks()[0].name, "Hips.translation");
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
-pub fn load(path: &Path) -> Result<Loaded, Error> {
+///
+/// A BVH file's skeleton is [`bvh::Bvh::skeleton_with_end_sites`]: the
+/// joints of [`bvh::Bvh::skeleton`] at the same indices, then one leaf
+/// joint `<parent>_end` per End Site.
+pub fn load(path: impl AsRef<Path>) -> Result<Loaded, Error> {
     load_with(path, &ImportOptions::default())
 }
 
 /// [`load`] with options.
-pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> {
+pub fn load_with(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Loaded, Error> {
+    let path = path.as_ref();
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -195,7 +201,8 @@ pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Loaded, Error> 
 
 /// Write `bytes` to `path` through a temporary file in the same directory,
 /// renamed over `path` only once everything is written and synced.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+pub fn write_atomically(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
+    let path = path.as_ref();
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
