@@ -13,7 +13,8 @@
 //! # Ok::<(), tcb_io::Error>(())
 //! ```
 
-use crate::{ClipDoc, Error, SettingsDoc, TrackDoc};
+use crate::clip::{ClipDoc, SettingsDoc, TrackDoc};
+use crate::error::Error;
 use glam::{DQuat, DVec3, Vec3};
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 use tcb_core::{RotationMode, TrackKind};

@@ -17,7 +17,8 @@
 //! to another f32 (one positive f32 does: then its f64 form).
 
 use crate::error::{Error, ErrorKind, Location};
-use serde::de::{self, IgnoredAny};
+use crate::json::{Extras, finite_f32};
+use serde::de;
 
 use glam::{Quat, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
@@ -200,21 +201,21 @@ pub fn load_clip(path: impl AsRef<Path>) -> Result<Clip, Error> {
 }
 
 /// Read and parse the clip file at `path` without building it (files
-/// above [`crate::DEFAULT_MAX_FILE_BYTES`] are refused unread).
+/// above [`crate::files::DEFAULT_MAX_FILE_BYTES`] are refused unread).
 pub fn read_clip_doc(path: impl AsRef<Path>) -> Result<ClipDoc, Error> {
-    read_clip_doc_limited(path.as_ref(), crate::DEFAULT_MAX_FILE_BYTES)
+    read_clip_doc_limited(path.as_ref(), crate::files::DEFAULT_MAX_FILE_BYTES)
 }
 
 /// [`read_clip_doc`] with its own file size limit.
 pub(crate) fn read_clip_doc_limited(path: &Path, limit: u64) -> Result<ClipDoc, Error> {
-    let text = crate::read_text_limited(path, limit)?;
+    let text = crate::files::read_text_limited(path, limit)?;
     ClipDoc::parse(&text).map_err(|e| e.in_file(path))
 }
 
 /// Write `doc` to `path`: to a temporary file beside it, then renamed over
 /// it, so that a failure leaves no half-written clip.
 pub fn write_clip_doc(doc: &ClipDoc, path: impl AsRef<Path>) -> Result<(), Error> {
-    crate::write_atomically(path, doc.to_json().as_bytes())
+    crate::files::write_atomically(path, doc.to_json().as_bytes())
 }
 
 impl ClipDoc {
@@ -413,56 +414,6 @@ mod named {
     }
 }
 
-/// `extras`: whatever the user keeps there, not kept by the reader but
-/// walked, so that it is nested no deeper than the JSON reader's limit
-/// (128 levels) like the rest of the file.
-pub(crate) struct Extras;
-
-impl<'de> Deserialize<'de> for Extras {
-    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> de::Visitor<'de> for V {
-            type Value = Extras;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("any JSON value")
-            }
-            fn visit_bool<E>(self, _: bool) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_i64<E>(self, _: i64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_u64<E>(self, _: u64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_f64<E>(self, _: f64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_str<E>(self, _: &str) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_unit<E>(self) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_none<E>(self) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_some<D: de::Deserializer<'de>>(self, d: D) -> Result<Extras, D::Error> {
-                Extras::deserialize(d)
-            }
-            fn visit_seq<A: de::SeqAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
-                while a.next_element::<Extras>()?.is_some() {}
-                Ok(Extras)
-            }
-            fn visit_map<A: de::MapAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
-                while a.next_entry::<IgnoredAny, Extras>()?.is_some() {}
-                Ok(Extras)
-            }
-        }
-        d.deserialize_any(V)
-    }
-}
-
 /// A value as written: a number, or an array of numbers (its shape is
 /// checked against the track's kind once the kind is known).
 #[derive(Clone, Debug, PartialEq)]
@@ -552,18 +503,6 @@ impl ValueIn {
                     .join(", ")
             ),
         }
-    }
-}
-
-/// An f64 as read that must fit an f32 (finite after rounding).
-pub(crate) fn finite_f32(x: f64, what: &str) -> Result<f32, String> {
-    let y = x as f32;
-    if y.is_finite() {
-        Ok(y)
-    } else {
-        // serde_json's shortest form (`1e300`, not 301 digits).
-        let text = serde_json::Number::from_f64(x).map_or(x.to_string(), |n| n.to_string());
-        Err(format!("{what} {text} is not a finite f32"))
     }
 }
 

@@ -32,7 +32,7 @@
 //! measured against the clip, and that error is reported
 //! ([`TrackExport::time_rounding`]).
 
-use crate::Error;
+use crate::error::Error;
 use gltf::json;
 use json::accessor::Type as AccessorType;
 use json::animation::Interpolation;
@@ -771,7 +771,7 @@ fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::
         v
     };
     crate::gltf_import::sampler_track(String::new(), kind, times, sampler.interpolation, value)
-        .build(&crate::SettingsDoc::default())
+        .build(&crate::clip::SettingsDoc::default())
 }
 
 /// How much more than its largest value at 9 evenly spaced points a cubic
@@ -1156,6 +1156,6 @@ pub fn export_file(
     let path = path.as_ref();
     let (bytes, report) =
         export(clip, skeleton, Container::for_path(path), options).map_err(|e| e.in_file(path))?;
-    crate::write_atomically(path, &bytes)?;
+    crate::files::write_atomically(path, &bytes)?;
     Ok(report)
 }

@@ -6,7 +6,8 @@
 //! allocated, so a file claiming more than it holds is an error, not a panic
 //! or a huge allocation.
 
-use crate::{ClipDoc, Error, KeyDoc, SettingsDoc, TrackDoc};
+use crate::clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
+use crate::error::Error;
 use glam::{Quat, Vec3};
 use gltf::Document;
 use gltf::accessor::{DataType, Dimensions};
@@ -96,7 +97,7 @@ pub fn import(
     animation: Option<&str>,
     name: &str,
 ) -> Result<GltfImport, Error> {
-    let options = crate::ImportOptions {
+    let options = crate::files::ImportOptions {
         animation: animation.map(str::to_string),
         ..Default::default()
     };
@@ -110,7 +111,7 @@ pub fn import_with(
     bytes: &[u8],
     base: Option<&Path>,
     name: &str,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<GltfImport, Error> {
     let gltf = parse(bytes)?;
     let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base, options)?;
@@ -428,7 +429,7 @@ fn load_buffers(
     doc: &Document,
     blob: Option<&[u8]>,
     base: Option<&Path>,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<Vec<Vec<u8>>, Error> {
     doc.buffers()
         .map(|b| {
@@ -485,7 +486,7 @@ fn read_buffer(
     base: &Path,
     uri: &str,
     byte_length: usize,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<Vec<u8>, String> {
     use std::io::Read;
     use std::path::Component;

@@ -9,8 +9,8 @@
 //! ]}
 //! ```
 
-use crate::clip::finite_f32;
 use crate::error::{Error, Location};
+use crate::json::finite_f32;
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -22,7 +22,7 @@ use tcb_core::skeleton::{Joint, Skeleton, Transform};
 pub(crate) struct SkeletonIn {
     joints: Vec<JointIn>,
     #[serde(default, rename = "extras")]
-    _extras: Option<crate::clip::Extras>,
+    _extras: Option<crate::json::Extras>,
 }
 
 #[derive(Deserialize)]
@@ -38,7 +38,7 @@ struct JointIn {
     #[serde(default)]
     scale: Option<Vec<f64>>,
     #[serde(default, rename = "extras")]
-    _extras: Option<crate::clip::Extras>,
+    _extras: Option<crate::json::Extras>,
 }
 
 impl SkeletonIn {
@@ -168,7 +168,7 @@ impl<'a> SkeletonOut<'a> {
 
 #[cfg(test)]
 mod tests {
-    use crate::ClipDoc;
+    use crate::clip::ClipDoc;
 
     fn clip(skeleton: &str) -> String {
         format!(
