@@ -11,9 +11,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::{Quat, Vec4};
-use tcb_core::basis::{hermite, hermite_basis};
 use tcb_core::ease::SegmentEase;
-use tcb_core::extrapolate::{Mapped, map_time};
+use tcb_core::simd::basis::{hermite, hermite_basis};
+use tcb_core::simd::extrapolate::{Mapped, map_time};
 use tcb_core::{Extrapolation, Interp, Track, TrackData, Value};
 
 /// One segment of a vector track (or of a hermite rotation's components).

@@ -26,7 +26,7 @@ fn clips() -> Vec<(String, tcb_core::Clip)> {
         let path = format!("{root}/data/cmu-01_01.bvh");
         out.push((
             format!("cmu {mode:?}"),
-            tcb_io::load_with(path.as_ref(), &options).unwrap().clip,
+            tcb_io::load_with(path, &options).unwrap().clip,
         ));
     }
     out
@@ -79,14 +79,13 @@ fn splines_agree_on_even_keys_with_tcb_zero() {
         rotation: RotationMode::Hermite,
         ..Default::default()
     };
-    let clip = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh").as_ref(), &options)
+    let clip = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;
     let peer = SplinesPeer::new(&clip);
     let worst = peer.agreement(&clip, 2000);
     assert!(worst < 1e-4, "splines vs tcb: {worst}");
     // And it can fail: a non-zero tension is a different curve.
-    let bounce =
-        tcb_io::load_clip(format!("{root}/tools/check/clips/rules.json").as_ref()).unwrap();
+    let bounce = tcb_io::load_clip(format!("{root}/tools/check/clips/rules.json")).unwrap();
     assert!(SplinesPeer::new(&bounce).agreement(&bounce, 200) > 1e-3);
 }

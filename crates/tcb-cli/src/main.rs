@@ -456,12 +456,30 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
     let report =
         tcb_io::gltf_export::export_file(&clip, skeleton.as_ref(), &args.output, &options)?;
     warn(&report.notes);
-    let resampled: Vec<_> = report
+    // Not exact: resampled, or on key times that glTF's f32 moves.
+    let inexact: Vec<_> = report
         .tracks
         .iter()
-        .filter_map(|t| t.resampled_error.map(|e| (&t.name, e)))
+        .filter_map(|t| t.error().map(|e| (&t.name, e)))
         .collect();
-    let worst = resampled
+    let resampled = report
+        .tracks
+        .iter()
+        .filter(|t| t.resampled_error.is_some())
+        .count();
+    let shifts: Vec<f64> = report
+        .tracks
+        .iter()
+        .filter_map(|t| t.time_rounding.map(|r| r.largest_shift))
+        .collect();
+    let moved = match shifts.iter().copied().reduce(f64::max) {
+        Some(s) => format!(
+            ", {} on keys moved by glTF's f32 times (up to {s:e} s)",
+            shifts.len()
+        ),
+        None => String::new(),
+    };
+    let worst = inexact
         .iter()
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(String::new(), |(n, e)| {
@@ -471,15 +489,14 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         format!("{} joints as the node hierarchy", s.joints.len())
     });
     eprintln!(
-        "tcb: wrote {}: {} tracks, {} exact, {} resampled{worst}; {joints}",
+        "tcb: wrote {}: {} tracks, {} exact, {resampled} resampled{moved}{worst}; {joints}",
         args.output.display(),
         report.tracks.len(),
-        report.tracks.len() - resampled.len(),
-        resampled.len(),
+        report.tracks.len() - inexact.len(),
     );
     if report.max_error() > args.max_error {
         eprintln!(
-            "tcb: warning: max error {:e} is above --max-error {:e} (a step inside a curve track cannot be followed by a cubic)",
+            "tcb: warning: max error {:e} is above --max-error {:e}, as `tcb import` reads the export back",
             report.max_error(),
             args.max_error
         );
@@ -1035,7 +1052,7 @@ fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
         .collect::<Result<Vec<_>, tcb_plot::PlotError>>()?;
     std::fs::create_dir_all(&args.output).map_err(|e| format!("{}: {e}", args.output.display()))?;
     for (name, svg) in &all {
-        tcb_io::write_atomically(&args.output.join(name), svg.as_bytes())?;
+        tcb_io::write_atomically(args.output.join(name), svg.as_bytes())?;
     }
     eprintln!(
         "tcb: wrote {} figures to {}",

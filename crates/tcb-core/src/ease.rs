@@ -15,7 +15,7 @@
 //! the segment, is constant in the middle, and falls linearly to zero over the
 //! last `e`.
 
-use crate::lane::Lane;
+use crate::simd::lane::Lane;
 
 /// The ease of one segment, normalized so that `from + to <= 1` (its
 /// fields are private so that nothing makes one that is not).

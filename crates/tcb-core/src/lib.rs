@@ -12,17 +12,16 @@
 //! | module | what |
 //! |---|---|
 //! | [`tangent`] | TCB weights, the four tangent rules, `match_speed`, ends, overrides |
-//! | [`basis`] | the Hermite basis row `[h1 h2 h3 h4]`, generic over lane types |
 //! | [`ease`] | 3ds Max ease to / ease from |
-//! | [`extrapolate`] | `pre` / `post` modes, in f64 |
 //! | [`track`] | [`Track`], the reference spline for `f32`, `Vec2`, `Vec3`, `Vec4` |
 //! | [`rotation`] | [`RotationTrack`]: `squad` and `hermite` on quaternions |
 //! | [`clip`] | [`Clip`]: named tracks sampled together |
 //! | [`sample_times`] | the paper's inbetweens, frame grids |
+//! | [`simd`] | the formulas over lane types the runtime's kernels share (not a stable API) |
 //!
 //! Tracks are validated once when built ([`TrackError`] names the key at
 //! fault); after that, sampling never fails and never panics, for any f64
-//! time including NaN and infinities (see [`extrapolate`]).
+//! time including NaN and infinities (see [`Extrapolation`]).
 //!
 //! ```
 //! use glam::Vec3;
@@ -46,18 +45,15 @@
 
 #![forbid(unsafe_code)]
 
-pub mod basis;
 pub mod clip;
 pub mod ease;
 pub mod error;
-pub mod extrapolate;
-pub mod lane;
 pub mod params;
 pub mod quat;
 pub mod rotation;
 pub mod sample_times;
+pub mod simd;
 pub mod skeleton;
-pub mod squad;
 pub mod tangent;
 pub mod track;
 pub mod vector;

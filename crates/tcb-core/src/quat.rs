@@ -7,8 +7,8 @@
 //! omega = 2 vec(q' conj(q))                                  angular velocity
 //! ```
 
-use crate::basis::Real;
-use crate::lane::Lane;
+use crate::simd::basis::Real;
+use crate::simd::lane::Lane;
 
 /// The Hamilton product `a b`.
 #[inline(always)]

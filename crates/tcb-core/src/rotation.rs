@@ -28,26 +28,26 @@
 //! In both modes `interp: linear` is slerp and `step` holds. The reference
 //! works in f64 and returns f32 quaternions. Velocities are d/dt of the
 //! output quaternion's components, from the analytic derivative of the
-//! power form ([`crate::squad`]).
+//! power form ([`crate::simd::squad`]).
 
 use crate::ease::SegmentEase;
 use crate::error::TrackError;
-use crate::extrapolate::{Mapped, map_time};
 use crate::params::{
     Ends, Extrapolation, Hemisphere, Interp, KeyParams, RotationMode, TrackSettings,
 };
+use crate::simd::extrapolate::{Mapped, map_time};
 use crate::tangent::{TangentKey, key_tangents};
 use crate::track::{Track, check_keys, keys_or_default, locate, segment_eases};
 use glam::{DQuat, DVec3, DVec4, Quat, Vec4};
 
-pub use crate::squad::{quat_exp, quat_log};
+pub use crate::simd::squad::{quat_exp, quat_log};
 
 /// Spherical linear interpolation without hemisphere correction,
-/// `p exp(s log(p^-1 q))` ([`crate::squad::slerp_power`]). Any `s` is
+/// `p exp(s log(p^-1 q))` ([`crate::simd::squad::slerp_power`]). Any `s` is
 /// allowed (it extrapolates along the arc).
 pub fn slerp(p: DQuat, q: DQuat, s: f64) -> DQuat {
-    let c = crate::squad::slerp_controls(p, q);
-    DQuat::from_array(crate::squad::slerp_power(
+    let c = crate::simd::squad::slerp_controls(p, q);
+    DQuat::from_array(crate::simd::squad::slerp_power(
         &[c[0], c[1], c[2], c[3]],
         &[c[4], c[5], c[6]],
         c[7],
@@ -56,10 +56,10 @@ pub fn slerp(p: DQuat, q: DQuat, s: f64) -> DQuat {
 }
 
 /// `squad(q0, q1, a, b, s) = slerp(slerp(q0, q1, s), slerp(a, b, s), 2s(1-s))`
-/// ([`crate::squad::squad`]).
+/// ([`crate::simd::squad::squad`]).
 pub fn squad(q0: DQuat, q1: DQuat, a: DQuat, b: DQuat, s: f64) -> DQuat {
-    DQuat::from_array(crate::squad::squad(
-        &crate::squad::controls(q0, q1, a, b),
+    DQuat::from_array(crate::simd::squad::squad(
+        &crate::simd::squad::controls(q0, q1, a, b),
         s,
     ))
 }
@@ -82,14 +82,14 @@ pub struct SquadSegment {
 }
 
 impl SquadSegment {
-    /// Its power-form controls ([`crate::squad::controls`]).
-    pub fn controls(&self) -> [f64; crate::squad::CONTROLS] {
-        crate::squad::controls(self.q0, self.q1, self.a, self.b)
+    /// Its power-form controls ([`crate::simd::squad::controls`]).
+    pub fn controls(&self) -> [f64; crate::simd::squad::CONTROLS] {
+        crate::simd::squad::controls(self.q0, self.q1, self.a, self.b)
     }
 
     /// The segment at `s`.
     pub fn at(&self, s: f64) -> DQuat {
-        DQuat::from_array(crate::squad::squad(&self.controls(), s))
+        DQuat::from_array(crate::simd::squad::squad(&self.controls(), s))
     }
 
     /// The unit rotation at `s` and its derivative with respect to `s`.
@@ -100,8 +100,8 @@ impl SquadSegment {
 
 /// Squad (or slerp, as squad with `a = q0`, `b = q1`) at `s`, normalized, and
 /// the derivative of the normalized curve with respect to `s`.
-fn unit_with_derivative(c: &[f64; crate::squad::CONTROLS], s: f64) -> (DQuat, DVec4) {
-    let (q, dq) = crate::squad::unit(c, s, true);
+fn unit_with_derivative(c: &[f64; crate::simd::squad::CONTROLS], s: f64) -> (DQuat, DVec4) {
+    let (q, dq) = crate::simd::squad::unit(c, s, true);
     (
         DQuat::from_array(q),
         DVec4::from_array(dq.expect("asked for")),
@@ -349,7 +349,7 @@ impl RotationTrack {
         (self.times[0], self.times[self.times.len() - 1])
     }
 
-    /// The rotation at `time` (any f64; see [`crate::extrapolate`]).
+    /// The rotation at `time` (any f64; see [`crate::simd::extrapolate`]).
     pub fn sample(&self, time: f64) -> Quat {
         self.sample_with_velocity(time).0
     }
@@ -387,7 +387,7 @@ impl RotationTrack {
             }
             (Interp::Linear, Shape::Hermite(_)) => {
                 let (q0, q1) = (self.keys[k], self.keys[k + 1]);
-                let (q, d) = unit_with_derivative(&crate::squad::controls(q0, q1, q0, q1), s);
+                let (q, d) = unit_with_derivative(&crate::simd::squad::controls(q0, q1, q0, q1), s);
                 (q, d * rate)
             }
             (_, Shape::Hermite(track)) => {
@@ -504,14 +504,14 @@ mod tests {
         };
         let track = RotationTrack::new(times, q.to_vec(), Vec::new(), &settings).unwrap();
         let t = 1.3599676637654653e138;
-        let mapped = match crate::extrapolate::map_time(
+        let mapped = match crate::simd::extrapolate::map_time(
             t,
             -3.625,
             -0.578124999,
             settings.pre,
             settings.post,
         ) {
-            crate::extrapolate::Mapped::Inside { time, .. } => time,
+            crate::simd::extrapolate::Mapped::Inside { time, .. } => time,
             other => panic!("{other:?}"),
         };
         assert!(mapped > -0.578124999, "{mapped}");

@@ -1,11 +1,11 @@
 //! The scalar reference spline for vector values (`f32`, `Vec2`, `Vec3`,
 //! `Vec4`): built and validated once, then sampled at any f64 time.
 
-use crate::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use crate::ease::SegmentEase;
 use crate::error::TrackError;
-use crate::extrapolate::{Mapped, map_time};
 use crate::params::{Ends, Interp, KeyParams, TrackSettings};
+use crate::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
+use crate::simd::extrapolate::{Mapped, map_time};
 use crate::tangent::{KeyTangents, TangentKey, key_tangents_wrapped};
 use crate::vector::{Value, Vector};
 
@@ -367,7 +367,7 @@ impl<V: Value> Track<V> {
             .scale(1.0 / (self.times[n - 1] - self.times[n - 2]))
     }
 
-    /// The value at `time` (seconds; any f64, see [`crate::extrapolate`]).
+    /// The value at `time` (seconds; any f64, see [`crate::simd::extrapolate`]).
     pub fn sample(&self, time: f64) -> V {
         self.sample_with_velocity(time).0
     }

@@ -209,7 +209,7 @@ proptest! {
             let m0 = (v[k + 1] - v[k - 1]) * a;
             let m1 = (v[k + 2] - v[k]) * a;
             for s in [0.25f32, 0.5, 0.8] {
-                let h = tcb_core::basis::hermite_basis(s);
+                let h = tcb_core::simd::basis::hermite_basis(s);
                 let want = v[k] * h[0] + v[k + 1] * h[1] + m0 * h[2] + m1 * h[3];
                 let got = track.sample(t[k] + dt * s as f64);
                 prop_assert!(close(got, want, 1e-5), "{got} {want}");

@@ -24,7 +24,7 @@
 //! a span is split where any of them is out of its own tolerance.
 
 use crate::band::{Normal, Row, WIDTH};
-use tcb_core::basis::hermite_basis;
+use tcb_core::simd::basis::hermite_basis;
 use tcb_core::tangent::ChordWeights;
 use tcb_core::{TangentRule, Tcb};
 

@@ -155,7 +155,7 @@ fn rest_height(rig: &Rig) -> f64 {
 fn reduced_cmu_is_within_the_shell_tolerance_at_three_tolerances() {
     let text = std::fs::read_to_string(BVH).unwrap();
     let rig = read_rig(&text);
-    let loaded = tcb_io::load(BVH.as_ref()).unwrap();
+    let loaded = tcb_io::load(BVH).unwrap();
     let skeleton = loaded.skeleton.clone().unwrap();
     assert_eq!(skeleton.joints.len(), rig.names.len());
     let h = rest_height(&rig);

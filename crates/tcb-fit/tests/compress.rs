@@ -10,7 +10,7 @@ fn cmu() -> tcb_io::Loaded {
         rotation: RotationMode::Hermite,
         ..Default::default()
     };
-    tcb_io::load_with(BVH.as_ref(), &options).unwrap()
+    tcb_io::load_with(BVH, &options).unwrap()
 }
 
 /// A track no joint uses (a camera's field of view, 60 degrees) beside the

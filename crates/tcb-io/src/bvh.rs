@@ -13,7 +13,8 @@
 //! # Ok::<(), tcb_io::Error>(())
 //! ```
 
-use crate::{ClipDoc, Error, SettingsDoc, TrackDoc};
+use crate::clip::{ClipDoc, SettingsDoc, TrackDoc};
+use crate::error::Error;
 use glam::{DQuat, DVec3, Vec3};
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 use tcb_core::{RotationMode, TrackKind};
@@ -106,6 +107,110 @@ impl<'a> Tokens<'a> {
     }
 }
 
+/// The first token: `HIERARCHY`.
+fn expect_hierarchy(t: &mut Tokens) -> Result<(), Error> {
+    match t.next() {
+        Some((_, "HIERARCHY")) => Ok(()),
+        Some((line, tok)) => Err(Error::syntax(
+            line,
+            format!("expected HIERARCHY, found '{tok}'"),
+        )),
+        None => Err(Error::syntax(1, "expected HIERARCHY")),
+    }
+}
+
+/// The name after `ROOT` or `JOINT` (`tok`, on `line`; the rest of the
+/// line up to `{`) and the `{` after it; a ROOT only outside every joint
+/// (`outside`), a JOINT only inside one, each name once (`names`).
+fn joint_name(
+    t: &mut Tokens,
+    line: usize,
+    tok: &str,
+    outside: bool,
+    names: &mut std::collections::HashSet<String>,
+) -> Result<String, Error> {
+    if (tok == "ROOT") != outside {
+        let msg = if tok == "ROOT" {
+            "ROOT inside a joint (use JOINT)"
+        } else {
+            "JOINT outside any ROOT"
+        };
+        return Err(Error::syntax(line, msg));
+    }
+    let mut name = Vec::new();
+    while let Some(&(l, w)) = t.tokens.get(t.at) {
+        if l != line || w == "{" {
+            break;
+        }
+        name.push(w);
+        t.at += 1;
+    }
+    let name = name.join(" ");
+    if name.is_empty() {
+        return Err(Error::syntax(line, format!("{tok} without a name")));
+    }
+    if !names.insert(name.clone()) {
+        return Err(Error::syntax(
+            line,
+            format!("a second joint named '{name}'"),
+        ));
+    }
+    match t.expect("'{'")? {
+        (_, "{") => Ok(name),
+        (l, w) => Err(Error::syntax(l, format!("expected '{{', found '{w}'"))),
+    }
+}
+
+/// The count and names after `CHANNELS`: at most 6, none twice.
+fn channel_list(t: &mut Tokens) -> Result<Vec<Channel>, Error> {
+    let (l, n) = t.expect("the channel count")?;
+    let n: usize = n
+        .parse()
+        .map_err(|_| Error::syntax(l, format!("'{n}' is not a channel count")))?;
+    if n > 6 {
+        return Err(Error::syntax(
+            l,
+            format!("CHANNELS {n}: at most 6 (X/Y/Z position and rotation)"),
+        ));
+    }
+    let mut channels = Vec::with_capacity(n);
+    for _ in 0..n {
+        let (l, name) = t.expect("a channel name")?;
+        let c = Channel::parse(name).ok_or_else(|| {
+            Error::syntax(
+                l,
+                format!("unknown channel '{name}' (expected Xposition … Zrotation)"),
+            )
+        })?;
+        if channels.contains(&c) {
+            return Err(Error::syntax(l, format!("channel '{name}' listed twice")));
+        }
+        channels.push(c);
+    }
+    Ok(channels)
+}
+
+/// The rest of `End Site { OFFSET x y z }` after `End`: its offset.
+fn end_site(t: &mut Tokens) -> Result<Vec3, Error> {
+    for want in ["Site", "{", "OFFSET"] {
+        let (l, w) = t.expect(want)?;
+        if w != want {
+            return Err(Error::syntax(
+                l,
+                format!("expected '{want}' in End Site, found '{w}'"),
+            ));
+        }
+    }
+    let offset = t.offset()?;
+    match t.expect("'}'")? {
+        (_, "}") => Ok(offset),
+        (l, w) => Err(Error::syntax(
+            l,
+            format!("expected '}}' closing End Site, found '{w}'"),
+        )),
+    }
+}
+
 impl Bvh {
     /// Parse BVH text.
     pub fn parse(text: &str) -> Result<Bvh, Error> {
@@ -136,135 +241,37 @@ impl Bvh {
         Ok(bvh)
     }
 
+    /// The `HIERARCHY` section: joints, their offsets and channels, End Sites.
     fn parse_hierarchy(&mut self, t: &mut Tokens) -> Result<(), Error> {
-        match t.next() {
-            Some((_, "HIERARCHY")) => {}
-            Some((line, tok)) => {
-                return Err(Error::syntax(
-                    line,
-                    format!("expected HIERARCHY, found '{tok}'"),
-                ));
-            }
-            None => return Err(Error::syntax(1, "expected HIERARCHY")),
-        }
+        expect_hierarchy(t)?;
         // Joints open and not yet closed.
         let mut stack: Vec<usize> = Vec::new();
         // Names so far (a search of the joints per joint is quadratic in a
         // wide hierarchy).
         let mut names = std::collections::HashSet::new();
         while let Some((line, tok)) = t.next() {
+            let open = |what: &str| {
+                stack
+                    .last()
+                    .copied()
+                    .ok_or_else(|| Error::syntax(line, format!("{what} outside a joint")))
+            };
             match tok {
                 "ROOT" | "JOINT" => {
-                    if (tok == "ROOT") != stack.is_empty() {
-                        let msg = if tok == "ROOT" {
-                            "ROOT inside a joint (use JOINT)"
-                        } else {
-                            "JOINT outside any ROOT"
-                        };
-                        return Err(Error::syntax(line, msg));
-                    }
-                    let mut name = Vec::new();
-                    while let Some(&(l, w)) = t.tokens.get(t.at) {
-                        if l != line || w == "{" {
-                            break;
-                        }
-                        name.push(w);
-                        t.at += 1;
-                    }
-                    let name = name.join(" ");
-                    if name.is_empty() {
-                        return Err(Error::syntax(line, format!("{tok} without a name")));
-                    }
-                    if !names.insert(name.clone()) {
-                        return Err(Error::syntax(
-                            line,
-                            format!("a second joint named '{name}'"),
-                        ));
-                    }
-                    match t.expect("'{'")? {
-                        (_, "{") => {}
-                        (l, w) => {
-                            return Err(Error::syntax(l, format!("expected '{{', found '{w}'")));
-                        }
-                    }
-                    if stack.len() == MAX_DEPTH {
-                        return Err(Error::syntax(
-                            line,
-                            format!(
-                                "joints nested deeper than {MAX_DEPTH} (the limit; rigs are tens deep)"
-                            ),
-                        ));
-                    }
-                    self.skeleton.joints.push(Joint {
-                        name,
-                        parent: stack.last().copied(),
-                        rest: Transform::IDENTITY,
-                    });
-                    self.channels.push(Vec::new());
-                    stack.push(self.skeleton.joints.len() - 1);
+                    let name = joint_name(t, line, tok, stack.is_empty(), &mut names)?;
+                    self.open_joint(name, line, &mut stack)?;
                 }
                 "OFFSET" => {
-                    let j = *stack
-                        .last()
-                        .ok_or_else(|| Error::syntax(line, "OFFSET outside a joint"))?;
+                    let j = open("OFFSET")?;
                     self.skeleton.joints[j].rest.translation = t.offset()?;
                 }
                 "CHANNELS" => {
-                    let j = *stack
-                        .last()
-                        .ok_or_else(|| Error::syntax(line, "CHANNELS outside a joint"))?;
-                    let (l, n) = t.expect("the channel count")?;
-                    let n: usize = n
-                        .parse()
-                        .map_err(|_| Error::syntax(l, format!("'{n}' is not a channel count")))?;
-                    if n > 6 {
-                        return Err(Error::syntax(
-                            l,
-                            format!("CHANNELS {n}: at most 6 (X/Y/Z position and rotation)"),
-                        ));
-                    }
-                    let mut channels = Vec::with_capacity(n);
-                    for _ in 0..n {
-                        let (l, name) = t.expect("a channel name")?;
-                        let c = Channel::parse(name).ok_or_else(|| {
-                            Error::syntax(
-                                l,
-                                format!(
-                                    "unknown channel '{name}' (expected Xposition … Zrotation)"
-                                ),
-                            )
-                        })?;
-                        if channels.contains(&c) {
-                            return Err(Error::syntax(l, format!("channel '{name}' listed twice")));
-                        }
-                        channels.push(c);
-                    }
-                    self.channels[j] = channels;
+                    let j = open("CHANNELS")?;
+                    self.channels[j] = channel_list(t)?;
                 }
                 "End" => {
-                    let j = *stack
-                        .last()
-                        .ok_or_else(|| Error::syntax(line, "End Site outside a joint"))?;
-                    for want in ["Site", "{", "OFFSET"] {
-                        let (l, w) = t.expect(want)?;
-                        if w != want {
-                            return Err(Error::syntax(
-                                l,
-                                format!("expected '{want}' in End Site, found '{w}'"),
-                            ));
-                        }
-                    }
-                    let offset = t.offset()?;
-                    match t.expect("'}'")? {
-                        (_, "}") => {}
-                        (l, w) => {
-                            return Err(Error::syntax(
-                                l,
-                                format!("expected '}}' closing End Site, found '{w}'"),
-                            ));
-                        }
-                    }
-                    self.end_sites.push((j, offset));
+                    let j = open("End Site")?;
+                    self.end_sites.push((j, end_site(t)?));
                 }
                 "}" => {
                     if stack.pop().is_none() {
@@ -279,6 +286,34 @@ impl Bvh {
                 }
             }
         }
+        self.check_hierarchy(t, &stack)
+    }
+
+    /// Adds joint `name` as a child of the innermost open joint and opens it.
+    fn open_joint(
+        &mut self,
+        name: String,
+        line: usize,
+        stack: &mut Vec<usize>,
+    ) -> Result<(), Error> {
+        if stack.len() == MAX_DEPTH {
+            return Err(Error::syntax(
+                line,
+                format!("joints nested deeper than {MAX_DEPTH} (the limit; rigs are tens deep)"),
+            ));
+        }
+        self.skeleton.joints.push(Joint {
+            name,
+            parent: stack.last().copied(),
+            rest: Transform::IDENTITY,
+        });
+        self.channels.push(Vec::new());
+        stack.push(self.skeleton.joints.len() - 1);
+        Ok(())
+    }
+
+    /// The end of the hierarchy: every joint closed, a root, some channels.
+    fn check_hierarchy(&self, t: &Tokens, stack: &[usize]) -> Result<(), Error> {
         if !stack.is_empty() {
             return Err(Error::syntax(
                 t.last_line,
@@ -294,6 +329,7 @@ impl Bvh {
         Ok(())
     }
 
+    /// The `MOTION` section after line `motion`: its header, then one row per frame.
     fn parse_motion(&mut self, lines: &[&str], motion: usize) -> Result<(), Error> {
         // (1-based line, text) of the non-blank lines after MOTION.
         let mut rest = lines
@@ -329,40 +365,9 @@ impl Bvh {
                 ));
             }
         };
-        let width = self.channel_count();
         let mut rows = 0usize;
         for (line, text) in rest {
-            let before = self.values.len();
-            for tok in text.split_whitespace() {
-                if self.values.len() - before == width {
-                    return Err(Error::syntax(
-                        line,
-                        format!("frame {rows} has more than {width} values (one per channel)"),
-                    ));
-                }
-                match tok.parse::<f32>() {
-                    Ok(v) if v.is_finite() => self.values.push(v),
-                    _ => {
-                        let c = self.values.len() - before;
-                        return Err(Error::syntax(
-                            line,
-                            format!(
-                                "frame {rows}, channel {c} ({}): '{tok}' is not a finite number",
-                                self.channel_name(c)
-                            ),
-                        ));
-                    }
-                }
-            }
-            let got = self.values.len() - before;
-            if got != width {
-                return Err(Error::syntax(
-                    line,
-                    format!(
-                        "frame {rows} has {got} values, expected {width} (truncated or malformed row)"
-                    ),
-                ));
-            }
+            self.read_row(line, text, rows)?;
             rows += 1;
         }
         if claimed != rows as u64 {
@@ -373,7 +378,48 @@ impl Bvh {
         Ok(())
     }
 
-    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation = `OFFSET`.
+    /// Frame `row`'s values, from `text` on `line`: one finite number per channel.
+    fn read_row(&mut self, line: usize, text: &str, row: usize) -> Result<(), Error> {
+        let width = self.channel_count();
+        let before = self.values.len();
+        for tok in text.split_whitespace() {
+            if self.values.len() - before == width {
+                return Err(Error::syntax(
+                    line,
+                    format!("frame {row} has more than {width} values (one per channel)"),
+                ));
+            }
+            match tok.parse::<f32>() {
+                Ok(v) if v.is_finite() => self.values.push(v),
+                _ => {
+                    let c = self.values.len() - before;
+                    return Err(Error::syntax(
+                        line,
+                        format!(
+                            "frame {row}, channel {c} ({}): '{tok}' is not a finite number",
+                            self.channel_name(c)
+                        ),
+                    ));
+                }
+            }
+        }
+        let got = self.values.len() - before;
+        if got != width {
+            return Err(Error::syntax(
+                line,
+                format!(
+                    "frame {row} has {got} values, expected {width} (truncated or malformed row)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Joints (`ROOT` and `JOINT`, not `End Site`), rest translation =
+    /// `OFFSET`, indexed as [`Self::channels`] and [`Self::local`] index
+    /// them. [`crate::load`] and [`Self::to_clip_doc`] give
+    /// [`Self::skeleton_with_end_sites`] instead: these joints at the same
+    /// indices, then a leaf joint per End Site.
     pub fn skeleton(&self) -> &Skeleton {
         &self.skeleton
     }
@@ -528,7 +574,9 @@ impl Bvh {
     /// The skeleton with each End Site as a leaf joint named
     /// `<parent>_end` (clip-format.md), so that tools composing the rig
     /// reach the ends of its chains (`<parent>_end2`, ... when a joint has
-    /// several, or the name is taken).
+    /// several, or the name is taken): [`Self::skeleton`]'s joints at the
+    /// same indices, then the End Sites in file order. What [`crate::load`]
+    /// gives.
     pub fn skeleton_with_end_sites(&self) -> Skeleton {
         let mut out = self.skeleton.clone();
         let mut names: std::collections::HashSet<String> =

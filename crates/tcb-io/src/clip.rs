@@ -10,9 +10,15 @@
 //! may carry for the user's own data, as in glTF. Errors name the track
 //! and the key: serde_path_to_error says where in the document an error
 //! is, and [`ClipDoc::parse`] turns that path into a [`Location`].
+//!
+//! A clip written reads back bit for bit: numbers are read as the nearest
+//! f64 (serde_json's `float_roundtrip`) and written in their shortest
+//! round-trip form, f32 values as f32 unless that form would round twice
+//! to another f32 (one positive f32 does: then its f64 form).
 
 use crate::error::{Error, ErrorKind, Location};
-use serde::de::{self, IgnoredAny};
+use crate::json::{Extras, finite_f32};
+use serde::de;
 
 use glam::{Quat, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
@@ -184,31 +190,32 @@ pub struct ClipDoc {
 /// Read, parse and build the clip at `path`.
 ///
 /// ```no_run
-/// let clip = tcb_io::load_clip("examples/clips/bounce.json".as_ref())?;
+/// let clip = tcb_io::load_clip("examples/clips/bounce.json")?;
 /// println!("{} channels", clip.channel_count());
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
-pub fn load_clip(path: &Path) -> Result<Clip, Error> {
+pub fn load_clip(path: impl AsRef<Path>) -> Result<Clip, Error> {
+    let path = path.as_ref();
     let doc = read_clip_doc(path)?;
     doc.build().map_err(|e| e.in_file(path))
 }
 
 /// Read and parse the clip file at `path` without building it (files
-/// above [`crate::DEFAULT_MAX_FILE_BYTES`] are refused unread).
-pub fn read_clip_doc(path: &Path) -> Result<ClipDoc, Error> {
-    read_clip_doc_limited(path, crate::DEFAULT_MAX_FILE_BYTES)
+/// above [`crate::files::DEFAULT_MAX_FILE_BYTES`] are refused unread).
+pub fn read_clip_doc(path: impl AsRef<Path>) -> Result<ClipDoc, Error> {
+    read_clip_doc_limited(path.as_ref(), crate::files::DEFAULT_MAX_FILE_BYTES)
 }
 
 /// [`read_clip_doc`] with its own file size limit.
 pub(crate) fn read_clip_doc_limited(path: &Path, limit: u64) -> Result<ClipDoc, Error> {
-    let text = crate::read_text_limited(path, limit)?;
+    let text = crate::files::read_text_limited(path, limit)?;
     ClipDoc::parse(&text).map_err(|e| e.in_file(path))
 }
 
 /// Write `doc` to `path`: to a temporary file beside it, then renamed over
 /// it, so that a failure leaves no half-written clip.
-pub fn write_clip_doc(doc: &ClipDoc, path: &Path) -> Result<(), Error> {
-    crate::write_atomically(path, doc.to_json().as_bytes())
+pub fn write_clip_doc(doc: &ClipDoc, path: impl AsRef<Path>) -> Result<(), Error> {
+    crate::files::write_atomically(path, doc.to_json().as_bytes())
 }
 
 impl ClipDoc {
@@ -407,56 +414,6 @@ mod named {
     }
 }
 
-/// `extras`: whatever the user keeps there, not kept by the reader but
-/// walked, so that it is nested no deeper than the JSON reader's limit
-/// (128 levels) like the rest of the file.
-pub(crate) struct Extras;
-
-impl<'de> Deserialize<'de> for Extras {
-    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> de::Visitor<'de> for V {
-            type Value = Extras;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("any JSON value")
-            }
-            fn visit_bool<E>(self, _: bool) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_i64<E>(self, _: i64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_u64<E>(self, _: u64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_f64<E>(self, _: f64) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_str<E>(self, _: &str) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_unit<E>(self) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_none<E>(self) -> Result<Extras, E> {
-                Ok(Extras)
-            }
-            fn visit_some<D: de::Deserializer<'de>>(self, d: D) -> Result<Extras, D::Error> {
-                Extras::deserialize(d)
-            }
-            fn visit_seq<A: de::SeqAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
-                while a.next_element::<Extras>()?.is_some() {}
-                Ok(Extras)
-            }
-            fn visit_map<A: de::MapAccess<'de>>(self, mut a: A) -> Result<Extras, A::Error> {
-                while a.next_entry::<IgnoredAny, Extras>()?.is_some() {}
-                Ok(Extras)
-            }
-        }
-        d.deserialize_any(V)
-    }
-}
-
 /// A value as written: a number, or an array of numbers (its shape is
 /// checked against the track's kind once the kind is known).
 #[derive(Clone, Debug, PartialEq)]
@@ -546,18 +503,6 @@ impl ValueIn {
                     .join(", ")
             ),
         }
-    }
-}
-
-/// An f64 as read that must fit an f32 (finite after rounding).
-pub(crate) fn finite_f32(x: f64, what: &str) -> Result<f32, String> {
-    let y = x as f32;
-    if y.is_finite() {
-        Ok(y)
-    } else {
-        // serde_json's shortest form (`1e300`, not 301 digits).
-        let text = serde_json::Number::from_f64(x).map_or(x.to_string(), |n| n.to_string());
-        Err(format!("{what} {text} is not a finite f32"))
     }
 }
 
@@ -963,6 +908,15 @@ impl serde_json::ser::Formatter for ClipFormatter {
     fn write_f32<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f32) -> std::io::Result<()> {
         self.number.clear();
         serde_json::ser::CompactFormatter.write_f32(&mut self.number, x)?;
+        if !reads_back_as_f32(&self.number, x) {
+            // The reader takes a number as the nearest f64, then rounds
+            // it to f32: that rounds twice, and for one f32 in 2^31
+            // (`7.038531e-26`, found by trying every f32) the shortest
+            // decimal lands on the midpoint of two f32s and rounds to the
+            // other. The f32's own value, written as an f64, is exact.
+            self.number.clear();
+            serde_json::ser::CompactFormatter.write_f64(&mut self.number, f64::from(x))?;
+        }
         self.write_number(w)
     }
     fn write_f64<W: ?Sized + std::io::Write>(&mut self, w: &mut W, x: f64) -> std::io::Result<()> {
@@ -970,6 +924,15 @@ impl serde_json::ser::Formatter for ClipFormatter {
         serde_json::ser::CompactFormatter.write_f64(&mut self.number, x)?;
         self.write_number(w)
     }
+}
+
+/// Whether `text`, read as the clip reader reads an f32 (the nearest f64,
+/// then rounded to f32), gives `x` back bit for bit.
+fn reads_back_as_f32(text: &[u8], x: f32) -> bool {
+    std::str::from_utf8(text)
+        .ok()
+        .and_then(|t| t.parse::<f64>().ok())
+        .is_some_and(|y| (y as f32).to_bits() == x.to_bits())
 }
 
 impl ClipFormatter {

@@ -107,8 +107,8 @@ impl Error {
     }
 
     /// Attach the file name (for errors from text parsed in memory).
-    pub fn in_file(mut self, file: &Path) -> Self {
-        self.location.file = Some(file.to_path_buf());
+    pub fn in_file(mut self, file: impl AsRef<Path>) -> Self {
+        self.location.file = Some(file.as_ref().to_path_buf());
         self
     }
 }

@@ -24,24 +24,61 @@
 //! 8 points per piece; the error reached is reported per track. glTF holds
 //! the end values outside the keys, so other `pre`/`post` modes are
 //! reported as notes. The document is built with the `gltf-json` types.
+//!
+//! glTF's key times are f32. Times beyond f32's range, and distinct times
+//! that are one f32, are refused (the file would not read back). Where
+//! f32 moves a key (0.1 s is not an f32; at 1e6 s, f32 steps by 1/16 s),
+//! the track is not exact: it is read back as `tcb import` reads it and
+//! measured against the clip, and that error is reported
+//! ([`TrackExport::time_rounding`]).
 
-use crate::Error;
+use crate::error::Error;
 use gltf::json;
 use json::accessor::Type as AccessorType;
 use json::animation::Interpolation;
 use json::validation::{Checked, USize64};
 use std::path::Path;
 use tcb_core::skeleton::Skeleton;
-use tcb_core::{Extrapolation, Interp, Track, TrackData, Value as TcbValue};
+use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value as TcbValue};
 
 /// How one track was written.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackExport {
     /// The track.
     pub name: String,
-    /// `None` when exact; else the largest difference from the reference
-    /// measured on the resampled curve (relative to max(1, |value|)).
+    /// `None` when the curve is written as it is; else the largest
+    /// difference from the reference (relative to max(1, |value|)) of the
+    /// resampled curve as `tcb import` reads the export back, measured as
+    /// [`TimeRounding::error`] is (and no less than the resampling's own
+    /// measure).
     pub resampled_error: Option<f64>,
+    /// `None` when every time written is the track's own (an f32); else
+    /// what rounding them to glTF's f32 key times did.
+    pub time_rounding: Option<TimeRounding>,
+}
+
+impl TrackExport {
+    /// `None` when exact; else the largest difference from the reference
+    /// (relative to max(1, |value|)) that a reader of the export gets,
+    /// resampling and f32 key times included.
+    pub fn error(&self) -> Option<f64> {
+        match (self.resampled_error, self.time_rounding) {
+            (None, None) => None,
+            (e, r) => Some(e.unwrap_or(0.0).max(r.map_or(0.0, |r| r.error))),
+        }
+    }
+}
+
+/// What glTF's f32 key times did to a track whose times are not all f32s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeRounding {
+    /// The largest distance a key (or a resampled knot) moved, seconds.
+    pub largest_shift: f64,
+    /// The largest difference from the reference (relative to max(1,
+    /// |value|)) of the track as `tcb import` reads the export back,
+    /// measured at the keys, the stored times and 7 points between each
+    /// two of them, widened to bound the difference between the points.
+    pub error: f64,
 }
 
 /// What [`export`] did.
@@ -54,17 +91,21 @@ pub struct ExportReport {
 }
 
 impl ExportReport {
-    /// The largest resampling error (0 when everything is exact).
+    /// The largest error of a track ([`TrackExport::error`]; 0 when
+    /// everything is exact).
     pub fn max_error(&self) -> f64 {
         self.tracks
             .iter()
-            .filter_map(|t| t.resampled_error)
+            .filter_map(TrackExport::error)
             .fold(0.0, f64::max)
     }
 }
 
 /// One sampler's data.
 struct Sampler {
+    /// The times the curve was built on.
+    source_times: Vec<f64>,
+    /// Those times as glTF stores them.
     times: Vec<f32>,
     interpolation: Interpolation,
     /// Output elements (for CUBICSPLINE: in, value, out per key).
@@ -81,6 +122,7 @@ struct Cubic {
     tout: Vec<Vec<f32>>,
 }
 
+/// A track's own keys and tangents as glTF CUBICSPLINE keys (time-unit tangents over the f32 spans).
 fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
     let times = t.times().to_vec();
     let n = times.len();
@@ -103,6 +145,7 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
     }
 }
 
+/// How glTF can hold a vector track: STEP, its own cubic, or resampled.
 fn exact_shape<V: TcbValue>(t: &Track<V>) -> Shape {
     let segs = t.segments();
     if segs.iter().all(|s| s.interp == Interp::Step) {
@@ -127,7 +170,7 @@ enum Shape {
 
 /// Hermite on one component over `[0, 1]` with time-unit tangents and span `d`.
 fn hermite(p0: f32, p1: f32, m0: f32, m1: f32, d: f32, u: f32) -> f32 {
-    let h = tcb_core::basis::hermite_basis(u);
+    let h = tcb_core::simd::basis::hermite_basis(u);
     h[0] * p0 + h[1] * p1 + h[2] * m0 * d + h[3] * m1 * d
 }
 
@@ -136,86 +179,22 @@ type Knot = (Vec<f32>, Vec<f32>, Vec<f32>);
 
 /// Resample `data` (dim components) as a cubic within `max_error`.
 fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
-    let dim = data.kind().dim();
-    let rotation = matches!(data, TrackData::Quat(_));
-    let keys = data.times().to_vec();
-    let sample = |t: f64| {
-        let (mut v, mut d) = (vec![0.0f32; dim], vec![0.0f32; dim]);
-        data.sample_into(t, &mut v, Some(&mut d));
-        (v, d)
+    let reference = Reference {
+        data,
+        dim: data.kind().dim(),
+        rotation: matches!(data, TrackData::Quat(_)),
     };
-    let (v0, d0) = sample(keys[0]);
+    let keys = data.times();
+    let (v0, d0) = reference.sample(keys[0]);
     let mut out = Cubic {
         times: vec![keys[0]],
         values: vec![v0],
-        tin: vec![vec![0.0; dim]],
+        tin: vec![vec![0.0; reference.dim]],
         tout: vec![d0],
     };
     let mut worst = 0.0f64;
     for k in 0..keys.len() - 1 {
-        let (a, b) = (keys[k], keys[k + 1]);
-        let mut best: Option<(Vec<f64>, Vec<Knot>, f64)> = None;
-        let mut pieces = 1;
-        while pieces <= 64 {
-            let knots: Vec<f64> = (0..=pieces)
-                .map(|j| a + (b - a) * j as f64 / pieces as f64)
-                .collect();
-            // (value, in tangent, out tangent) at each knot. The in tangent at
-            // b is the left derivative; its out tangent is replaced by the
-            // next segment's first knot (and at the last key the reference's
-            // velocity is already the left derivative).
-            let at: Vec<_> = knots
-                .iter()
-                .enumerate()
-                .map(|(j, &t)| {
-                    let (v, d) = sample(t);
-                    let din = if j == pieces {
-                        sample(b - (b - a) * 1e-7).1
-                    } else {
-                        d.clone()
-                    };
-                    (v, din, d)
-                })
-                .collect();
-            let mut err = 0.0f64;
-            for j in 0..pieces {
-                let d = (knots[j + 1] - knots[j]) as f32;
-                for i in 1..8 {
-                    let u = i as f32 / 8.0;
-                    let t = knots[j] + f64::from(u) * (knots[j + 1] - knots[j]);
-                    let mut got: Vec<f32> = (0..dim)
-                        .map(|c| {
-                            hermite(at[j].0[c], at[j + 1].0[c], at[j].2[c], at[j + 1].1[c], d, u)
-                        })
-                        .collect();
-                    if rotation {
-                        let l = got.iter().map(|x| x * x).sum::<f32>().sqrt();
-                        got.iter_mut().for_each(|x| *x /= l);
-                    }
-                    let want = sample(t).0;
-                    let diff = |s: f32| {
-                        want.iter()
-                            .zip(&got)
-                            .map(|(w, g)| f64::from((w - s * g).abs() / w.abs().max(1.0)))
-                            .fold(0.0, f64::max)
-                    };
-                    err = err.max(if rotation {
-                        diff(1.0).min(diff(-1.0))
-                    } else {
-                        diff(1.0)
-                    });
-                }
-            }
-            let better = best.as_ref().is_none_or(|b| err < b.2);
-            if better {
-                best = Some((knots, at, err));
-            }
-            if err <= max_error {
-                break;
-            }
-            pieces *= 2;
-        }
-        let (knots, at, err) = best.expect("at least one try");
+        let (knots, at, err) = reference.fit_segment(keys[k], keys[k + 1], max_error);
         worst = worst.max(err);
         // The knot at `a` is already there: set its out tangent, add the rest.
         let last = out.times.len() - 1;
@@ -234,6 +213,112 @@ fn resample(data: &TrackData, max_error: f64) -> (Cubic, f64) {
     (out, worst)
 }
 
+/// The track [`resample`] follows.
+struct Reference<'a> {
+    data: &'a TrackData,
+    dim: usize,
+    rotation: bool,
+}
+
+impl Reference<'_> {
+    /// Value and velocity at `t`.
+    fn sample(&self, t: f64) -> (Vec<f32>, Vec<f32>) {
+        let (mut v, mut d) = (vec![0.0f32; self.dim], vec![0.0f32; self.dim]);
+        self.data.sample_into(t, &mut v, Some(&mut d));
+        (v, d)
+    }
+
+    /// Segment `[a, b]` split into 1, 2, 4, ... 64 equal pieces until the
+    /// cubic through the knots is within `max_error` (bounded between the
+    /// measured points): the knots, their samples and the error, of the
+    /// best try.
+    fn fit_segment(&self, a: f64, b: f64, max_error: f64) -> (Vec<f64>, Vec<Knot>, f64) {
+        let mut best: Option<(Vec<f64>, Vec<Knot>, f64)> = None;
+        let mut pieces = 1;
+        while pieces <= 64 {
+            let knots: Vec<f64> = (0..=pieces)
+                .map(|j| a + (b - a) * j as f64 / pieces as f64)
+                .collect();
+            // glTF stores the knots as f32: finer pieces than f32 tells
+            // apart would be keys at one time (the keys themselves are
+            // apart in f32, `check_times`).
+            if pieces > 1 && knots.windows(2).any(|w| w[0] as f32 >= w[1] as f32) {
+                break;
+            }
+            let at = self.knot_samples(&knots, a, b);
+            let err = self.pieces_error(&knots, &at);
+            if best.as_ref().is_none_or(|b| err < b.2) {
+                best = Some((knots, at, err));
+            }
+            if err * BETWEEN_POINTS <= max_error {
+                break;
+            }
+            pieces *= 2;
+        }
+        best.expect("at least one try")
+    }
+
+    /// (value, in tangent, out tangent) at each knot of `[a, b]`. The in
+    /// tangent at b is the left derivative; its out tangent is replaced by
+    /// the next segment's first knot (and at the last key the reference's
+    /// velocity is already the left derivative).
+    fn knot_samples(&self, knots: &[f64], a: f64, b: f64) -> Vec<Knot> {
+        let last = knots.len() - 1;
+        knots
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| {
+                let (v, d) = self.sample(t);
+                let din = if j == last {
+                    self.sample(b - (b - a) * 1e-7).1
+                } else {
+                    d.clone()
+                };
+                (v, din, d)
+            })
+            .collect()
+    }
+
+    /// The largest difference between the reference and the cubic pieces
+    /// through `at`, at 7 points inside each piece.
+    fn pieces_error(&self, knots: &[f64], at: &[Knot]) -> f64 {
+        let mut err = 0.0f64;
+        for j in 0..knots.len() - 1 {
+            let d = (knots[j + 1] - knots[j]) as f32;
+            for i in 1..8 {
+                let u = i as f32 / 8.0;
+                let t = knots[j] + f64::from(u) * (knots[j + 1] - knots[j]);
+                let mut got: Vec<f32> = (0..self.dim)
+                    .map(|c| hermite(at[j].0[c], at[j + 1].0[c], at[j].2[c], at[j + 1].1[c], d, u))
+                    .collect();
+                if self.rotation {
+                    let l = got.iter().map(|x| x * x).sum::<f32>().sqrt();
+                    got.iter_mut().for_each(|x| *x /= l);
+                }
+                err = err.max(difference(&self.sample(t).0, &got, self.rotation));
+            }
+        }
+        err
+    }
+}
+
+/// `got` against `want` relative to max(1, |value|), rotations up to sign:
+/// the error [`resample`] and the read-back check measure.
+fn difference(want: &[f32], got: &[f32], rotation: bool) -> f64 {
+    let diff = |s: f32| {
+        want.iter()
+            .zip(got)
+            .map(|(w, g)| f64::from((w - s * g).abs() / w.abs().max(1.0)))
+            .fold(0.0, f64::max)
+    };
+    if rotation {
+        diff(1.0).min(diff(-1.0))
+    } else {
+        diff(1.0)
+    }
+}
+
+/// A CUBICSPLINE sampler of `c`: in-tangent, value, out-tangent per key.
 fn cubic_sampler(c: &Cubic, kind: AccessorType) -> Sampler {
     let width = c.values[0].len();
     let mut output = Vec::with_capacity(c.times.len() * width * 3);
@@ -243,6 +328,7 @@ fn cubic_sampler(c: &Cubic, kind: AccessorType) -> Sampler {
         output.extend_from_slice(&c.tout[k]);
     }
     Sampler {
+        source_times: c.times.clone(),
         times: c.times.iter().map(|&t| t as f32).collect(),
         interpolation: Interpolation::CubicSpline,
         output,
@@ -356,8 +442,9 @@ pub enum Container {
 
 impl Container {
     /// `.glb` for a path ending in `glb` (any case), else `.gltf`.
-    pub fn for_path(path: &Path) -> Container {
+    pub fn for_path(path: impl AsRef<Path>) -> Container {
         if path
+            .as_ref()
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
         {
@@ -377,57 +464,16 @@ pub fn export(
     container: Container,
     options: &ExportOptions,
 ) -> Result<(Vec<u8>, ExportReport), Error> {
-    let binary = container == Container::Glb;
     let max_error = options.max_error;
     let track_names = renamed(clip, &options.rename)?;
-    let mut report = ExportReport::default();
-    let mut nodes: Vec<NodeOut> = skeleton
-        .map(|s| {
-            s.joints
-                .iter()
-                .map(|j| NodeOut {
-                    name: j.name.clone(),
-                    parent: j.parent,
-                    rest: Some(j.rest),
-                    morphs: 0,
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    // (node, path, sampler)
-    let mut channels: Vec<(usize, &'static str, Sampler)> = Vec::new();
-    // Weight tracks per node: (target index, track index).
+    let mut scene = Scene::of(skeleton);
+    let mut notes = Vec::new();
+    // Weight tracks per node: (node, [(target index, track index)]).
     let mut weights: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
     for (ti, t) in clip.tracks().iter().enumerate() {
         let (node, path, morph) = target(&track_names[ti], &t.data).map_err(Error::import)?;
-        let ni = match nodes.iter().position(|n| n.name == node) {
-            Some(i) => i,
-            None => {
-                nodes.push(NodeOut {
-                    name: node,
-                    parent: None,
-                    rest: None,
-                    morphs: 0,
-                });
-                nodes.len() - 1
-            }
-        };
-        let (pre, post) = match &t.data {
-            TrackData::Quat(r) => (r.settings().pre, r.settings().post),
-            TrackData::Scalar(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec2(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec3(x) => (x.settings().pre, x.settings().post),
-            TrackData::Vec4(x) => (x.settings().pre, x.settings().post),
-        };
-        for (side, mode) in [("pre", pre), ("post", post)] {
-            if mode != Extrapolation::Constant {
-                report.notes.push(format!(
-                    "track '{}': {side} '{}' is not expressible; glTF holds the end value",
-                    t.name,
-                    mode.name()
-                ));
-            }
-        }
+        let ni = scene.node(node);
+        notes.extend(extrapolation_notes(&t.name, &t.data));
         if path == "weights" {
             match weights.iter_mut().find(|w| w.0 == ni) {
                 Some(w) => w.1.push((morph, ti)),
@@ -435,51 +481,336 @@ pub fn export(
             }
             continue;
         }
-        let (sampler, err) = track_sampler(&t.data, max_error);
-        report.tracks.push(TrackExport {
-            name: t.name.clone(),
-            resampled_error: err,
-        });
-        channels.push((ni, path, sampler));
+        scene.add(ni, path, export_track(&t.name, &t.data, max_error)?);
     }
-    for (ni, mut list) in weights {
+    for (ni, list) in weights {
+        scene.add_weights(clip, ni, list, max_error)?;
+    }
+    notes.extend(resampling_note(&scene.tracks, &scene.fits, max_error));
+    notes.extend(time_rounding_note(&scene.tracks, &scene.fits, max_error));
+    let bytes = write(
+        clip.name(),
+        &scene.nodes,
+        &scene.channels,
+        container == Container::Glb,
+    )?;
+    let report = ExportReport {
+        tracks: scene.tracks,
+        notes,
+    };
+    Ok((bytes, report))
+}
+
+/// What [`export`] builds: the nodes, the channels, and per track its
+/// report and the resampling's own measure.
+struct Scene {
+    nodes: Vec<NodeOut>,
+    /// (node, path, sampler)
+    channels: Vec<(usize, &'static str, Sampler)>,
+    tracks: Vec<TrackExport>,
+    fits: Vec<Option<f64>>,
+}
+
+impl Scene {
+    /// The skeleton's joints as nodes (none without one).
+    fn of(skeleton: Option<&Skeleton>) -> Scene {
+        let nodes = skeleton
+            .map(|s| {
+                s.joints
+                    .iter()
+                    .map(|j| NodeOut {
+                        name: j.name.clone(),
+                        parent: j.parent,
+                        rest: Some(j.rest),
+                        morphs: 0,
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        Scene {
+            nodes,
+            channels: Vec::new(),
+            tracks: Vec::new(),
+            fits: Vec::new(),
+        }
+    }
+
+    /// The node named `name`, a new root node if there is none.
+    fn node(&mut self, name: String) -> usize {
+        match self.nodes.iter().position(|n| n.name == name) {
+            Some(i) => i,
+            None => {
+                self.nodes.push(NodeOut {
+                    name,
+                    parent: None,
+                    rest: None,
+                    morphs: 0,
+                });
+                self.nodes.len() - 1
+            }
+        }
+    }
+
+    /// A written track as the channel `path` of node `ni`.
+    fn add(&mut self, ni: usize, path: &'static str, w: Written) {
+        self.tracks.push(w.report);
+        self.fits.push(w.fit);
+        self.channels.push((ni, path, w.sampler));
+    }
+
+    /// Node `ni`'s weight tracks `list` ((target index, track index)) as
+    /// one channel of a mesh with that many morph targets.
+    fn add_weights(
+        &mut self,
+        clip: &tcb_core::Clip,
+        ni: usize,
+        mut list: Vec<(usize, usize)>,
+        max_error: f64,
+    ) -> Result<(), Error> {
         list.sort();
         if list.iter().enumerate().any(|(i, (m, _))| *m != i) {
             return Err(Error::import(format!(
                 "node '{}': weight tracks must be numbered 0, 1, 2, ... without gaps or repeats",
-                nodes[ni].name
+                self.nodes[ni].name
             )));
         }
-        let per: Vec<(Sampler, Option<f64>)> = list
+        let per: Vec<Written> = list
             .iter()
-            .map(|(_, ti)| track_sampler(&clip.tracks()[*ti].data, max_error))
-            .collect();
-        if per
-            .iter()
-            .any(|(s, _)| s.times != per[0].0.times || s.interpolation != per[0].0.interpolation)
-        {
+            .map(|(_, ti)| {
+                let t = &clip.tracks()[*ti];
+                export_track(&t.name, &t.data, max_error)
+            })
+            .collect::<Result<_, _>>()?;
+        let first = &per[0].sampler;
+        if per.iter().any(|w| {
+            w.sampler.times != first.times || w.sampler.interpolation != first.interpolation
+        }) {
             return Err(Error::import(format!(
                 "node '{}': glTF stores all morph weights of a node in one sampler; its weight tracks need the same key times and the same exactness (all exact or all resampled the same way)",
-                nodes[ni].name
+                self.nodes[ni].name
             )));
         }
-        for ((_, ti), (_, e)) in list.iter().zip(&per) {
-            report.tracks.push(TrackExport {
-                name: clip.tracks()[*ti].name.clone(),
-                resampled_error: *e,
-            });
-        }
-        nodes[ni].morphs = list.len();
-        channels.push((
-            ni,
-            "weights",
-            merge(&per.iter().map(|p| &p.0).collect::<Vec<_>>()),
-        ));
+        self.tracks.extend(per.iter().map(|w| w.report.clone()));
+        self.fits.extend(per.iter().map(|w| w.fit));
+        self.nodes[ni].morphs = list.len();
+        let merged = merge(&per.iter().map(|w| &w.sampler).collect::<Vec<_>>());
+        self.channels.push((ni, "weights", merged));
+        Ok(())
     }
-    let bytes = write(clip.name(), &nodes, &channels, binary)?;
-    Ok((bytes, report))
 }
 
+/// Notes for `pre`/`post` modes glTF cannot hold (it holds the end values).
+fn extrapolation_notes(name: &str, data: &TrackData) -> Vec<String> {
+    let (pre, post) = match data {
+        TrackData::Quat(r) => (r.settings().pre, r.settings().post),
+        TrackData::Scalar(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec2(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec3(x) => (x.settings().pre, x.settings().post),
+        TrackData::Vec4(x) => (x.settings().pre, x.settings().post),
+    };
+    [("pre", pre), ("post", post)]
+        .into_iter()
+        .filter(|(_, mode)| *mode != Extrapolation::Constant)
+        .map(|(side, mode)| {
+            format!(
+                "track '{name}': {side} '{}' is not expressible; glTF holds the end value",
+                mode.name()
+            )
+        })
+        .collect()
+}
+
+/// One note for the tracks whose resampling stopped above `max_error`
+/// by its own measure (`fits`, one per track).
+fn resampling_note(tracks: &[TrackExport], fits: &[Option<f64>], max_error: f64) -> Option<String> {
+    let over: Vec<(&str, f64)> = tracks
+        .iter()
+        .zip(fits)
+        .filter_map(|(t, f)| f.filter(|f| *f > max_error).map(|f| (t.name.as_str(), f)))
+        .collect();
+    let (name, worst) = over.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let what = match over.len() {
+        1 => format!("track '{name}': resampled to {worst:e} at best"),
+        n => format!("{n} tracks: resampled to up to {worst:e} at best (in '{name}')"),
+    };
+    Some(format!(
+        "{what}, above the max error {max_error:e} (a step inside a curve track cannot be followed by a cubic)"
+    ))
+}
+
+/// One note for the tracks that glTF's f32 key times put further off than
+/// `max_error` where their curve (exact, or resampled by its own measure,
+/// `fits`) is within it: why, and what to do.
+fn time_rounding_note(
+    tracks: &[TrackExport],
+    fits: &[Option<f64>],
+    max_error: f64,
+) -> Option<String> {
+    let over: Vec<(&str, TimeRounding)> = tracks
+        .iter()
+        .zip(fits)
+        .filter(|(_, f)| f.unwrap_or(0.0) <= max_error)
+        .filter_map(|(t, _)| t.time_rounding.map(|r| (t.name.as_str(), r)))
+        .filter(|(_, r)| r.error > max_error)
+        .collect();
+    let shift = over
+        .iter()
+        .map(|(_, r)| r.largest_shift)
+        .fold(0.0, f64::max);
+    let (name, worst) = over
+        .iter()
+        .max_by(|a, b| a.1.error.total_cmp(&b.1.error))
+        .map(|(n, r)| (*n, r.error))?;
+    let what = match over.len() {
+        1 => format!(
+            "track '{name}': glTF's f32 key times move its keys by up to {shift:.2e} s, which puts it {worst:e} off the clip"
+        ),
+        n => format!(
+            "{n} tracks: glTF's f32 key times move their keys by up to {shift:.2e} s, which puts them up to {worst:e} off the clip (in '{name}')"
+        ),
+    };
+    Some(format!(
+        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: shift the clip's times toward 0, or accept it with a larger max error)"
+    ))
+}
+
+/// One track as written.
+struct Written {
+    sampler: Sampler,
+    report: TrackExport,
+    /// The resampling's own measure (`None`: written as it is).
+    fit: Option<f64>,
+}
+
+/// Track `name`'s sampler and report: its times checked against glTF's
+/// f32 key times (`check_times`), and, where it is resampled or f32 moves
+/// its times, the track read back as `tcb import` reads it and measured.
+fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written, Error> {
+    check_times(name, data.times())?;
+    let (sampler, fit) = track_sampler(data, max_error);
+    let largest_shift = sampler
+        .source_times
+        .iter()
+        .zip(&sampler.times)
+        .map(|(&t, &f)| (f64::from(f) - t).abs())
+        .fold(0.0, f64::max);
+    let measured = if fit.is_some() || largest_shift > 0.0 {
+        let back = read_back(data.kind(), &sampler).map_err(|e| {
+            Error::import(format!(
+                "track '{name}': its glTF keys would not read back ({e})"
+            ))
+        })?;
+        read_back_error(data, &back)
+    } else {
+        0.0
+    };
+    let report = TrackExport {
+        name: name.to_string(),
+        resampled_error: fit.map(|f| f.max(measured)),
+        time_rounding: (largest_shift > 0.0).then_some(TimeRounding {
+            largest_shift,
+            error: measured,
+        }),
+    };
+    Ok(Written {
+        sampler,
+        report,
+        fit,
+    })
+}
+
+/// `t` in seconds as a message writes it (`1e39`, not 40 digits).
+fn seconds(t: f64) -> String {
+    if t != 0.0 && !(1e-4..1e16).contains(&t.abs()) {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
+/// Refuses key times glTF cannot store: beyond f32's range, or two
+/// distinct times that are one f32 (the export would not read back).
+fn check_times(name: &str, times: &[f64]) -> Result<(), Error> {
+    for (k, &t) in times.iter().enumerate() {
+        if !(t as f32).is_finite() {
+            return Err(Error::import(format!(
+                "track '{name}': key {k} is at {} s, beyond glTF's key times (f32, at most {:e} s); scale or shift the clip's times into that range before exporting",
+                seconds(t),
+                f32::MAX
+            )));
+        }
+        if k > 0 && times[k - 1] as f32 == t as f32 {
+            let at = t as f32;
+            let step = f64::from(at.next_up()) - f64::from(at);
+            return Err(Error::import(format!(
+                "track '{name}': keys {} and {k} (at {} and {} s) are one time in glTF's f32 key times ({} s apart at that time); shift the clip's times toward 0, or space those keys further apart, before exporting",
+                k - 1,
+                seconds(times[k - 1]),
+                seconds(t),
+                seconds(step)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `sampler` as `tcb import` reads it: its f32 times, its output, the
+/// importer's own conversion (`gltf_import::sampler_track`).
+fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::TrackError> {
+    let times = sampler.times.iter().map(|&t| f64::from(t)).collect();
+    let dim = kind.dim();
+    let per_key = if sampler.interpolation == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
+    let value = |k: usize, e: usize| {
+        let at = (k * per_key + e) * dim;
+        let mut v = [0.0; 4];
+        v[..dim].copy_from_slice(&sampler.output[at..at + dim]);
+        v
+    };
+    crate::gltf_import::sampler_track(String::new(), kind, times, sampler.interpolation, value)
+        .build(&crate::clip::SettingsDoc::default())
+}
+
+/// How much more than its largest value at 9 evenly spaced points a cubic
+/// can reach between them: with `h = 1/8` of the interval, Markov's
+/// inequality bounds the second derivative by `96 max|p|`, so linear
+/// interpolation misses by at most `12 h² max|p|`, and
+/// `max|p| <= max|p(x_i)| / (1 - 12/64) = 1.23 max|p(x_i)|`.
+const BETWEEN_POINTS: f64 = 1.25;
+
+/// The largest difference between `data` and `back` (relative to max(1,
+/// |value|), rotations up to sign) at the keys of both and 7 points
+/// between each two, `data` held at its end values outside its keys as
+/// glTF holds them; times [`BETWEEN_POINTS`], so that it bounds the
+/// difference between the points too.
+fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
+    let dim = data.kind().dim();
+    let rotation = data.kind() == TrackKind::Quat;
+    let own = data.times();
+    let (first, last) = (own[0], own[own.len() - 1]);
+    let mut times: Vec<f64> = own.iter().chain(back.times()).copied().collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let (mut want, mut got) = ([0.0f32; 4], [0.0f32; 4]);
+    let mut worst = 0.0f64;
+    let mut at = |t: f64| {
+        data.sample_into(t.clamp(first, last), &mut want[..dim], None);
+        back.sample_into(t, &mut got[..dim], None);
+        worst = worst.max(difference(&want[..dim], &got[..dim], rotation));
+    };
+    for w in times.windows(2) {
+        for i in 0..8 {
+            at(w[0] + (w[1] - w[0]) * f64::from(i) / 8.0);
+        }
+    }
+    at(times[times.len() - 1]);
+    worst * BETWEEN_POINTS
+}
+
+/// The sampler of `data` in the shape glTF can hold, and the resampling's own error (`None`: written as it is).
 fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
     let kind = match data.kind().dim() {
         1 => AccessorType::Scalar,
@@ -514,6 +845,7 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
                 output.extend_from_slice(&v);
             }
             let sampler = Sampler {
+                source_times: data.times().to_vec(),
                 times: data.times().iter().map(|&t| t as f32).collect(),
                 interpolation: if shape == Shape::Step {
                     Interpolation::Step
@@ -542,6 +874,7 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
     }
 }
 
+/// One sampler of several morph targets' samplers (same times), outputs interleaved per element.
 fn merge(samplers: &[&Sampler]) -> Sampler {
     let targets = samplers.len();
     let per_key = if samplers[0].interpolation == Interpolation::CubicSpline {
@@ -557,6 +890,7 @@ fn merge(samplers: &[&Sampler]) -> Sampler {
         }
     }
     Sampler {
+        source_times: samplers[0].source_times.clone(),
         times: samplers[0].times.clone(),
         interpolation: samplers[0].interpolation,
         output,
@@ -659,13 +993,13 @@ impl Builder {
     }
 }
 
+/// The glTF (or GLB) file of `nodes` and one animation `name` of `channels`.
 fn write(
     name: &str,
     nodes: &[NodeOut],
     channels: &[(usize, &'static str, Sampler)],
     binary: bool,
 ) -> Result<Vec<u8>, Error> {
-    use json::accessor::Type;
     let mut b = Builder {
         root: json::Root {
             asset: json::Asset {
@@ -676,115 +1010,139 @@ fn write(
         },
         bin: Vec::new(),
     };
-    let mut samplers = Vec::new();
-    let mut anim_channels = Vec::new();
-    for (node, path, s) in channels {
-        let input = b.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
-        let count = s.output.len() / s.kind.multiplicity();
-        let output = b.accessor(&s.output, count, s.kind, false, false);
-        samplers.push(json::animation::Sampler {
-            extensions: None,
-            extras: Default::default(),
-            input,
-            interpolation: Checked::Valid(s.interpolation),
-            output,
-        });
-        let property = match *path {
-            "translation" => json::animation::Property::Translation,
-            "rotation" => json::animation::Property::Rotation,
-            "scale" => json::animation::Property::Scale,
-            _ => json::animation::Property::MorphTargetWeights,
-        };
-        anim_channels.push(json::animation::Channel {
-            sampler: json::Index::new(samplers.len() as u32 - 1),
-            target: json::animation::Target {
+    // Accessors are numbered as they are pushed: the animation's first,
+    // then the morph meshes'.
+    b.animation(name, channels);
+    b.nodes(nodes);
+    b.finish(binary)
+}
+
+impl Builder {
+    /// The animation `name`: a sampler (input and output accessors) and a
+    /// channel per entry of `channels`.
+    fn animation(&mut self, name: &str, channels: &[(usize, &'static str, Sampler)]) {
+        use json::accessor::Type;
+        let mut samplers = Vec::new();
+        let mut anim_channels = Vec::new();
+        for (node, path, s) in channels {
+            let input = self.accessor(&s.times, s.times.len(), Type::Scalar, true, false);
+            let count = s.output.len() / s.kind.multiplicity();
+            let output = self.accessor(&s.output, count, s.kind, false, false);
+            samplers.push(json::animation::Sampler {
                 extensions: None,
                 extras: Default::default(),
-                node: json::Index::new(*node as u32),
-                path: Checked::Valid(property),
-            },
+                input,
+                interpolation: Checked::Valid(s.interpolation),
+                output,
+            });
+            let property = match *path {
+                "translation" => json::animation::Property::Translation,
+                "rotation" => json::animation::Property::Rotation,
+                "scale" => json::animation::Property::Scale,
+                _ => json::animation::Property::MorphTargetWeights,
+            };
+            anim_channels.push(json::animation::Channel {
+                sampler: json::Index::new(samplers.len() as u32 - 1),
+                target: json::animation::Target {
+                    extensions: None,
+                    extras: Default::default(),
+                    node: json::Index::new(*node as u32),
+                    path: Checked::Valid(property),
+                },
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+        self.root.push(json::Animation {
             extensions: None,
             extras: Default::default(),
+            channels: anim_channels,
+            name: Some(name.to_string()),
+            samplers,
         });
     }
-    let meshes: Vec<Option<json::Index<json::Mesh>>> = nodes
-        .iter()
-        .map(|n| (n.morphs > 0).then(|| b.morph_mesh(n.morphs)))
-        .collect();
-    let mut roots = Vec::new();
-    let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); nodes.len()];
-    for (i, n) in nodes.iter().enumerate() {
-        match n.parent {
-            Some(p) => children[p].push(json::Index::new(i as u32)),
-            None => roots.push(json::Index::new(i as u32)),
+
+    /// The nodes (children, rest transforms without their identity parts,
+    /// a morph mesh where weights are animated) and the scene of their roots.
+    fn nodes(&mut self, nodes: &[NodeOut]) {
+        let meshes: Vec<Option<json::Index<json::Mesh>>> = nodes
+            .iter()
+            .map(|n| (n.morphs > 0).then(|| self.morph_mesh(n.morphs)))
+            .collect();
+        let mut roots = Vec::new();
+        let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); nodes.len()];
+        for (i, n) in nodes.iter().enumerate() {
+            match n.parent {
+                Some(p) => children[p].push(json::Index::new(i as u32)),
+                None => roots.push(json::Index::new(i as u32)),
+            }
         }
+        for (i, n) in nodes.iter().enumerate() {
+            let rest = n.rest.unwrap_or_default();
+            let node = json::Node {
+                name: Some(n.name.clone()),
+                children: (!children[i].is_empty()).then(|| children[i].clone()),
+                mesh: meshes[i],
+                // Identity parts are left out, as glTF writers do.
+                translation: (rest.translation != glam::Vec3::ZERO)
+                    .then(|| <[f32; 3]>::from(rest.translation)),
+                rotation: (rest.rotation != glam::Quat::IDENTITY).then(|| {
+                    json::scene::UnitQuaternion(<[f32; 4]>::from(rest.rotation.normalize()))
+                }),
+                scale: (rest.scale != glam::Vec3::ONE).then(|| <[f32; 3]>::from(rest.scale)),
+                ..Default::default()
+            };
+            self.root.push(node);
+        }
+        let scene = self.root.push(json::Scene {
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            nodes: roots,
+        });
+        self.root.scene = Some(scene);
     }
-    for (i, n) in nodes.iter().enumerate() {
-        let rest = n.rest.unwrap_or_default();
-        let node = json::Node {
-            name: Some(n.name.clone()),
-            children: (!children[i].is_empty()).then(|| children[i].clone()),
-            mesh: meshes[i],
-            // Identity parts are left out, as glTF writers do.
-            translation: (rest.translation != glam::Vec3::ZERO)
-                .then(|| <[f32; 3]>::from(rest.translation)),
-            rotation: (rest.rotation != glam::Quat::IDENTITY)
-                .then(|| json::scene::UnitQuaternion(<[f32; 4]>::from(rest.rotation.normalize()))),
-            scale: (rest.scale != glam::Vec3::ONE).then(|| <[f32; 3]>::from(rest.scale)),
-            ..Default::default()
+
+    /// The file: the buffer padded to 4 bytes, then GLB chunks or a
+    /// `.gltf` with the buffer as a data URI.
+    fn finish(mut self, binary: bool) -> Result<Vec<u8>, Error> {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let too_big = || Error::import("the export is larger than glTF's 4 GiB limit");
+        let mut buffer = json::Buffer {
+            byte_length: USize64::from(self.bin.len()),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
         };
-        b.root.push(node);
-    }
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        nodes: roots,
-    });
-    b.root.scene = Some(scene);
-    b.root.push(json::Animation {
-        extensions: None,
-        extras: Default::default(),
-        channels: anim_channels,
-        name: Some(name.to_string()),
-        samplers,
-    });
-    while !b.bin.len().is_multiple_of(4) {
-        b.bin.push(0);
-    }
-    let too_big = || Error::import("the export is larger than glTF's 4 GiB limit");
-    let mut buffer = json::Buffer {
-        byte_length: USize64::from(b.bin.len()),
-        name: None,
-        uri: None,
-        extensions: None,
-        extras: Default::default(),
-    };
-    let serialize = |e: serde_json::Error| Error::import(format!("writing the glTF JSON: {e}"));
-    if binary {
-        b.root.push(buffer);
-        let json_bytes = b.root.to_vec().map_err(serialize)?;
-        let length = 12 + 8 + json_bytes.len().next_multiple_of(4) + 8 + b.bin.len();
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: u32::try_from(length).map_err(|_| too_big())?,
-            },
-            json: json_bytes.into(),
-            bin: Some(b.bin.into()),
-        };
-        glb.to_vec()
-            .map_err(|e| Error::import(format!("writing the GLB: {e}")))
-    } else {
-        buffer.uri = Some(format!(
-            "data:application/octet-stream;base64,{}",
-            crate::gltf_import::base64_encode(&b.bin)
-        ));
-        b.root.push(buffer);
-        let mut text = b.root.to_vec_pretty().map_err(serialize)?;
-        text.push(b'\n');
-        Ok(text)
+        let serialize = |e: serde_json::Error| Error::import(format!("writing the glTF JSON: {e}"));
+        if binary {
+            self.root.push(buffer);
+            let json_bytes = self.root.to_vec().map_err(serialize)?;
+            let length = 12 + 8 + json_bytes.len().next_multiple_of(4) + 8 + self.bin.len();
+            let glb = gltf::binary::Glb {
+                header: gltf::binary::Header {
+                    magic: *b"glTF",
+                    version: 2,
+                    length: u32::try_from(length).map_err(|_| too_big())?,
+                },
+                json: json_bytes.into(),
+                bin: Some(self.bin.into()),
+            };
+            glb.to_vec()
+                .map_err(|e| Error::import(format!("writing the GLB: {e}")))
+        } else {
+            buffer.uri = Some(format!(
+                "data:application/octet-stream;base64,{}",
+                crate::gltf_import::base64_encode(&self.bin)
+            ));
+            self.root.push(buffer);
+            let mut text = self.root.to_vec_pretty().map_err(serialize)?;
+            text.push(b'\n');
+            Ok(text)
+        }
     }
 }
 
@@ -792,11 +1150,12 @@ fn write(
 pub fn export_file(
     clip: &tcb_core::Clip,
     skeleton: Option<&Skeleton>,
-    path: &Path,
+    path: impl AsRef<Path>,
     options: &ExportOptions,
 ) -> Result<ExportReport, Error> {
+    let path = path.as_ref();
     let (bytes, report) =
         export(clip, skeleton, Container::for_path(path), options).map_err(|e| e.in_file(path))?;
-    crate::write_atomically(path, &bytes)?;
+    crate::files::write_atomically(path, &bytes)?;
     Ok(report)
 }

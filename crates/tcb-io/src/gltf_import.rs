@@ -6,7 +6,8 @@
 //! allocated, so a file claiming more than it holds is an error, not a panic
 //! or a huge allocation.
 
-use crate::{ClipDoc, Error, KeyDoc, SettingsDoc, TrackDoc};
+use crate::clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
+use crate::error::Error;
 use glam::{Quat, Vec3};
 use gltf::Document;
 use gltf::accessor::{DataType, Dimensions};
@@ -88,14 +89,15 @@ fn check_indices(root: &gltf::json::Root) -> Result<(), Error> {
 
 /// Import animation `animation` (a name or an index; the first when `None`)
 /// from glTF or GLB bytes. `base` is the directory external buffers are
-/// relative to (`None`: external buffers are an error).
+/// relative to (`None`: external buffers are an error; an `Option<&Path>`
+/// rather than a generic path, so that `None` needs no type).
 pub fn import(
     bytes: &[u8],
     base: Option<&Path>,
     animation: Option<&str>,
     name: &str,
 ) -> Result<GltfImport, Error> {
-    let options = crate::ImportOptions {
+    let options = crate::files::ImportOptions {
         animation: animation.map(str::to_string),
         ..Default::default()
     };
@@ -109,9 +111,39 @@ pub fn import_with(
     bytes: &[u8],
     base: Option<&Path>,
     name: &str,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<GltfImport, Error> {
-    let animation = options.animation.as_deref();
+    let gltf = parse(bytes)?;
+    let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base, options)?;
+    let mut warnings = Vec::new();
+    let names = node_names(&gltf.document, &mut warnings);
+    let skeleton = skeleton(&gltf.document, &names);
+    let anim = choose_animation(&gltf.document, options.animation.as_deref(), &mut warnings)?;
+    let mut tracks = Vec::new();
+    for (c, channel) in anim.channels().enumerate() {
+        let node = &names[channel.target().node().index()];
+        channel_tracks(&buffers, &channel, node, &mut tracks, &mut warnings).map_err(|m| {
+            Error::import(format!(
+                "animation {}, channel {c} ({node}): {m}",
+                describe(&anim)
+            ))
+        })?;
+    }
+    Ok(GltfImport {
+        doc: ClipDoc {
+            name: anim.name().unwrap_or(name).to_string(),
+            defaults: SettingsDoc::default(),
+            tracks,
+            skeleton: Some(skeleton.clone()),
+        },
+        skeleton,
+        warnings,
+    })
+}
+
+/// A glTF or GLB file's document, its indices checked before the `gltf`
+/// crate follows them.
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf, Error> {
     let invalid =
         |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
     // The `gltf` crate (1.4.1) subtracts the header's 12 bytes from the
@@ -130,20 +162,24 @@ pub fn import_with(
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(&e))?;
     let json = unchecked.document.into_json();
     check_indices(&json)?;
-    let gltf = gltf::Gltf {
+    Ok(gltf::Gltf {
         document: gltf::Document::from_json(json).map_err(|e| invalid(&e))?,
         blob: unchecked.blob,
-    };
-    let buffers = load_buffers(&gltf.document, gltf.blob.as_deref(), base, options)?;
-    let mut warnings = Vec::new();
-    let names = node_names(&gltf.document, &mut warnings);
-    let skeleton = skeleton(&gltf.document, &names);
+    })
+}
 
-    let animations: Vec<_> = gltf.document.animations().collect();
+/// The animation `want` names (by name, else by index), or the first
+/// (with a warning when there are others).
+fn choose_animation<'a>(
+    document: &'a Document,
+    want: Option<&str>,
+    warnings: &mut Vec<String>,
+) -> Result<gltf::Animation<'a>, Error> {
+    let animations: Vec<_> = document.animations().collect();
     if animations.is_empty() {
         return Err(Error::import("the file has no animations"));
     }
-    let anim = match animation {
+    match want {
         None => {
             if animations.len() > 1 {
                 warnings.push(format!(
@@ -152,7 +188,7 @@ pub fn import_with(
                     describe(&animations[0])
                 ));
             }
-            animations[0].clone()
+            Ok(animations[0].clone())
         }
         Some(want) => animations
             .iter()
@@ -165,126 +201,145 @@ pub fn import_with(
                     "no animation '{want}' (the file has: {})",
                     all.join(", ")
                 ))
-            })?,
-    };
-
-    let mut tracks = Vec::new();
-    for (c, channel) in anim.channels().enumerate() {
-        let target = channel.target();
-        let node = &names[target.node().index()];
-        let sampler = channel.sampler();
-        let what = |m: String| {
-            Error::import(format!(
-                "animation {}, channel {c} ({node}): {m}",
-                describe(&anim)
-            ))
-        };
-        let times: Vec<f64> = read(&buffers, &sampler.input(), 1)
-            .map_err(|m| what(format!("input: {m}")))?
-            .into_iter()
-            .map(f64::from)
-            .collect();
-        let interp = sampler.interpolation();
-        let per_key = if interp == Interpolation::CubicSpline {
-            3
-        } else {
-            1
-        };
-        let (suffix, kind, dim) = match target.property() {
-            Property::Translation => ("translation", TrackKind::Vec3, 3),
-            Property::Rotation => ("rotation", TrackKind::Quat, 4),
-            Property::Scale => ("scale", TrackKind::Vec3, 3),
-            Property::MorphTargetWeights => ("weights", TrackKind::Scalar, 1),
-        };
-        let out =
-            read(&buffers, &sampler.output(), dim).map_err(|m| what(format!("output: {m}")))?;
-        let rows = out.len() / dim;
-        let elements = times.len() * per_key;
-        if elements == 0 || rows % elements != 0 || (dim > 1 && rows != elements) {
-            return Err(what(format!(
-                "{} input times but {rows} output elements (expected {} per key{})",
-                times.len(),
-                per_key,
-                if dim == 1 { " per morph target" } else { "" }
-            )));
-        }
-        let targets = rows / elements;
-        for target_index in 0..targets {
-            // Element e of key k, morph target i: row (k * per_key + e) * targets + i.
-            let value = |k: usize, e: usize| -> [f32; 4] {
-                let row = (k * per_key + e) * targets + target_index;
-                let mut v = [0.0; 4];
-                v[..dim].copy_from_slice(&out[row * dim..(row + 1) * dim]);
-                v
-            };
-            let value_e = if per_key == 3 { 1 } else { 0 };
-            let mut values: Vec<[f32; 4]> = (0..times.len()).map(|k| value(k, value_e)).collect();
-            let mut keys: Vec<KeyDoc> = (0..times.len())
-                .map(|k| match interp {
-                    Interpolation::Linear => KeyDoc {
-                        interp: Some(Interp::Linear),
-                        ..KeyDoc::default()
-                    },
-                    Interpolation::Step => KeyDoc {
-                        interp: Some(Interp::Step),
-                        ..KeyDoc::default()
-                    },
-                    Interpolation::CubicSpline => KeyDoc {
-                        tangent_in: Some(value(k, 0)),
-                        tangent_out: Some(value(k, 2)),
-                        ..KeyDoc::default()
-                    },
-                })
-                .collect();
-            let mut times = times.clone();
-            if times.len() == 1 {
-                // A constant: a clip track needs two keys.
-                times.push(times[0] + 1.0);
-                values.push(values[0]);
-                keys.push(keys[0].clone());
-                keys[0].interp = Some(Interp::Step);
-                warnings.push(format!(
-                    "{node}.{suffix}: one key; held as a constant (second key at {} s)",
-                    times[1]
-                ));
-            }
-            let name = if kind == TrackKind::Scalar {
-                format!("{node}.weights.{target_index}")
-            } else {
-                format!("{node}.{suffix}")
-            };
-            if tracks.iter().any(|t: &TrackDoc| t.name == name) {
-                return Err(what(format!("a second channel animates '{name}'")));
-            }
-            let mut settings = SettingsDoc::default();
-            if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
-                // Viewers interpolate the stored components as they are,
-                // sign changes and all (clip-format.md).
-                settings.rotation = Some(RotationMode::Hermite);
-                settings.hemisphere = Some(Hemisphere::Keep);
-            }
-            tracks.push(TrackDoc {
-                name,
-                kind,
-                times,
-                values,
-                keys,
-                settings,
-            });
-        }
+            }),
     }
-    Ok(GltfImport {
-        doc: ClipDoc {
-            name: anim.name().unwrap_or(name).to_string(),
-            defaults: SettingsDoc::default(),
-            tracks,
-            skeleton: Some(skeleton.clone()),
-        },
-        skeleton,
-        warnings,
-    })
 }
 
+/// The track name suffix, kind and components of a channel's target.
+fn target_kind(property: Property) -> (&'static str, TrackKind, usize) {
+    match property {
+        Property::Translation => ("translation", TrackKind::Vec3, 3),
+        Property::Rotation => ("rotation", TrackKind::Quat, 4),
+        Property::Scale => ("scale", TrackKind::Vec3, 3),
+        Property::MorphTargetWeights => ("weights", TrackKind::Scalar, 1),
+    }
+}
+
+/// The tracks of one animation channel of node `node` (one per morph
+/// target for weights), appended to `tracks`; the error says what, not
+/// where.
+fn channel_tracks(
+    buffers: &[Vec<u8>],
+    channel: &gltf::animation::Channel,
+    node: &str,
+    tracks: &mut Vec<TrackDoc>,
+    warnings: &mut Vec<String>,
+) -> Result<(), String> {
+    let sampler = channel.sampler();
+    let times: Vec<f64> = read(buffers, &sampler.input(), 1)
+        .map_err(|m| format!("input: {m}"))?
+        .into_iter()
+        .map(f64::from)
+        .collect();
+    let interp = sampler.interpolation();
+    let per_key = if interp == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
+    let (suffix, kind, dim) = target_kind(channel.target().property());
+    let out = read(buffers, &sampler.output(), dim).map_err(|m| format!("output: {m}"))?;
+    let rows = out.len() / dim;
+    let elements = times.len() * per_key;
+    if elements == 0 || rows % elements != 0 || (dim > 1 && rows != elements) {
+        return Err(format!(
+            "{} input times but {rows} output elements (expected {} per key{})",
+            times.len(),
+            per_key,
+            if dim == 1 { " per morph target" } else { "" }
+        ));
+    }
+    let targets = rows / elements;
+    for target_index in 0..targets {
+        // Element e of key k, morph target i: row (k * per_key + e) * targets + i.
+        let value = |k: usize, e: usize| -> [f32; 4] {
+            let row = (k * per_key + e) * targets + target_index;
+            let mut v = [0.0; 4];
+            v[..dim].copy_from_slice(&out[row * dim..(row + 1) * dim]);
+            v
+        };
+        let name = if kind == TrackKind::Scalar {
+            format!("{node}.weights.{target_index}")
+        } else {
+            format!("{node}.{suffix}")
+        };
+        if tracks.iter().any(|t: &TrackDoc| t.name == name) {
+            return Err(format!("a second channel animates '{name}'"));
+        }
+        let mut track = sampler_track(name, kind, times.clone(), interp, value);
+        if track.times.len() == 1 {
+            hold_single_key(&mut track);
+            warnings.push(format!(
+                "{node}.{suffix}: one key; held as a constant (second key at {} s)",
+                track.times[1]
+            ));
+        }
+        tracks.push(track);
+    }
+    Ok(())
+}
+
+/// A track of one key made a constant: a clip track needs two keys, so a
+/// second one 1 s later, the first a `step`.
+fn hold_single_key(track: &mut TrackDoc) {
+    track.times.push(track.times[0] + 1.0);
+    track.values.push(track.values[0]);
+    track.keys.push(track.keys[0].clone());
+    track.keys[0].interp = Some(Interp::Step);
+}
+
+/// One glTF sampler's keys as a clip track, as `tcb import` reads them:
+/// `value(k, e)` is element `e` of key `k` (CUBICSPLINE: 0 in-tangent, 1
+/// value, 2 out-tangent; otherwise 0 the value). `LINEAR` and `STEP` become
+/// `interp` keys, `CUBICSPLINE` explicit tangents (rotations `hermite`,
+/// `keep`, as viewers interpolate the stored components, clip-format.md).
+/// The glTF export reads its own samplers back through this.
+pub(crate) fn sampler_track(
+    name: String,
+    kind: TrackKind,
+    times: Vec<f64>,
+    interp: Interpolation,
+    value: impl Fn(usize, usize) -> [f32; 4],
+) -> TrackDoc {
+    let value_e = if interp == Interpolation::CubicSpline {
+        1
+    } else {
+        0
+    };
+    let values = (0..times.len()).map(|k| value(k, value_e)).collect();
+    let keys = (0..times.len())
+        .map(|k| match interp {
+            Interpolation::Linear => KeyDoc {
+                interp: Some(Interp::Linear),
+                ..KeyDoc::default()
+            },
+            Interpolation::Step => KeyDoc {
+                interp: Some(Interp::Step),
+                ..KeyDoc::default()
+            },
+            Interpolation::CubicSpline => KeyDoc {
+                tangent_in: Some(value(k, 0)),
+                tangent_out: Some(value(k, 2)),
+                ..KeyDoc::default()
+            },
+        })
+        .collect();
+    let mut settings = SettingsDoc::default();
+    if kind == TrackKind::Quat && interp == Interpolation::CubicSpline {
+        settings.rotation = Some(RotationMode::Hermite);
+        settings.hemisphere = Some(Hemisphere::Keep);
+    }
+    TrackDoc {
+        name,
+        kind,
+        times,
+        values,
+        keys,
+        settings,
+    }
+}
+
+/// An animation as messages name it: `'name' (index)` or its index.
 fn describe(a: &gltf::Animation) -> String {
     match a.name() {
         Some(n) => format!("'{n}' ({})", a.index()),
@@ -313,6 +368,7 @@ fn node_names(doc: &Document, warnings: &mut Vec<String>) -> Vec<String> {
     names
 }
 
+/// The node hierarchy as a skeleton, parents before children (breadth first from the roots).
 fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
     let n = doc.nodes().len();
     let mut parent = vec![None; n];
@@ -355,7 +411,11 @@ fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
                 parent: parent[i].map(|p| slot[p]),
                 rest: Transform {
                     translation: Vec3::from_array(t),
-                    rotation: Quat::from_array(r),
+                    // A zero rotation is left as it is: the reader refuses it.
+                    rotation: match Quat::from_array(r) {
+                        q if q.length_squared() == 0.0 => q,
+                        q => crate::skeleton_json::unit_rotation(q),
+                    },
                     scale: Vec3::from_array(s),
                 },
             }
@@ -364,11 +424,12 @@ fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
     Skeleton { joints }
 }
 
+/// Every buffer's bytes: the GLB chunk, a data URI or an external file (`read_buffer`), checked against its `byteLength`.
 fn load_buffers(
     doc: &Document,
     blob: Option<&[u8]>,
     base: Option<&Path>,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<Vec<Vec<u8>>, Error> {
     doc.buffers()
         .map(|b| {
@@ -425,7 +486,7 @@ fn read_buffer(
     base: &Path,
     uri: &str,
     byte_length: usize,
-    options: &crate::ImportOptions,
+    options: &crate::files::ImportOptions,
 ) -> Result<Vec<u8>, String> {
     use std::io::Read;
     use std::path::Component;
@@ -532,41 +593,55 @@ fn read(buffers: &[Vec<u8>], a: &gltf::Accessor, dim: usize) -> Result<Vec<f32>,
         None => return Err(format!("{what} has no buffer view")),
     };
     if let Some(sparse) = a.sparse() {
-        // Core glTF 2.0 (gltf-transform writes it for morph animation):
-        // replace the listed elements.
-        let n = sparse.count();
-        if n == 0 || n > count {
-            return Err(format!(
-                "{what}: sparse count {n} (must be 1 to the accessor's {count})"
-            ));
-        }
-        let iv = sparse.indices();
-        let size = iv.index_type().size();
-        let raw = bytes_of(buffers, &iv.view(), iv.offset(), n * size).ok_or_else(|| {
-            format!(
-                "{what}: {n} sparse indices do not fit in buffer view {}",
-                iv.view().index()
-            )
-        })?;
-        let vv = sparse.values();
-        let values = decode(buffers, &vv.view(), vv.offset(), n, ty, dim, false, &what)?;
-        let mut previous = None;
-        for (i, b) in raw.chunks_exact(size).enumerate() {
-            let index = match size {
-                1 => usize::from(b[0]),
-                2 => usize::from(u16::from_le_bytes([b[0], b[1]])),
-                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
-            };
-            if index >= count || previous.is_some_and(|p| index <= p) {
-                return Err(format!(
-                    "{what}: sparse index {i} is {index} (indices must increase and stay below {count})"
-                ));
-            }
-            previous = Some(index);
-            out[index * dim..(index + 1) * dim].copy_from_slice(&values[i * dim..(i + 1) * dim]);
-        }
+        apply_sparse(buffers, &sparse, &mut out, ty, dim, &what)?;
     }
     Ok(out)
+}
+
+/// Core glTF 2.0 sparse storage (gltf-transform writes it for morph
+/// animation): replaces the listed elements of `out` (`dim` components
+/// each), after checking every index and byte.
+fn apply_sparse(
+    buffers: &[Vec<u8>],
+    sparse: &gltf::accessor::sparse::Sparse,
+    out: &mut [f32],
+    ty: DataType,
+    dim: usize,
+    what: &str,
+) -> Result<(), String> {
+    let count = out.len() / dim;
+    let n = sparse.count();
+    if n == 0 || n > count {
+        return Err(format!(
+            "{what}: sparse count {n} (must be 1 to the accessor's {count})"
+        ));
+    }
+    let iv = sparse.indices();
+    let size = iv.index_type().size();
+    let raw = bytes_of(buffers, &iv.view(), iv.offset(), n * size).ok_or_else(|| {
+        format!(
+            "{what}: {n} sparse indices do not fit in buffer view {}",
+            iv.view().index()
+        )
+    })?;
+    let vv = sparse.values();
+    let values = decode(buffers, &vv.view(), vv.offset(), n, ty, dim, false, what)?;
+    let mut previous = None;
+    for (i, b) in raw.chunks_exact(size).enumerate() {
+        let index = match size {
+            1 => usize::from(b[0]),
+            2 => usize::from(u16::from_le_bytes([b[0], b[1]])),
+            _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+        };
+        if index >= count || previous.is_some_and(|p| index <= p) {
+            return Err(format!(
+                "{what}: sparse index {i} is {index} (indices must increase and stay below {count})"
+            ));
+        }
+        previous = Some(index);
+        out[index * dim..(index + 1) * dim].copy_from_slice(&values[i * dim..(i + 1) * dim]);
+    }
+    Ok(())
 }
 
 /// Largest element count of a sparse accessor with no buffer view.
@@ -641,6 +716,7 @@ fn decode(
     Ok(out)
 }
 
+/// A URI's `%XX` escapes decoded (others kept as written).
 fn percent_decode(s: &str) -> String {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());

@@ -9,8 +9,8 @@
 //! ]}
 //! ```
 
-use crate::clip::finite_f32;
 use crate::error::{Error, Location};
+use crate::json::finite_f32;
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -22,7 +22,7 @@ use tcb_core::skeleton::{Joint, Skeleton, Transform};
 pub(crate) struct SkeletonIn {
     joints: Vec<JointIn>,
     #[serde(default, rename = "extras")]
-    _extras: Option<crate::clip::Extras>,
+    _extras: Option<crate::json::Extras>,
 }
 
 #[derive(Deserialize)]
@@ -38,7 +38,7 @@ struct JointIn {
     #[serde(default)]
     scale: Option<Vec<f64>>,
     #[serde(default, rename = "extras")]
-    _extras: Option<crate::clip::Extras>,
+    _extras: Option<crate::json::Extras>,
 }
 
 impl SkeletonIn {
@@ -98,17 +98,34 @@ impl SkeletonIn {
                     format!("{what}: rotation is zero (not a rotation)"),
                 ));
             }
+            let rotation = unit_rotation(rotation);
             out.push(Joint {
                 name: j.name,
                 parent,
                 rest: Transform {
                     translation: Vec3::new(t[0], t[1], t[2]),
-                    rotation: rotation.normalize(),
+                    rotation,
                     scale: Vec3::new(s[0], s[1], s[2]),
                 },
             });
         }
         Ok(Skeleton { joints: out })
+    }
+}
+
+/// How far a rotation's squared length may be from 1 and still count as
+/// unit: a normalized f32 quaternion is within a few ulps of 1 (2.4e-7).
+const UNIT: f32 = 1e-6;
+
+/// `q` normalized, unless it is already unit (within [`UNIT`]): then as it
+/// is, bit for bit. Normalizing again could move a component by an ulp,
+/// so the reader, the writer and the glTF importer all use this, and a
+/// rest rotation written then read is the one written.
+pub(crate) fn unit_rotation(q: Quat) -> Quat {
+    if (q.length_squared() - 1.0).abs() <= UNIT {
+        q
+    } else {
+        q.normalize()
     }
 }
 
@@ -141,7 +158,7 @@ impl<'a> SkeletonOut<'a> {
                     parent: j.parent,
                     translation: j.rest.translation.to_array(),
                     rotation: (j.rest.rotation != Quat::IDENTITY)
-                        .then(|| j.rest.rotation.to_array()),
+                        .then(|| unit_rotation(j.rest.rotation).to_array()),
                     scale: (j.rest.scale != Vec3::ONE).then(|| j.rest.scale.to_array()),
                 })
                 .collect(),
@@ -151,7 +168,7 @@ impl<'a> SkeletonOut<'a> {
 
 #[cfg(test)]
 mod tests {
-    use crate::ClipDoc;
+    use crate::clip::ClipDoc;
 
     fn clip(skeleton: &str) -> String {
         format!(
@@ -177,6 +194,34 @@ mod tests {
         assert_eq!(s.joints[2].rest.translation, glam::Vec3::ZERO);
         let again = ClipDoc::parse(&doc.to_json()).unwrap();
         assert_eq!(again, doc);
+    }
+
+    #[test]
+    fn unit_rotations_are_kept_and_normalizing_is_done_once() {
+        use super::unit_rotation;
+        use glam::Quat;
+        // Random directions and lengths (an LCG; no dependency needed).
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        for _ in 0..100_000 {
+            let q = Quat::from_xyzw(next(), next(), next(), next()) * (2.0 + next());
+            if q.length_squared() == 0.0 {
+                continue;
+            }
+            let u = unit_rotation(q);
+            assert!((u.length() - 1.0).abs() < 1e-6, "{q:?}");
+            assert_eq!(
+                unit_rotation(u).to_array().map(f32::to_bits),
+                u.to_array().map(f32::to_bits)
+            );
+        }
+        let q = Quat::from_rotation_y(1.0);
+        assert_eq!(unit_rotation(q), q);
     }
 
     #[test]

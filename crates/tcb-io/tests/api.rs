@@ -146,13 +146,13 @@ fn options_out_of_range() {
     };
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
     for file in ["simple_skin.gltf", "cmu-01_01.bvh"] {
-        let err = tcb_io::load_with(&data.join(file), &options)
+        let err = tcb_io::load_with(data.join(file), &options)
             .unwrap_err()
             .to_string();
         assert!(err.contains("max_file_bytes"), "{err}");
     }
     let err = tcb_io::load_with(
-        &data.join("simple_skin.gltf"),
+        data.join("simple_skin.gltf"),
         &ImportOptions {
             animation: Some("no such animation".into()),
             ..ImportOptions::default()
@@ -201,4 +201,59 @@ fn a_default_tcb_that_is_not_finite_is_refused_where_it_is_unused() {
     };
     let err = doc.build().unwrap_err().to_string();
     assert_eq!(err, "defaults: tcb [inf, 0, 0] is not finite");
+}
+
+/// Issue 30's trap: every function of tcb-io that takes a file path takes
+/// anything that is one (`&str`, `String`, `&Path`, `PathBuf`), as std's
+/// own file functions do.
+#[test]
+fn path_taking_functions_accept_any_path_type() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let bvh = format!("{root}data/cmu-01_01.bvh");
+    let a = tcb_io::load(bvh.as_str()).unwrap();
+    let b = tcb_io::load(&bvh).unwrap();
+    let c = tcb_io::load(Path::new(&bvh)).unwrap();
+    let d = tcb_io::load_with(std::path::PathBuf::from(&bvh), &ImportOptions::default()).unwrap();
+    assert!([&b, &c, &d].iter().all(|l| l.doc == a.doc));
+
+    let dir = std::env::temp_dir().join(format!("tcb-io-api-paths-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = format!("{}/clip.json", dir.display());
+    tcb_io::write_clip_doc(&a.doc, json.as_str()).unwrap();
+    assert_eq!(tcb_io::read_clip_doc(json.clone()).unwrap(), a.doc);
+    assert_eq!(
+        tcb_io::load_clip(&json).unwrap().tracks().len(),
+        a.clip.tracks().len()
+    );
+    let glb = format!("{}/clip.glb", dir.display());
+    assert_eq!(Container::for_path(&glb), Container::Glb);
+    tcb_io::gltf_export::export_file(&a.clip, None, glb.as_str(), &ExportOptions::default())
+        .unwrap();
+    tcb_io::write_atomically(format!("{}/bytes", dir.display()), b"x").unwrap();
+    let e = tcb_io::Error::import("no").in_file("x.json");
+    assert_eq!(e.to_string(), "x.json: no");
+}
+
+/// Issue 30's trap, the other half: `tcb_io::load` of a BVH and
+/// `Bvh::parse(..)` name the same joints at the same indices. `load` (and
+/// `Bvh::to_clip_doc`) add one leaf joint `<parent>_end` per End Site
+/// after them (`Bvh::skeleton_with_end_sites`); `Bvh::skeleton` is the
+/// joints with channels alone, as `Bvh::local` and `Bvh::channels` index
+/// them. That difference is what this test pins.
+#[test]
+fn load_and_parse_give_the_same_joints_and_name_the_end_sites() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+    let loaded = tcb_io::load(path).unwrap();
+    let skeleton = loaded.skeleton.unwrap();
+    let bvh = tcb_io::bvh::Bvh::parse(&std::fs::read_to_string(path).unwrap()).unwrap();
+    assert_eq!(skeleton, bvh.skeleton_with_end_sites());
+    assert_eq!(loaded.doc.skeleton.as_ref(), Some(&skeleton));
+    let joints = &bvh.skeleton().joints;
+    assert_eq!((joints.len(), bvh.end_sites().len()), (31, 7));
+    assert_eq!(&skeleton.joints[..joints.len()], &joints[..]);
+    for (end, &(parent, offset)) in skeleton.joints[joints.len()..].iter().zip(bvh.end_sites()) {
+        assert_eq!(end.name, format!("{}_end", joints[parent].name));
+        assert_eq!(end.parent, Some(parent));
+        assert_eq!(end.rest.translation, offset);
+    }
 }

@@ -29,7 +29,7 @@ fn every_mode_draws_every_kind() {
         "examples/clips/spin.json",
         "data/simple_skin.gltf",
     ] {
-        let loaded = tcb_io::load(&root.join(clip)).unwrap();
+        let loaded = tcb_io::load(root.join(clip)).unwrap();
         for mode in [
             tcb_plot::Mode::Value,
             tcb_plot::Mode::Velocity,
@@ -94,7 +94,7 @@ fn bad_requests_are_one_clear_line() {
 #[test]
 fn dense_capture_is_drawn_as_a_line_without_marks() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let cmu = tcb_io::load(&root.join("data/cmu-01_01.bvh")).unwrap();
+    let cmu = tcb_io::load(root.join("data/cmu-01_01.bvh")).unwrap();
     let path = |clip: &tcb_core::Clip, track: &str| {
         let plot = tcb_plot::Plot {
             tracks: vec![track.into()],
@@ -107,7 +107,7 @@ fn dense_capture_is_drawn_as_a_line_without_marks() {
     let svg = path(&cmu.clip, "Hips.translation");
     assert_eq!(svg.matches("<circle").count(), 0);
     // A handful of keys keeps them.
-    let careen = tcb_io::load(&root.join("examples/clips/careen.json")).unwrap();
+    let careen = tcb_io::load(root.join("examples/clips/careen.json")).unwrap();
     let plot = tcb_plot::Plot {
         tracks: vec!["ball.path".into()],
         mode: tcb_plot::Mode::Path { components: [0, 1] },

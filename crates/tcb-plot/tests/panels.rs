@@ -8,7 +8,7 @@ use tcb_plot::{Mode, Plot, render_with_notes};
 
 fn load(clip: &str) -> tcb_core::Clip {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    tcb_io::load(&root.join(clip)).unwrap().clip
+    tcb_io::load(root.join(clip)).unwrap().clip
 }
 
 fn plot(mode: Mode) -> Plot {
@@ -190,7 +190,7 @@ fn a_rigs_path_is_drawn_on_its_ground_plane() {
     assert_eq!(tcb_plot::ground_plane(&Skeleton::default()), [0, 2]);
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     for rig in ["data/cmu-01_01.bvh", "data/simple_skin.gltf"] {
-        let skeleton = tcb_io::load(&root.join(rig)).unwrap().skeleton.unwrap();
+        let skeleton = tcb_io::load(root.join(rig)).unwrap().skeleton.unwrap();
         assert_eq!(tcb_plot::ground_plane(&skeleton), [0, 2], "{rig}");
     }
 }

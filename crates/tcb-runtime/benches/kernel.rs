@@ -204,7 +204,7 @@ fn packed(c: &mut Criterion) {
         rotation: RotationMode::Hermite,
         ..Default::default()
     };
-    let clip = tcb_io::load_with(path.as_ref(), &options).unwrap().clip;
+    let clip = tcb_io::load_with(path, &options).unwrap().clip;
     let steps = vec![1.0 / 4096.0; clip.tracks().len()];
     let source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();
     let packed = Arc::new(tcb_runtime::Packed::encode(&source).unwrap());

@@ -25,7 +25,7 @@
 //! their end derivatives, checked against the f64 formula when the clip is
 //! compiled (see `rotation_controls`); the few segments where that cubic
 //! would miss (large turns between keys) are evaluated exactly, lane by
-//! lane under a mask, from [`tcb_core::squad`] in `f64x4`. Nothing falls
+//! lane under a mask, from [`tcb_core::simd::squad`] in `f64x4`. Nothing falls
 //! back to the scalar reference.
 
 use crate::grid::TimeGrid;

@@ -5,9 +5,9 @@
 use wide::{f32x8, f64x4};
 
 /// `q0 [x y z w], n01 [x y z], alpha01, a [x y z w], n_ab [x y z], alpha_ab`
-/// of 4 quaternions in f64 ([`tcb_core::squad::CONTROLS`]): the two outer
+/// of 4 quaternions in f64 ([`tcb_core::simd::squad::CONTROLS`]): the two outer
 /// slerps of squad as start point, log axis and log angle.
-pub(crate) const SQ_STRIDE: usize = tcb_core::squad::CONTROLS;
+pub(crate) const SQ_STRIDE: usize = tcb_core::simd::squad::CONTROLS;
 
 /// One rotation block on one stored segment, evaluated exactly: the lanes
 /// of `mask` take squad in f64 from `ExactTable::controls[controls]` (two

@@ -24,10 +24,10 @@
 //! `rate` carries the direction of `oscillate` (-1 on backward legs).
 
 use tcb_core::Extrapolation;
-use tcb_core::basis::{hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::SegmentEase;
-use tcb_core::extrapolate::{Mapped, map_time};
-use tcb_core::lane::Lane;
+use tcb_core::simd::basis::{hermite_basis, hermite_basis_derivative};
+use tcb_core::simd::extrapolate::{Mapped, map_time};
+use tcb_core::simd::lane::Lane;
 use tcb_core::track::segment_from;
 
 /// Key times, segment eases and extrapolation shared by a group of channels.

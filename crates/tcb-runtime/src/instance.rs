@@ -42,6 +42,28 @@ impl std::fmt::Display for PlaybackError {
 
 impl std::error::Error for PlaybackError {}
 
+/// [`Instance::sample_to`] given a slice of another length than the
+/// pose's channels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OutputLength {
+    /// Floats given.
+    pub given: usize,
+    /// Floats the pose has (its channels).
+    pub want: usize,
+}
+
+impl std::fmt::Display for OutputLength {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "a pose of {} floats written into a slice of {}",
+            self.want, self.given
+        )
+    }
+}
+
+impl std::error::Error for OutputLength {}
+
 /// One playing copy of a clip: a cursor per group and the output pose.
 /// Allocates when created, never when sampling.
 #[derive(Clone, Debug)]
@@ -195,6 +217,42 @@ impl Instance {
             Some(rig) => &rig.pose,
             None => &self.pose,
         }
+    }
+
+    /// Sample at `time` (as [`sample`](Self::sample)) and write the pose
+    /// into the caller's `out`: every track's components in the order of
+    /// [`Pose::layout`]`().tracks()` (file order for a clip, the rig's order
+    /// with a rig), components consecutive (`x y z` for a vec3, `x y z w`
+    /// for a rotation, one float for a scalar): [`Clip::channel_count`]
+    /// floats (the rig's channel count with a rig). The kernels write 8
+    /// channels a vector into the instance's blocks, then one pass gathers
+    /// them into `out`; nothing is allocated. A slice of another length is
+    /// an error, and nothing is sampled or written.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// let clip = tcb_io::ClipDoc::parse(r#"{"format": "tcb-clip/1", "tracks": [
+    ///   {"name": "x", "kind": "scalar", "times": [0, 2], "values": [0, 4]},
+    ///   {"name": "p", "kind": "vec3", "times": [0, 2], "values": [[0, 0, 0], [2, 4, 6]]}]}"#)
+    ///     .unwrap().build().unwrap();
+    /// let mut inst = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(&clip)));
+    /// let mut row = [0.0f32; 4]; // x, then p's x y z
+    /// inst.sample_to(1.0, &mut row).unwrap();
+    /// assert_eq!(row, [2.0, 1.0, 2.0, 3.0]);
+    /// assert!(inst.sample_to(1.0, &mut [0.0; 3]).is_err());
+    /// ```
+    ///
+    /// [`Clip::channel_count`]: crate::Clip::channel_count
+    pub fn sample_to(&mut self, time: f64, out: &mut [f32]) -> Result<(), OutputLength> {
+        let want: usize = self.pose().layout.slots.iter().map(|s| s.kind.dim()).sum();
+        if out.len() != want {
+            return Err(OutputLength {
+                given: out.len(),
+                want,
+            });
+        }
+        self.sample(time).write_row(out, None);
+        Ok(())
     }
 
     /// Sample every track at `time` (seconds; any f64) into the pose,

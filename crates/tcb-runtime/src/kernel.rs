@@ -3,7 +3,7 @@
 
 use crate::exact::{Exact, SQ_STRIDE};
 use crate::segment::Segment;
-use tcb_core::basis::hermite;
+use tcb_core::simd::basis::hermite;
 use wide::{f32x8, f64x4};
 
 #[inline(always)]
@@ -13,7 +13,7 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
 
 /// Values of vector channels on segment `c` (one plane per block):
 /// `h1 P0 + h2 P1 + h3 M0 + h4 M1`, the formula of
-/// [`tcb_core::basis::hermite`] itself.
+/// [`tcb_core::simd::basis::hermite`] itself.
 ///
 /// The kernels take the frame's rows as numbers and splat them where their
 /// loop starts, so that nothing of 8 lanes is live between them (with the
@@ -210,7 +210,7 @@ pub(crate) fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4
 
 /// The lanes of `mask` (`e.mask`, or `e.value_mask` without velocities) in
 /// one rotation block (4 planes), exactly: squad
-/// in f64 ([`tcb_core::squad`]) at `s`, normalized, velocity times `rate`.
+/// in f64 ([`tcb_core::simd::squad`]) at `s`, normalized, velocity times `rate`.
 ///
 /// This runs in f64 (four lanes per [`f64x4`], two halves per block): the
 /// inner slerp between nearly opposite quaternions amplifies its inputs'
@@ -230,7 +230,7 @@ pub(crate) fn exact_quats(
     out: &mut [f32x8],
     vel: Option<&mut [f32x8]>,
 ) {
-    use tcb_core::squad::CONTROLS;
+    use tcb_core::simd::squad::CONTROLS;
     let want_v = vel.is_some();
     let mut q = [[0.0f32; 8]; 4];
     let mut dq = [[0.0f32; 8]; 4];
@@ -281,15 +281,15 @@ pub(crate) fn exact_quats(
     }
 }
 
-/// The unit squad at `s` ([`tcb_core::squad::unit`]), and with `rate` its
+/// The unit squad at `s` ([`tcb_core::simd::squad::unit`]), and with `rate` its
 /// velocity times `rate`: for one lane and for four.
 #[inline(always)]
-fn squad_at<L: tcb_core::lane::Lane>(
-    c: &[L; tcb_core::squad::CONTROLS],
+fn squad_at<L: tcb_core::simd::lane::Lane>(
+    c: &[L; tcb_core::simd::squad::CONTROLS],
     s: L,
     rate: Option<L>,
 ) -> ([L; 4], Option<[L; 4]>) {
-    let (v, d) = tcb_core::squad::unit(c, s, rate.is_some());
+    let (v, d) = tcb_core::simd::squad::unit(c, s, rate.is_some());
     (v, d.zip(rate).map(|(d, r)| d.map(|x| x * r)))
 }
 

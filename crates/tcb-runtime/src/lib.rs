@@ -62,7 +62,7 @@ pub mod batch;
 pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, GridStats};
 pub use compile::CompileOptions;
-pub use instance::{Instance, Playback, PlaybackError};
+pub use instance::{Instance, OutputLength, Playback, PlaybackError};
 pub use layout::{PoseLayout, TrackId, TrackSlot};
 pub use pack::{KeyValues, PackError, PackSource, PackTrack, Packed};
 

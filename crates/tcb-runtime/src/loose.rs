@@ -18,20 +18,20 @@
 //! 2. A block whose eight lanes are all inside their keys (most frames)
 //!    then needs nothing but `u = (t - ws) / D`, the ease if any lane eases,
 //!    and the Hermite rows per lane: no window test, no time mapping.
-//! 3. Other blocks run [`tcb_core::extrapolate::map_lanes`] across eight
+//! 3. Other blocks run [`tcb_core::simd::extrapolate::map_lanes`] across eight
 //!    grids in `f64x4` (pre/post per lane, wrap in f64, selects instead of
 //!    branches), reload lanes whose mapped time left their window, and take
 //!    the sentinel rows of [`crate::grid::sentinel_rows`].
 //!
-//! The rows are evaluated by the same [`tcb_core::basis::hermite`] on
+//! The rows are evaluated by the same [`tcb_core::simd::basis::hermite`] on
 //! `f32x8` as every other kernel, from the same f64 `u` as the reference,
 //! so the values are the reference's bit for bit.
 use crate::grid::{LaneRows, TimeGrid, sentinel_rows};
 use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
-use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use tcb_core::ease::{SegmentEase, ease};
-use tcb_core::extrapolate::{ModeLanes, map_lanes};
+use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
+use tcb_core::simd::extrapolate::{ModeLanes, map_lanes};
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 

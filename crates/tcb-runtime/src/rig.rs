@@ -20,7 +20,7 @@
 //! # /*
 //! let path = "data/cmu-01_01.bvh"; // from the repository's root
 //! # */
-//! let loaded = tcb_io::load(path.as_ref()).unwrap();
+//! let loaded = tcb_io::load(path).unwrap();
 //! let rig = Arc::new(Rig::from_skeleton(loaded.skeleton.as_ref().unwrap()).unwrap());
 //! let clip = Arc::new(Clip::compile(&loaded.clip));
 //! let mut walk = Instance::with_rig(clip.clone(), &rig).unwrap();

@@ -18,7 +18,7 @@ use tcb_core::skeleton::{Skeleton, Transform};
 /// # /*
 /// let path = "data/cmu-01_01.bvh"; // from the repository's root
 /// # */
-/// let loaded = tcb_io::load(path.as_ref()).unwrap();
+/// let loaded = tcb_io::load(path).unwrap();
 /// let clip = Arc::new(tcb_runtime::Clip::compile(&loaded.clip));
 /// let binding = tcb_runtime::SkeletonBinding::new(loaded.skeleton.unwrap(), &clip);
 /// let mut instance = tcb_runtime::Instance::new(clip);

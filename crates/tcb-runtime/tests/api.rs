@@ -220,3 +220,38 @@ fn quantizing_extreme_ranges() {
         assert!(p.vec3(id).is_some());
     }
 }
+
+/// Sampling into the caller's slice: the pose's channels in its tracks'
+/// order (the rig's with a rig), as `write_row` gives them; another length
+/// is an error and nothing is sampled.
+#[test]
+fn sampling_into_a_callers_slice() {
+    let c = clip(&["a.position", "b.rotation", "c.position"]);
+    let mut inst = Instance::new(c.clone());
+    let mut out = vec![f32::NAN; c.channel_count()];
+    inst.sample_to(0.4, &mut out).unwrap();
+    let mut want = vec![0.0; c.channel_count()];
+    Instance::new(c.clone())
+        .sample(0.4)
+        .write_row(&mut want, None);
+    assert_eq!(out, want);
+    let e = inst.sample_to(1.5, &mut out[..9]).unwrap_err();
+    assert_eq!((e.given, e.want), (9, 10));
+    assert_eq!(out, want, "nothing written");
+    // Through a rig: its order, with a track the clip lacks at its rest value.
+    let mut tracks = Rig::from_clip(&c).unwrap().tracks().to_vec();
+    tracks.insert(
+        0,
+        RigTrack {
+            name: "extra".into(),
+            kind: TrackKind::Scalar,
+            rest: [7.0, 0.0, 0.0, 0.0],
+        },
+    );
+    let rig = Arc::new(Rig::new(tracks).unwrap());
+    let mut r = Instance::with_rig(c.clone(), &rig).unwrap();
+    let mut row = vec![0.0; 11];
+    r.sample_to(0.4, &mut row).unwrap();
+    assert_eq!(row[0], 7.0);
+    assert_eq!(row[1..], want[..]);
+}

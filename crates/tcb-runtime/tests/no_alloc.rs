@@ -60,7 +60,7 @@ fn steady_playback_and_blending_allocate_nothing() {
         "tools/check/clips/extrapolation.json",
         "examples/clips/spin.json",
     ] {
-        let clip = tcb_io::load_clip(format!("{root}/{name}").as_ref()).unwrap();
+        let clip = tcb_io::load_clip(format!("{root}/{name}")).unwrap();
         clips.push(Arc::new(tcb_runtime::Clip::compile(&clip)));
         let quantize = tcb_runtime::CompileOptions::default().quantize(true);
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
@@ -70,7 +70,7 @@ fn steady_playback_and_blending_allocate_nothing() {
         rotation: tcb_core::RotationMode::Hermite,
         ..Default::default()
     };
-    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh").as_ref(), &options)
+    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;
     let source = tcb_runtime::PackSource::quantize(&cmu, &vec![1.0 / 4096.0; cmu.tracks().len()]);
@@ -147,7 +147,7 @@ fn loading_a_packed_clip_allocates_no_keys() {
         rotation: tcb_core::RotationMode::Hermite,
         ..Default::default()
     };
-    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh").as_ref(), &options)
+    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;
     let full =

@@ -21,7 +21,7 @@ struct Setup {
 }
 
 fn setup() -> Setup {
-    let loaded = tcb_io::load(BVH.as_ref()).unwrap();
+    let loaded = tcb_io::load(BVH).unwrap();
     let rig = Arc::new(Rig::from_skeleton(loaded.skeleton.as_ref().unwrap()).unwrap());
     let mut doc = loaded.doc.clone();
     // Only the first 400 frames, to keep the test quick.

@@ -149,7 +149,7 @@ impl Clip {
     /// # /*
     /// let path = "data/cmu-01_01.bvh"; // from the repository's root
     /// # */
-    /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
+    /// let source = tcb_io::load(path).unwrap().clip;
     /// let plain = tcb_runtime::Clip::compile(&source);
     /// let options = tcb_runtime::CompileOptions::default().quantize(true);
     /// let small = tcb_runtime::Clip::compile_with(&source, &options);

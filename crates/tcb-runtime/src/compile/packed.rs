@@ -199,7 +199,7 @@ impl Clip {
     /// let path = "data/cmu-01_01.bvh"; // from the repository's root
     /// # */
     /// // What `tcb compress` writes (here in steps of 1/4096, not searched).
-    /// let source = tcb_io::load(path.as_ref()).unwrap().clip;
+    /// let source = tcb_io::load(path).unwrap().clip;
     /// let steps = vec![1.0 / 4096.0; source.tracks().len()];
     /// let packed = Packed::encode(&PackSource::quantize(&source, &steps).unwrap()).unwrap();
     /// let bytes = packed.to_bytes(); // or std::fs::read("cmu.tcbc")

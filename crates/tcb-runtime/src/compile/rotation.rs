@@ -60,13 +60,13 @@ pub(crate) fn rotation_controls(t: &RotationTrack, exact_velocities: bool) -> Ro
         let c = match squad {
             Some(segs) => segs[k].controls(),
             None if interps[k] == Interp::Linear => {
-                tcb_core::squad::controls(keys[k], keys[k + 1], keys[k], keys[k + 1])
+                tcb_core::simd::squad::controls(keys[k], keys[k + 1], keys[k], keys[k + 1])
             }
             None => continue, // a hermite curve or step segment: exact as it is
         };
         // The ends are the keys themselves (stored once per key, see `per_key`).
-        let (_, d0) = tcb_core::squad::squad_with_derivative(&c, 0.0);
-        let (_, d1) = tcb_core::squad::squad_with_derivative(&c, 1.0);
+        let (_, d0) = tcb_core::simd::squad::squad_with_derivative(&c, 0.0);
+        let (_, d1) = tcb_core::simd::squad::squad_with_derivative(&c, 1.0);
         let next = if interps[k] == Interp::Step { k } else { k + 1 };
         let (q0, q1) = (keys[k].to_array(), keys[next].to_array());
         let mut ctl: [[f32; 4]; 4] =
@@ -117,13 +117,13 @@ pub(crate) fn rotation_controls(t: &RotationTrack, exact_velocities: bool) -> Ro
 /// follows the curve more closely than the one through its end
 /// derivatives, and its velocity less.
 fn fitted_tangents(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4]) -> [[f32; 4]; 4] {
-    use tcb_core::basis::hermite_basis;
+    use tcb_core::simd::basis::hermite_basis;
     const POINTS: usize = 64;
     let (mut a11, mut a12, mut a22) = (0.0f64, 0.0f64, 0.0f64);
     let mut rhs = [[0.0f64; 2]; 4];
     for j in 1..POINTS {
         let s = j as f64 / POINTS as f64;
-        let (q, _) = tcb_core::squad::unit(c, s, false);
+        let (q, _) = tcb_core::simd::squad::unit(c, s, false);
         let h = hermite_basis(s);
         a11 += h[2] * h[2];
         a12 += h[2] * h[3];
@@ -150,7 +150,7 @@ fn fitted_tangents(c: &[f64; SQ_STRIDE], ctl: &[[f32; 4]; 4]) -> [[f32; 4]; 4] {
 /// large where a curve between keys on opposite hemispheres, kept as
 /// written, passes near zero.
 pub(crate) fn normalize_gain(rot: &RotationControls) -> f32 {
-    use tcb_core::basis::{hermite, hermite_basis};
+    use tcb_core::simd::basis::{hermite, hermite_basis};
     let n = rot.comps[0].len();
     let mut least = 1.0f32;
     for s in 1..n - 1 {
@@ -207,14 +207,14 @@ fn cubic_holds(
     max_rate: f64,
     (a, b): (f64, f64),
 ) -> Holds {
-    use tcb_core::basis::{hermite, hermite_basis, hermite_basis_derivative};
+    use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
     let mut holds = Holds {
         values: true,
         velocities: true,
     };
     for j in 0..=16 {
         let s = j as f64 / 16.0;
-        let (q, dq) = tcb_core::squad::unit(c, a + (b - a) * s, true);
+        let (q, dq) = tcb_core::simd::squad::unit(c, a + (b - a) * s, true);
         let dq = dq.expect("asked for").map(|x| x * (b - a));
         let (h, dh) = (hermite_basis(s as f32), hermite_basis_derivative(s as f32));
         let p = ctl.map(|k| hermite(&h, k[0], k[1], k[2], k[3]));
@@ -289,8 +289,8 @@ pub(crate) fn split_rotation(
                     (0..m)
                         .map(|j| {
                             let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
-                            let (qa, da) = tcb_core::squad::squad_with_derivative(&c, a);
-                            let (qb, db) = tcb_core::squad::squad_with_derivative(&c, b);
+                            let (qa, da) = tcb_core::simd::squad::squad_with_derivative(&c, a);
+                            let (qb, db) = tcb_core::simd::squad::squad_with_derivative(&c, b);
                             let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
                                 // The segment's own ends stay its keys.
                                 let p0 = if j == 0 {

@@ -282,7 +282,14 @@ impl PackCache {
         // Rows: the segment's keys after the block's first two.
         let end = (k + SEGMENT_KEYS).min(g.keys);
         let first = if block { 2.min(end - k) } else { 0 };
-        read_segment(s, pos, &self.reads, first..end - k, &mut self.res, 8 * g.planes);
+        read_segment(
+            s,
+            pos,
+            &self.reads,
+            first..end - k,
+            &mut self.res,
+            8 * g.planes,
+        );
     }
 }
 

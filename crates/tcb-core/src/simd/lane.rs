@@ -9,7 +9,7 @@
 //! choice is computed and the mask picks, so a formula has no branch that
 //! depends on a lane's data.
 
-use crate::basis::Real;
+use crate::simd::basis::Real;
 use std::ops::{BitAnd, BitOr, Div, Neg, Not};
 
 /// Per-lane booleans of a [`Lane`] type.

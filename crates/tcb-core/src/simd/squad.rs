@@ -20,8 +20,8 @@
 //! opposite) its axis is ill-conditioned, which is why the runtime runs this
 //! in f64.
 
-use crate::lane::Lane;
 use crate::quat::mul;
+use crate::simd::lane::Lane;
 use glam::{DQuat, DVec3};
 
 /// `log` of a unit quaternion: `(v sin(th/2), cos(th/2)) -> v th/2`.

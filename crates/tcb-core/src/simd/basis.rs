@@ -55,7 +55,7 @@ impl Real for wide::f32x8 {
 /// `[h1, h2, h3, h4]` at `s`.
 ///
 /// ```
-/// use tcb_core::basis::hermite_basis;
+/// use tcb_core::simd::basis::hermite_basis;
 /// assert_eq!(hermite_basis(0.0f32), [1.0, 0.0, 0.0, 0.0]);
 /// assert_eq!(hermite_basis(1.0f32), [0.0, 1.0, 0.0, 0.0]);
 /// assert_eq!(hermite_basis(0.5f32), [0.5, 0.5, 0.125, -0.125]);

@@ -19,8 +19,8 @@
 //! an infinite time the value of the end key on its side (as `constant`
 //! would, or zero for `reset`), all with zero velocity.
 
-use crate::lane::{Lane, Mask};
 use crate::params::Extrapolation;
+use crate::simd::lane::{Lane, Mask};
 
 /// Where a sample time lands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,7 +56,7 @@ pub enum Mapped {
 /// Map `time` for a track with keys spanning `[t0, tn]`.
 ///
 /// ```
-/// use tcb_core::{Extrapolation as E, extrapolate::{map_time, Mapped}};
+/// use tcb_core::{Extrapolation as E, simd::extrapolate::{map_time, Mapped}};
 /// let m = map_time(5.5, 0.0, 2.0, E::Constant, E::Oscillate);
 /// // m = 2 (even), r = 1.5
 /// assert_eq!(m, Mapped::Inside { time: 1.5, direction: 1.0, cycles: 0.0 });
