@@ -3,24 +3,14 @@
 //! times move are reported, not called exact, and `tcb import` reads the
 //! export back within the error reported.
 
+mod common;
+
+use common::{scratch, stderr, stdout, tcb};
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn tcb(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tcb"))
-        .args(args)
-        .output()
-        .expect("run tcb")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
+/// This binary's scratch folder.
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tcb-export-times-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scratch("export-times-test")
 }
 
 /// A clip file `name` of one `a.translation` track at `times`.
@@ -74,7 +64,7 @@ fn times_gltf_cannot_hold_are_one_line_and_write_nothing() {
 fn sample(file: &str, at: &str) -> Vec<Vec<f64>> {
     let o = tcb(&["sample", "--scalar", file, "--at", at]);
     assert!(o.status.success(), "{}", stderr(&o));
-    String::from_utf8_lossy(&o.stdout)
+    stdout(&o)
         .lines()
         .skip(1)
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())

@@ -3,34 +3,13 @@
 
 mod common;
 
-use common::{file, scratch, stderr, stderr_has, stdout, tcb};
+use common::{file, scratch, short_cmu, stderr, stderr_has, stdout, tcb};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
 /// This binary's scratch folder.
 fn dir() -> PathBuf {
     scratch("reduce-test")
-}
-
-/// The first `frames` frames of the bundled CMU clip, as a BVH file.
-fn short_cmu(frames: usize) -> PathBuf {
-    let text = std::fs::read_to_string(file("data/cmu-01_01.bvh")).unwrap();
-    let (head, motion) = text.split_once("MOTION").unwrap();
-    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
-    let _frames = lines.next().unwrap();
-    let frame_time = lines.next().unwrap();
-    let rows: Vec<&str> = lines.take(frames).collect();
-    let out = format!(
-        "{head}MOTION\nFrames: {frames}\n{frame_time}\n{}\n",
-        rows.join("\n")
-    );
-    // A file per call: tests run in parallel, and two rewriting one path
-    // could hand a `tcb` child a file being truncated.
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path = dir().join(format!("cmu-{frames}-{n}.bvh"));
-    std::fs::write(&path, out).unwrap();
-    path
 }
 
 /// `tcb reduce INPUT -o OUT [EXTRA...]`, which must succeed.

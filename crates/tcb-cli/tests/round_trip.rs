@@ -3,39 +3,14 @@
 //! key times (frame times such as `348 * 0.0083333`, which a reader that is
 //! not round-trip exact reads 1 ulp off), values and tangents alike.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(path)
-}
+use common::{command, scratch, short_cmu, stderr};
+use std::path::PathBuf;
 
+/// This binary's scratch folder.
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tcb-round-trip-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// The first `frames` frames of the bundled CMU clip, as a BVH file.
-fn short_cmu(frames: usize) -> PathBuf {
-    let text = std::fs::read_to_string(repo("data/cmu-01_01.bvh")).unwrap();
-    let (head, motion) = text.split_once("MOTION").unwrap();
-    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
-    let _frames = lines.next().unwrap();
-    let frame_time = lines.next().unwrap();
-    let rows: Vec<&str> = lines.take(frames).collect();
-    let path = dir().join(format!("cmu-{frames}.bvh"));
-    std::fs::write(
-        &path,
-        format!(
-            "{head}MOTION\nFrames: {frames}\n{frame_time}\n{}\n",
-            rows.join("\n")
-        ),
-    )
-    .unwrap();
-    path
+    scratch("round-trip-test")
 }
 
 /// Equal `Debug` text is equal bits: every float is printed in its
@@ -90,13 +65,13 @@ fn a_reduced_clip_written_then_read_is_the_clip_verified() {
 
     // `tcb reduce` writes that same text.
     let out = dir().join("reduced-by-tcb.json");
-    let o = Command::new(env!("CARGO_BIN_EXE_tcb"))
+    let o = command()
         .args(["reduce", input.to_str().unwrap(), "-o"])
         .arg(&out)
         .args(["--tolerance", "0.005"])
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         std::fs::read_to_string(&out).unwrap() == reduced.doc.to_json(),
         "tcb reduce wrote another clip than tcb_fit::reduce made"

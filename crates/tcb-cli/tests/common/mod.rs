@@ -52,3 +52,24 @@ pub fn stderr_has(o: &Output, text: &str) {
     let err = stderr(o);
     assert!(err.contains(text), "{err}");
 }
+
+/// The first `frames` frames of the bundled CMU clip, as a BVH file.
+pub fn short_cmu(frames: usize) -> PathBuf {
+    let text = std::fs::read_to_string(file("data/cmu-01_01.bvh")).unwrap();
+    let (head, motion) = text.split_once("MOTION").unwrap();
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let _frames = lines.next().unwrap();
+    let frame_time = lines.next().unwrap();
+    let rows: Vec<&str> = lines.take(frames).collect();
+    let out = format!(
+        "{head}MOTION\nFrames: {frames}\n{frame_time}\n{}\n",
+        rows.join("\n")
+    );
+    // A file per call: tests run in parallel, and two rewriting one path
+    // could hand a `tcb` child a file being truncated.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = scratch("cmu").join(format!("cmu-{frames}-{n}.bvh"));
+    std::fs::write(&path, out).unwrap();
+    path
+}
