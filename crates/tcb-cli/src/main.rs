@@ -438,16 +438,7 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         )
         .into());
     }
-    let rename = args
-        .rename
-        .iter()
-        .map(|r| {
-            r.split_once('=')
-                .filter(|(a, b)| !a.is_empty() && !b.is_empty())
-                .map(|(a, b)| (a.to_string(), b.to_string()))
-                .ok_or_else(|| format!("--rename {r}: expected FROM=TO"))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let rename = renames(&args.rename)?;
     let (clip, skeleton) = load_any(&args.clip, &import_options_plain())?;
     let options = tcb_io::gltf_export::ExportOptions {
         max_error: args.max_error,
@@ -456,6 +447,41 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
     let report =
         tcb_io::gltf_export::export_file(&clip, skeleton.as_ref(), &args.output, &options)?;
     warn(&report.notes);
+    eprintln!(
+        "tcb: wrote {}: {}",
+        args.output.display(),
+        export_summary(&report, skeleton.as_ref())
+    );
+    if report.max_error() > args.max_error {
+        eprintln!(
+            "tcb: warning: max error {:e} is above --max-error {:e}, as `tcb import` reads the export back",
+            report.max_error(),
+            args.max_error
+        );
+    }
+    Ok(())
+}
+
+/// `--rename FROM=TO` arguments as pairs.
+fn renames(rename: &[String]) -> Result<Vec<(String, String)>, String> {
+    rename
+        .iter()
+        .map(|r| {
+            r.split_once('=')
+                .filter(|(a, b)| !a.is_empty() && !b.is_empty())
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .ok_or_else(|| format!("--rename {r}: expected FROM=TO"))
+        })
+        .collect()
+}
+
+/// `tcb export`'s account of what it wrote: tracks exact, resampled or on
+/// key times that glTF's f32 moves, the largest error and where, and the
+/// skeleton.
+fn export_summary(
+    report: &tcb_io::gltf_export::ExportReport,
+    skeleton: Option<&tcb_core::skeleton::Skeleton>,
+) -> String {
     // Not exact: resampled, or on key times that glTF's f32 moves.
     let inexact: Vec<_> = report
         .tracks
@@ -485,23 +511,14 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
         .map_or(String::new(), |(n, e)| {
             format!(" (max error {e:e}, in {n})")
         });
-    let joints = skeleton.as_ref().map_or("no skeleton".to_string(), |s| {
+    let joints = skeleton.map_or("no skeleton".to_string(), |s| {
         format!("{} joints as the node hierarchy", s.joints.len())
     });
-    eprintln!(
-        "tcb: wrote {}: {} tracks, {} exact, {resampled} resampled{moved}{worst}; {joints}",
-        args.output.display(),
+    format!(
+        "{} tracks, {} exact, {resampled} resampled{moved}{worst}; {joints}",
         report.tracks.len(),
         report.tracks.len() - inexact.len(),
-    );
-    if report.max_error() > args.max_error {
-        eprintln!(
-            "tcb: warning: max error {:e} is above --max-error {:e}, as `tcb import` reads the export back",
-            report.max_error(),
-            args.max_error
-        );
-    }
-    Ok(())
+    )
 }
 
 fn compress(args: &CompressArgs) -> Result<(), BoxError> {
