@@ -35,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ));
     let rig = Arc::new(Rig::from_skeleton(bvh.skeleton())?);
     let binding = SkeletonBinding::for_layout(bvh.skeleton().clone(), rig.layout());
-    let joints = bvh.skeleton().joints.len();
+    let joints = bvh.skeleton().joints().len();
 
     // Four characters, each with its two layers and its blended pose.
     struct Character {

@@ -512,7 +512,7 @@ fn export_summary(
             format!(" (max error {e:e}, in {n})")
         });
     let joints = skeleton.map_or("no skeleton".to_string(), |s| {
-        format!("{} joints as the node hierarchy", s.joints.len())
+        format!("{} joints as the node hierarchy", s.joints().len())
     });
     format!(
         "{} tracks, {} exact, {resampled} resampled{moved}{worst}; {joints}",
@@ -732,8 +732,12 @@ fn info(args: &InfoArgs) -> Result<(), BoxError> {
     )?;
     match &loaded.skeleton {
         Some(s) => {
-            let roots = s.joints.iter().filter(|j| j.parent.is_none()).count();
-            writeln!(out, "skeleton: {} joints, {roots} root(s)", s.joints.len())?
+            let roots = s.joints().iter().filter(|j| j.parent.is_none()).count();
+            writeln!(
+                out,
+                "skeleton: {} joints, {roots} root(s)",
+                s.joints().len()
+            )?
         }
         None => writeln!(out, "skeleton: none")?,
     }

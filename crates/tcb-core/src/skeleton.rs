@@ -56,14 +56,87 @@ pub struct Joint {
     pub rest: Transform,
 }
 
-/// Joints, parents before children.
+/// Joints, parents before children: every joint's parent comes before it
+/// ([`Skeleton::new`] and [`Skeleton::push`] refuse anything else), so one
+/// pass in order composes model-space transforms.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Skeleton {
-    /// The joints.
-    pub joints: Vec<Joint>,
+    joints: Vec<Joint>,
 }
 
+/// A joint whose parent does not come before it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SkeletonError {
+    /// The joint's index.
+    pub joint: usize,
+    /// Its name.
+    pub name: String,
+    /// Its parent's index (not below `joint`).
+    pub parent: usize,
+}
+
+impl std::fmt::Display for SkeletonError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "joint {} ({:?}) has parent {}, which does not come before it: list parents before their children",
+            self.joint, self.name, self.parent
+        )
+    }
+}
+
+impl std::error::Error for SkeletonError {}
+
 impl Skeleton {
+    /// A skeleton of `joints`, each one's parent before it.
+    ///
+    /// ```
+    /// use tcb_core::skeleton::{Joint, Skeleton, Transform};
+    /// let joint = |name: &str, parent| Joint { name: name.into(), parent, rest: Transform::IDENTITY };
+    /// assert!(Skeleton::new(vec![joint("hip", None), joint("knee", Some(0))]).is_ok());
+    /// let e = Skeleton::new(vec![joint("knee", Some(1)), joint("hip", None)]).unwrap_err();
+    /// assert_eq!((e.joint, e.parent), (0, 1));
+    /// ```
+    pub fn new(joints: Vec<Joint>) -> Result<Skeleton, SkeletonError> {
+        let mut s = Skeleton {
+            joints: Vec::with_capacity(joints.len()),
+        };
+        for j in joints {
+            s.push(j)?;
+        }
+        Ok(s)
+    }
+
+    /// Add a joint after the others (its parent, if any, already in);
+    /// returns its index.
+    pub fn push(&mut self, joint: Joint) -> Result<usize, SkeletonError> {
+        let i = self.joints.len();
+        if let Some(p) = joint.parent.filter(|&p| p >= i) {
+            return Err(SkeletonError {
+                joint: i,
+                name: joint.name,
+                parent: p,
+            });
+        }
+        self.joints.push(joint);
+        Ok(i)
+    }
+
+    /// The joints, parents before children.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// Joint `i`'s rest transform, to change (its place in the hierarchy
+    /// cannot be).
+    pub fn rest_mut(&mut self, i: usize) -> Option<&mut Transform> {
+        self.joints.get_mut(i).map(|j| &mut j.rest)
+    }
+
+    /// The joints, given back.
+    pub fn into_joints(self) -> Vec<Joint> {
+        self.joints
+    }
     /// The index of the joint called `name`.
     pub fn joint(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
@@ -76,10 +149,10 @@ impl Skeleton {
     /// use glam::{Quat, Vec3};
     /// use tcb_core::skeleton::{Joint, Skeleton, Transform};
     /// let at = |x: f32| Transform { translation: Vec3::new(x, 0.0, 0.0), ..Transform::IDENTITY };
-    /// let skeleton = Skeleton { joints: vec![
+    /// let skeleton = Skeleton::new(vec![
     ///     Joint { name: "hip".into(), parent: None, rest: at(1.0) },
     ///     Joint { name: "knee".into(), parent: Some(0), rest: at(2.0) },
-    /// ]};
+    /// ]).unwrap();
     /// let local = [at(1.0), at(2.0)];
     /// let mut model = [glam::Affine3A::IDENTITY; 2];
     /// skeleton.model_transforms(&local, &mut model);

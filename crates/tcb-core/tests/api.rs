@@ -214,18 +214,33 @@ fn segment_eases_are_normalized() {
     }
 }
 
-/// A skeleton is plain data: parents not below their joints, loops, and
-/// slices of any length compose without a panic.
+/// A skeleton's parents come before their joints: a parent at or after
+/// its joint (itself, a loop, one not there) is refused by the constructor
+/// and by `push`, with the joint named; valid skeletons compose with slices
+/// of any length without a panic.
 #[test]
-fn skeletons_of_any_shape_compose() {
+fn skeletons_keep_parents_before_children() {
     let joint = |parent| Joint {
-        name: String::new(),
+        name: "j".into(),
         parent,
         rest: Transform::IDENTITY,
     };
-    let s = Skeleton {
-        joints: vec![joint(Some(0)), joint(Some(7)), joint(Some(1)), joint(None)],
-    };
+    for (joints, at) in [
+        (vec![joint(Some(0))], 0),
+        (vec![joint(None), joint(Some(7))], 1),
+        (vec![joint(None), joint(Some(2)), joint(Some(1))], 1),
+    ] {
+        let e = Skeleton::new(joints).unwrap_err();
+        assert_eq!(e.joint, at);
+        assert!(
+            e.to_string().contains("parents before their children"),
+            "{e}"
+        );
+    }
+    let mut s = Skeleton::new(vec![joint(None), joint(Some(0)), joint(Some(1))]).unwrap();
+    assert!(s.push(joint(Some(3))).is_err());
+    assert_eq!(s.push(joint(Some(2))), Ok(3));
+    assert_eq!(s.joints().len(), 4);
     for n in [0, 1, 4, 9] {
         let local = vec![Transform::IDENTITY; n];
         s.model_transforms(&local, &mut vec![Affine3A::IDENTITY; 4]);

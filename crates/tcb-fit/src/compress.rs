@@ -264,7 +264,7 @@ impl Budget {
         let tracks = clip.tracks();
         match (s.metric, skeleton) {
             (Metric::Shell, Some(sk)) => {
-                let n = sk.joints.len();
+                let n = sk.joints().len();
                 let joint: Vec<Option<usize>> = tracks
                     .iter()
                     .map(|t| bound_joint(sk, &t.name, t.data.kind()).map(|(j, _)| j))
@@ -277,15 +277,15 @@ impl Budget {
                 }
                 let mut down = count.clone();
                 for j in (0..n).rev() {
-                    if let Some(p) = sk.joints[j].parent.filter(|&p| p < j) {
-                        let off = f64::from(sk.joints[j].rest.translation.length());
+                    if let Some(p) = sk.joints()[j].parent.filter(|&p| p < j) {
+                        let off = f64::from(sk.joints()[j].rest.translation.length());
                         reach[p] = reach[p].max(reach[j] + off);
                         down[p] = down[p].max(count[p] + down[j]);
                     }
                 }
                 let mut up = count.clone();
                 for j in 0..n {
-                    if let Some(p) = sk.joints[j].parent.filter(|&p| p < j) {
+                    if let Some(p) = sk.joints()[j].parent.filter(|&p| p < j) {
                         up[j] += up[p];
                     }
                 }

@@ -85,7 +85,7 @@ pub struct Measured {
 /// The rest-pose height H of `docs/reduce.md`: the largest distance of any
 /// joint from the (first) root in the rest pose.
 pub fn rest_height(skeleton: &Skeleton) -> f64 {
-    let local: Vec<Transform> = skeleton.joints.iter().map(|j| j.rest).collect();
+    let local: Vec<Transform> = skeleton.joints().iter().map(|j| j.rest).collect();
     let mut model = vec![DAffine3::IDENTITY; local.len()];
     skeleton.model_transforms_f64(&local, &mut model);
     let Some(root) = model.first() else {
@@ -112,7 +112,7 @@ pub fn shell_error(
     let bind_b = SkeletonBinding::new(skeleton.clone(), reduced);
     let mut ia = Instance::new(reference.clone());
     let mut ib = Instance::new(reduced.clone());
-    let n = skeleton.joints.len();
+    let n = skeleton.joints().len();
     let mut local = vec![Transform::IDENTITY; n];
     let (mut ma, mut mb) = (vec![DAffine3::IDENTITY; n], vec![DAffine3::IDENTITY; n]);
     let mut worst = Worst::none();
@@ -122,7 +122,7 @@ pub fn shell_error(
         skeleton.model_transforms_f64(&local, &mut ma);
         bind_b.local_transforms(ib.sample(t), &mut local);
         skeleton.model_transforms_f64(&local, &mut mb);
-        for (j, joint) in skeleton.joints.iter().enumerate() {
+        for (j, joint) in skeleton.joints().iter().enumerate() {
             let e = point_error(&ma[j], &mb[j], radius);
             worst.take(e, e / tolerance, &joint.name, t);
             each[j] = each[j].max(e / tolerance);

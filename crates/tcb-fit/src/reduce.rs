@@ -811,7 +811,7 @@ impl<'a> Plan<'a> {
                                 ..
                             }),
                         ) => {
-                            for d in 0..s.joints.len() {
+                            for d in 0..s.joints().len() {
                                 if descends(s, d, *a) && !units.contains(&d) {
                                     units.push(d);
                                 }
@@ -1041,7 +1041,7 @@ pub(crate) fn descends(skeleton: &Skeleton, mut d: usize, a: usize) -> bool {
         if d == a {
             return true;
         }
-        match skeleton.joints[d].parent {
+        match skeleton.joints()[d].parent {
             Some(p) if p < d => d = p,
             _ => return false,
         }
@@ -1098,9 +1098,9 @@ fn chains(
     channels: usize,
     radius: f64,
 ) -> (Vec<f64>, Vec<usize>) {
-    let n = skeleton.joints.len();
+    let n = skeleton.joints().len();
     let mut offset: Vec<f64> = skeleton
-        .joints
+        .joints()
         .iter()
         .map(|j| f64::from(j.rest.translation.length()))
         .collect();
@@ -1130,7 +1130,7 @@ fn chains(
         }
         at += dim;
     }
-    let parent = |j: usize| skeleton.joints[j].parent.filter(|&p| p < j);
+    let parent = |j: usize| skeleton.joints()[j].parent.filter(|&p| p < j);
     // Below: longest offset chain and most tracks on a chain, leaves up.
     let mut reach = vec![0.0f64; n];
     let mut down = count.clone();

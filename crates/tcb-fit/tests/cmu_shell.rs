@@ -157,7 +157,7 @@ fn reduced_cmu_is_within_the_shell_tolerance_at_three_tolerances() {
     let rig = read_rig(&text);
     let loaded = tcb_io::load(BVH).unwrap();
     let skeleton = loaded.skeleton.clone().unwrap();
-    assert_eq!(skeleton.joints.len(), rig.names.len());
+    assert_eq!(skeleton.joints().len(), rig.names.len());
     let h = rest_height(&rig);
     let (default_e, radius) = (6e-5 * h, 0.018 * h);
     for scale in [1.0, 10.0, 0.1] {

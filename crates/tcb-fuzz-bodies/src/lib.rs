@@ -151,7 +151,7 @@ pub fn reduce(data: &[u8]) {
                 },
             });
         }
-        Some(Skeleton { joints })
+        Some(Skeleton::new(joints).unwrap())
     } else {
         None
     };

@@ -263,7 +263,10 @@ impl Bvh {
                 }
                 "OFFSET" => {
                     let j = open("OFFSET")?;
-                    self.skeleton.joints[j].rest.translation = t.offset()?;
+                    let offset = t.offset()?;
+                    if let Some(rest) = self.skeleton.rest_mut(j) {
+                        rest.translation = offset;
+                    }
                 }
                 "CHANNELS" => {
                     let j = open("CHANNELS")?;
@@ -302,13 +305,17 @@ impl Bvh {
                 format!("joints nested deeper than {MAX_DEPTH} (the limit; rigs are tens deep)"),
             ));
         }
-        self.skeleton.joints.push(Joint {
+        let joint = Joint {
             name,
             parent: stack.last().copied(),
             rest: Transform::IDENTITY,
-        });
+        };
+        let at = self
+            .skeleton
+            .push(joint)
+            .expect("a joint's parent is the joint open around it, before it");
         self.channels.push(Vec::new());
-        stack.push(self.skeleton.joints.len() - 1);
+        stack.push(at);
         Ok(())
     }
 
@@ -320,7 +327,7 @@ impl Bvh {
                 "the hierarchy ends with joints not closed by '}'",
             ));
         }
-        if self.skeleton.joints.is_empty() {
+        if self.skeleton.joints().is_empty() {
             return Err(Error::syntax(t.last_line, "no ROOT joint"));
         }
         if self.channel_count() == 0 {
@@ -469,7 +476,7 @@ impl Bvh {
                 };
                 return format!(
                     "{} {}{kind}",
-                    self.skeleton.joints[j].name,
+                    self.skeleton.joints()[j].name,
                     ["X", "Y", "Z"][axis]
                 );
             }
@@ -484,7 +491,7 @@ impl Bvh {
     /// Yrotation` is `qz * qx * qy`), in f64; `None` beyond the frames or
     /// the joints.
     pub fn local(&self, frame: usize, joint: usize) -> Option<(DVec3, DQuat)> {
-        if frame >= self.frame_count() || joint >= self.skeleton.joints.len() {
+        if frame >= self.frame_count() || joint >= self.skeleton.joints().len() {
             return None;
         }
         let first: usize = self.channels[..joint].iter().map(Vec::len).sum();
@@ -495,7 +502,7 @@ impl Bvh {
     /// the joint whose channels start at `first` in it.
     fn local_at(&self, row: usize, first: usize, joint: usize) -> (DVec3, DQuat) {
         let row = &self.values[row..];
-        let mut t = self.skeleton.joints[joint].rest.translation.as_dvec3();
+        let mut t = self.skeleton.joints()[joint].rest.translation.as_dvec3();
         let mut q = DQuat::IDENTITY;
         for (i, c) in self.channels[joint].iter().enumerate() {
             let v = f64::from(row[first + i]);
@@ -524,7 +531,7 @@ impl Bvh {
         let mut tracks = Vec::new();
         let count = self.channel_count();
         let mut first = 0;
-        for (j, joint) in self.skeleton.joints.iter().enumerate() {
+        for (j, joint) in self.skeleton.joints().iter().enumerate() {
             let ch = &self.channels[j];
             let at = first;
             first += ch.len();
@@ -580,9 +587,9 @@ impl Bvh {
     pub fn skeleton_with_end_sites(&self) -> Skeleton {
         let mut out = self.skeleton.clone();
         let mut names: std::collections::HashSet<String> =
-            out.joints.iter().map(|j| j.name.clone()).collect();
+            out.joints().iter().map(|j| j.name.clone()).collect();
         for &(parent, offset) in &self.end_sites {
-            let base = format!("{}_end", self.skeleton.joints[parent].name);
+            let base = format!("{}_end", self.skeleton.joints()[parent].name);
             let mut name = base.clone();
             let mut n = 1;
             while names.contains(&name) {
@@ -590,14 +597,15 @@ impl Bvh {
                 name = format!("{base}{n}");
             }
             names.insert(name.clone());
-            out.joints.push(Joint {
+            out.push(Joint {
                 name,
                 parent: Some(parent),
                 rest: Transform {
                     translation: offset,
                     ..Transform::IDENTITY
                 },
-            });
+            })
+            .expect("an End Site's parent is a joint before it");
         }
         out
     }

@@ -516,7 +516,7 @@ impl Scene {
     fn of(skeleton: Option<&Skeleton>) -> Scene {
         let nodes = skeleton
             .map(|s| {
-                s.joints
+                s.joints()
                     .iter()
                     .map(|j| NodeOut {
                         name: j.name.clone(),

@@ -421,7 +421,7 @@ fn skeleton(doc: &Document, names: &[String]) -> Skeleton {
             }
         })
         .collect();
-    Skeleton { joints }
+    Skeleton::new(joints).expect("breadth first from the roots: parents before children")
 }
 
 /// Every buffer's bytes: the GLB chunk, a data URI or an external file (`read_buffer`), checked against its `byteLength`.

@@ -109,7 +109,7 @@ impl SkeletonIn {
                 },
             });
         }
-        Ok(Skeleton { joints: out })
+        Ok(Skeleton::new(out).expect("each parent checked to be below its joint above"))
     }
 }
 
@@ -151,7 +151,7 @@ impl<'a> SkeletonOut<'a> {
     pub(crate) fn of(skeleton: &'a Skeleton) -> Self {
         SkeletonOut {
             joints: skeleton
-                .joints
+                .joints()
                 .iter()
                 .map(|j| JointOut {
                     name: &j.name,
@@ -189,9 +189,9 @@ mod tests {
         );
         let doc = ClipDoc::parse(&text).unwrap();
         let s = doc.skeleton.as_ref().unwrap();
-        assert_eq!(s.joints.len(), 3);
-        assert_eq!(s.joints[1].parent, Some(0));
-        assert_eq!(s.joints[2].rest.translation, glam::Vec3::ZERO);
+        assert_eq!(s.joints().len(), 3);
+        assert_eq!(s.joints()[1].parent, Some(0));
+        assert_eq!(s.joints()[2].rest.translation, glam::Vec3::ZERO);
         let again = ClipDoc::parse(&doc.to_json()).unwrap();
         assert_eq!(again, doc);
     }

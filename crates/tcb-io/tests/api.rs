@@ -248,10 +248,13 @@ fn load_and_parse_give_the_same_joints_and_name_the_end_sites() {
     let bvh = tcb_io::bvh::Bvh::parse(&std::fs::read_to_string(path).unwrap()).unwrap();
     assert_eq!(skeleton, bvh.skeleton_with_end_sites());
     assert_eq!(loaded.doc.skeleton.as_ref(), Some(&skeleton));
-    let joints = &bvh.skeleton().joints;
+    let joints = &bvh.skeleton().joints();
     assert_eq!((joints.len(), bvh.end_sites().len()), (31, 7));
-    assert_eq!(&skeleton.joints[..joints.len()], &joints[..]);
-    for (end, &(parent, offset)) in skeleton.joints[joints.len()..].iter().zip(bvh.end_sites()) {
+    assert_eq!(&skeleton.joints()[..joints.len()], &joints[..]);
+    for (end, &(parent, offset)) in skeleton.joints()[joints.len()..]
+        .iter()
+        .zip(bvh.end_sites())
+    {
         assert_eq!(end.name, format!("{}_end", joints[parent].name));
         assert_eq!(end.parent, Some(parent));
         assert_eq!(end.rest.translation, offset);

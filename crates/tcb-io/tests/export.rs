@@ -221,11 +221,11 @@ fn hierarchy_round_trips(path: &str) {
     .unwrap();
     let again = import(&bytes, None, None, "rt").unwrap();
     let back = &again.skeleton;
-    assert_eq!(back.joints.len(), skeleton.joints.len(), "{path}");
-    for joint in &skeleton.joints {
-        let b = &back.joints[back.joint(&joint.name).expect("joint kept")];
+    assert_eq!(back.joints().len(), skeleton.joints().len(), "{path}");
+    for joint in skeleton.joints() {
+        let b = &back.joints()[back.joint(&joint.name).expect("joint kept")];
         let name = |s: &tcb_core::skeleton::Skeleton, p: Option<usize>| {
-            p.map(|p| s.joints[p].name.clone())
+            p.map(|p| s.joints()[p].name.clone())
         };
         assert_eq!(
             name(back, b.parent),

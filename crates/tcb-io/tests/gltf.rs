@@ -39,8 +39,8 @@ fn simple_skin_samples_as_gltf_linear_slerp() {
     assert_eq!(clip.tracks().len(), 1);
     assert_eq!(clip.tracks()[0].name, "node2.rotation");
     let skeleton = loaded.skeleton.unwrap();
-    assert_eq!(skeleton.joints.len(), 3);
-    assert_eq!(skeleton.joints[2].parent, Some(1));
+    assert_eq!(skeleton.joints().len(), 3);
+    assert_eq!(skeleton.joints()[2].parent, Some(1));
 
     // The keys, read with the gltf crate's own reader.
     let text = std::fs::read_to_string(&path).unwrap();

@@ -108,8 +108,8 @@ fn hand_picked_numbers_read_back_bit_for_bit() {
                 settings: SettingsDoc::default(),
             },
         ],
-        skeleton: Some(Skeleton {
-            joints: vec![Joint {
+        skeleton: Some(
+            Skeleton::new(vec![Joint {
                 name: "a".into(),
                 parent: None,
                 rest: Transform {
@@ -117,8 +117,9 @@ fn hand_picked_numbers_read_back_bit_for_bit() {
                     rotation: Quat::from_rotation_y(1.0),
                     scale: Vec3::new(1.0, TRICKY_F32, 2.0),
                 },
-            }],
-        }),
+            }])
+            .unwrap(),
+        ),
     };
     assert_reads_back(&doc);
 }
@@ -263,20 +264,23 @@ fn skeleton() -> impl Strategy<Value = Skeleton> {
         ),
         1..4,
     )
-    .prop_map(|joints| Skeleton {
-        joints: joints
-            .into_iter()
-            .enumerate()
-            .map(|(i, (t, (x, y, z), s, root))| Joint {
-                name: format!("j{i}"),
-                parent: (i > 0 && !root).then(|| i - 1),
-                rest: Transform {
-                    translation: Vec3::new(t[0], t[1], t[2]),
-                    rotation: Quat::from_euler(glam::EulerRot::ZXY, x, y, z),
-                    scale: Vec3::new(s[0], s[1], s[2]),
-                },
-            })
-            .collect(),
+    .prop_map(|joints| {
+        Skeleton::new(
+            joints
+                .into_iter()
+                .enumerate()
+                .map(|(i, (t, (x, y, z), s, root))| Joint {
+                    name: format!("j{i}"),
+                    parent: (i > 0 && !root).then(|| i - 1),
+                    rest: Transform {
+                        translation: Vec3::new(t[0], t[1], t[2]),
+                        rotation: Quat::from_euler(glam::EulerRot::ZXY, x, y, z),
+                        scale: Vec3::new(s[0], s[1], s[2]),
+                    },
+                })
+                .collect(),
+        )
+        .unwrap()
     })
 }
 

@@ -104,8 +104,8 @@ pub const MAX_MARKED_KEYS: usize = 300;
 /// captures), x and y for a Z-up one. Up is whichever of y and z the rest
 /// pose's joints spread along more (x runs across the body in both).
 pub fn ground_plane(skeleton: &Skeleton) -> [usize; 2] {
-    let n = skeleton.joints.len();
-    let local: Vec<_> = skeleton.joints.iter().map(|j| j.rest).collect();
+    let n = skeleton.joints().len();
+    let local: Vec<_> = skeleton.joints().iter().map(|j| j.rest).collect();
     let mut model = vec![glam::Affine3A::IDENTITY; n];
     skeleton.model_transforms(&local, &mut model);
     let extent = |axis: usize| {

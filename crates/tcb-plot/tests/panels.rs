@@ -167,20 +167,19 @@ fn rig(up: glam::Vec3) -> Skeleton {
         translation: t,
         ..Transform::IDENTITY
     };
-    Skeleton {
-        joints: vec![
-            Joint {
-                name: "root".into(),
-                parent: None,
-                rest: at(glam::Vec3::ZERO),
-            },
-            Joint {
-                name: "head".into(),
-                parent: Some(0),
-                rest: at(up + 0.3 * glam::Vec3::X),
-            },
-        ],
-    }
+    Skeleton::new(vec![
+        Joint {
+            name: "root".into(),
+            parent: None,
+            rest: at(glam::Vec3::ZERO),
+        },
+        Joint {
+            name: "head".into(),
+            parent: Some(0),
+            rest: at(up + 0.3 * glam::Vec3::X),
+        },
+    ])
+    .unwrap()
 }
 
 #[test]

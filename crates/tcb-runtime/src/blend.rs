@@ -8,7 +8,8 @@
 //! rotations                     normalize(sum_i w_i sign(q_i . q_0) q_i)
 //! ```
 //!
-//! Lanes whose weights sum to zero keep the first layer's value. Velocities,
+//! Lanes whose weights sum to less than [`MIN_WEIGHT_SUM`] (1e-12) in
+//! magnitude keep the first layer's value. Velocities,
 //! when every pose has them, are blended with the same weights (and signs).
 //!
 //! Every pose and mask must have the output's layout: poses of one clip, of
@@ -26,6 +27,12 @@
 //!
 //! Scale tracks are vectors here, so their difference is added too (ozz
 //! multiplies scales); the two agree at weights 0 and 1 on a unit reference.
+
+/// Lanes whose layer weights sum to less than this in magnitude keep the
+/// first layer's value, as at a sum of zero: dividing by a smaller sum
+/// (a denormal) would give infinities, and weights that small blend
+/// nothing a frame can show.
+pub const MIN_WEIGHT_SUM: f32 = 1e-12;
 
 use crate::clip::Clip;
 use crate::kernel::normalize;
@@ -199,6 +206,9 @@ pub fn blend(
     } = out;
     let mut out_dv = out_dv.as_mut().filter(|_| with_velocity);
     let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+    let min_sum = f32x8::splat(MIN_WEIGHT_SUM);
+    // Lanes whose weights sum to almost nothing keep the first layer.
+    let none_at = |sum: f32x8| sum.abs().simd_lt(min_sum);
     // The weight of layer i in block b, and the sum over layers.
     let w_at = |i: usize, b: usize| {
         let w = f32x8::splat(layers[i].1);
@@ -231,7 +241,7 @@ pub fn blend(
         let base_v = &base.values[r.clone()];
         for ((b, o), &x0) in r.clone().zip(&mut out_v[r.clone()]).zip(base_v) {
             let sum = sum_at(b);
-            let none = sum.simd_eq(zero);
+            let none = none_at(sum);
             let inv = none.select(zero, one / sum);
             *o = none.select(x0, *o * inv);
         }
@@ -239,7 +249,7 @@ pub fn blend(
             let base_dv = &base.velocities.as_ref().expect("checked")[r.clone()];
             for ((b, o), &v0) in r.clone().zip(dv).zip(base_dv) {
                 let sum = sum_at(b);
-                let none = sum.simd_eq(zero);
+                let none = none_at(sum);
                 *o = none.select(v0, *o * none.select(zero, one / sum));
             }
         }
@@ -273,7 +283,8 @@ pub fn blend(
             }
         }
         let len = (acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2] + acc[3] * acc[3]).sqrt();
-        let keep = sum.simd_eq(zero) | len.simd_eq(zero);
+        // A length below f32's smallest normal would make its inverse inf.
+        let keep = none_at(sum) | len.simd_lt(f32x8::splat(f32::MIN_POSITIVE));
         let inv = keep.select(zero, one / len);
         let inv_sum = keep.select(zero, one / sum);
         for (c, o) in out_v[block..block + 4].iter_mut().enumerate() {

@@ -157,13 +157,15 @@ impl Instance {
             Playback::Clamp if t > t1 => (t1, 0.0),
             Playback::Clamp => (t, speed as f32),
             _ if d <= 0.0 || !t.is_finite() => (t0, 0.0),
-            Playback::Loop => (t0 + (t - t0).rem_euclid(d), speed as f32),
+            // Clamped into the keys: `t0 + u` rounds, and a hair outside them
+            // the clip's own `pre` or `post` would apply.
+            Playback::Loop => ((t0 + (t - t0).rem_euclid(d)).clamp(t0, t1), speed as f32),
             Playback::PingPong => {
                 let u = (t - t0).rem_euclid(2.0 * d);
                 if u <= d {
-                    (t0 + u, speed as f32)
+                    ((t0 + u).clamp(t0, t1), speed as f32)
                 } else {
-                    (t0 + 2.0 * d - u, -speed as f32)
+                    ((t0 + 2.0 * d - u).clamp(t0, t1), -speed as f32)
                 }
             }
         }

@@ -176,8 +176,8 @@ impl Rig {
     /// skeleton's rest transforms. Fails only on a hand-built skeleton with
     /// two joints of one name or a non-finite rest (tcb-io refuses both).
     pub fn from_skeleton(skeleton: &Skeleton) -> Result<Self, RigError> {
-        let mut tracks = Vec::with_capacity(3 * skeleton.joints.len());
-        for j in &skeleton.joints {
+        let mut tracks = Vec::with_capacity(3 * skeleton.joints().len());
+        for j in skeleton.joints() {
             let (t, r, s) = (j.rest.translation, j.rest.rotation, j.rest.scale);
             tracks.push(RigTrack {
                 name: format!("{}.translation", j.name),

@@ -49,7 +49,7 @@ impl SkeletonBinding {
                 .filter(|&t| layout.slot(t).is_some_and(|s| s.kind == kind))
         };
         let tracks = skeleton
-            .joints
+            .joints()
             .iter()
             .map(|j| {
                 [
@@ -80,7 +80,7 @@ impl SkeletonBinding {
     /// transform's, as does everything of a `pose` of another layout.
     #[inline]
     pub fn local_transforms(&self, pose: &Pose, out: &mut [Transform]) {
-        for ((joint, tracks), o) in self.skeleton.joints.iter().zip(&self.tracks).zip(out) {
+        for ((joint, tracks), o) in self.skeleton.joints().iter().zip(&self.tracks).zip(out) {
             let rest = &joint.rest;
             *o = Transform {
                 translation: tracks[0]

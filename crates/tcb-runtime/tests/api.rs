@@ -160,9 +160,10 @@ fn rigs_and_playback_refuse_bad_values() {
     }
 }
 
-/// A skeleton is plain data (public fields): one whose parents are not
-/// below their joints, or that names tracks of other kinds, still binds
-/// and composes without a panic, into slices of any length.
+/// A skeleton whose parents are not before their joints cannot be made
+/// (`Skeleton::new` refuses it); one that names a joint twice or tracks of
+/// other kinds still binds and composes without a panic, into slices of
+/// any length.
 #[test]
 fn skeletons_of_any_shape_bind_and_compose() {
     let a = clip(&["a.translation", "b.rotation", "c.rotation"]);
@@ -171,14 +172,14 @@ fn skeletons_of_any_shape_bind_and_compose() {
         parent,
         rest: Transform::IDENTITY,
     };
-    let skeleton = Skeleton {
-        joints: vec![
-            joint("a", Some(5)),
-            joint("b", Some(1)),
-            joint("c", Some(0)),
-            joint("a", None),
-        ],
-    };
+    assert!(Skeleton::new(vec![joint("a", Some(5)), joint("b", None)]).is_err());
+    let skeleton = Skeleton::new(vec![
+        joint("c", None),
+        joint("b", Some(0)),
+        joint("a", Some(0)),
+        joint("a", Some(1)),
+    ])
+    .unwrap();
     let binding = SkeletonBinding::new(skeleton, &a);
     let mut i = Instance::new(a);
     let pose = i.sample(0.7);

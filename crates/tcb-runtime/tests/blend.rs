@@ -211,3 +211,34 @@ fn masked_velocities_by_hand() {
     let want = (pa.vec3(pos).unwrap() * wa + pb.vec3(pos).unwrap() * wb * 0.5) / (wa + wb * 0.5);
     assert!((out.vec3(pos).unwrap() - want).abs().max_element() < 1e-5);
 }
+
+/// Issue 29, class 7: weights whose sum is a denormal (2e-40) divided into
+/// the layers gave inf. Below `blend::MIN_WEIGHT_SUM` a lane keeps the
+/// first layer's value, as at a sum of zero; above it the blend is the
+/// weighted mean, finite.
+#[test]
+fn weights_near_zero_keep_the_first_layer() {
+    let clip = clip();
+    let (pos, rot) = (clip.track("pos").unwrap(), clip.track("rot").unwrap());
+    let mut a = Instance::new(clip.clone()).with_velocities();
+    let mut b = Instance::new(clip.clone()).with_velocities();
+    a.sample(0.5);
+    b.sample(1.5);
+    let mut out = a.pose().clone();
+    for w in [
+        2e-40f32,
+        1e-38,
+        -2e-40,
+        tcb_runtime::blend::MIN_WEIGHT_SUM / 2.0,
+    ] {
+        blend(&mut out, &[(a.pose(), w), (b.pose(), 0.0)], None).unwrap();
+        assert_eq!(out.vec3(pos), a.pose().vec3(pos), "{w}");
+        assert_eq!(out.quat(rot), a.pose().quat(rot), "{w}");
+        assert_eq!(out.vec3_velocity(pos), a.pose().vec3_velocity(pos), "{w}");
+    }
+    let w = tcb_runtime::blend::MIN_WEIGHT_SUM;
+    blend(&mut out, &[(a.pose(), w), (b.pose(), w)], None).unwrap();
+    let mean = (a.pose().vec3(pos).unwrap() + b.pose().vec3(pos).unwrap()) / 2.0;
+    assert!((out.vec3(pos).unwrap() - mean).length() < 1e-5);
+    assert!(out.quat(rot).unwrap().is_finite());
+}

@@ -221,21 +221,21 @@ fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
     .unwrap();
     let scene = read(&glb);
     // The hierarchy is the skeleton's: same names, same parents.
-    assert_eq!(scene.names.len(), skeleton.joints.len());
-    for (j, joint) in skeleton.joints.iter().enumerate() {
+    assert_eq!(scene.names.len(), skeleton.joints().len());
+    for (j, joint) in skeleton.joints().iter().enumerate() {
         let node = scene.names.iter().position(|n| *n == joint.name).unwrap();
         let parent = scene.parent[node].map(|p| scene.names[p].as_str());
-        let want = joint.parent.map(|p| skeleton.joints[p].name.as_str());
+        let want = joint.parent.map(|p| skeleton.joints()[p].name.as_str());
         assert_eq!(parent, want, "parent of joint {j} ({})", joint.name);
     }
     let clip = Arc::new(Clip::compile(&loaded.clip));
     let binding = SkeletonBinding::new(skeleton.clone(), &clip);
     let mut instance = Instance::new(clip);
-    let n = skeleton.joints.len();
+    let n = skeleton.joints().len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];
     let nodes: Vec<usize> = skeleton
-        .joints
+        .joints()
         .iter()
         .map(|j| scene.names.iter().position(|n| *n == j.name).unwrap())
         .collect();
@@ -293,13 +293,13 @@ fn threejs_positions_match_skeleton_binding() {
     let clip = Arc::new(Clip::compile(&loaded.clip));
     let binding = SkeletonBinding::new(skeleton.clone(), &clip);
     let mut instance = Instance::new(clip);
-    let n = skeleton.joints.len();
+    let n = skeleton.joints().len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];
     let (mut worst, mut compared) = (0.0f64, 0);
     for (t, joints) in doc.as_object().unwrap() {
         binding.model_transforms(instance.sample(t.parse().unwrap()), &mut local, &mut model);
-        for (j, joint) in skeleton.joints.iter().enumerate() {
+        for (j, joint) in skeleton.joints().iter().enumerate() {
             let p = &joints[joint.name.as_str()];
             let theirs = DVec3::new(
                 p[0].as_f64().unwrap(),

@@ -17,7 +17,7 @@ fn cmu_model_space_positions_match_the_bvh() {
     let binding = SkeletonBinding::new(bvh.skeleton().clone(), &clip);
     assert_eq!(binding.animated_joints(), 31);
     let mut instance = Instance::new(clip);
-    let n = bvh.skeleton().joints.len();
+    let n = bvh.skeleton().joints().len();
     let mut local = vec![Default::default(); n];
     let mut model = vec![glam::Affine3A::IDENTITY; n];
     let mut want = vec![DAffine3::IDENTITY; n];
@@ -28,7 +28,7 @@ fn cmu_model_space_positions_match_the_bvh() {
             &mut local,
             &mut model,
         );
-        for (j, joint) in bvh.skeleton().joints.iter().enumerate() {
+        for (j, joint) in bvh.skeleton().joints().iter().enumerate() {
             let (t, q) = bvh.local(frame, j).expect("a frame and joint of the file");
             let m = DAffine3::from_rotation_translation(q, t);
             want[j] = joint.parent.map_or(m, |p| want[p] * m);
