@@ -65,7 +65,7 @@ pub struct Loaded {
 /// let path = "data/cmu-01_01.bvh"; // from the repository's root
 /// # */
 /// let loaded = tcb_io::load(path)?; // a &str, String, &Path or PathBuf
-/// assert_eq!(loaded.skeleton.unwrap().joints.len(), 31 + 7); // joints and End Sites
+/// assert_eq!(loaded.skeleton.unwrap().joints().len(), 31 + 7); // joints and End Sites
 /// assert_eq!(loaded.clip.tracks()[0].name, "Hips.translation");
 /// # Ok::<(), tcb_io::Error>(())
 /// ```

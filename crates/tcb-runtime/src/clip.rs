@@ -87,6 +87,8 @@ pub struct Clip {
     pub(crate) time_range: Option<(f64, f64)>,
     /// Per track: the bound on the error quantization adds (0 without).
     pub(crate) quant_error: Vec<f32>,
+    /// Per track: its keys are stored in 16 bits.
+    pub(crate) quantized: Vec<bool>,
     /// The packed clip it was compiled from (`crate::pack`), whose stream
     /// its group decodes.
     pub(crate) packed: Option<Arc<Packed>>,
@@ -133,6 +135,18 @@ impl Clip {
     pub fn quantization_error(&self, track: TrackId) -> Option<f32> {
         self.layout.slot(track)?;
         Some(self.quant_error.get(track.index).copied().unwrap_or(0.0))
+    }
+
+    /// Whether `track`'s keys are stored in 16 bits (`None` for a track of
+    /// another layout): false without [`CompileOptions::quantize`], and for
+    /// a track whose range 16 bits cannot span within a finite bound
+    /// (values or tangents beyond f32 in its keys), which quantizing keeps
+    /// in f32 (with its group).
+    ///
+    /// [`CompileOptions::quantize`]: crate::CompileOptions::quantize
+    pub fn is_quantized(&self, track: TrackId) -> Option<bool> {
+        self.layout.slot(track)?;
+        Some(self.quantized.get(track.index).copied().unwrap_or(false))
     }
 
     /// First and last key time over all tracks.

@@ -119,10 +119,12 @@ impl LooseLane {
     }
 
     /// Store the keys in 16 bits (as `crate::quant` does for groups) and
-    /// return, per component, the largest error made on `[P, TO, TI]`.
-    pub fn quantize(&mut self) -> Vec<[f32; KEY_STRIDE]> {
+    /// return, per component, the largest error made on `[P, TO, TI]`; or,
+    /// where a range or an error is not finite (values or tangents beyond
+    /// f32), keep them in f32 and return `None`.
+    pub fn quantize(&mut self) -> Option<Vec<[f32; KEY_STRIDE]>> {
         let Keys::F32(keys) = &self.keys else {
-            return vec![[0.0; KEY_STRIDE]; self.dim];
+            return Some(vec![[0.0; KEY_STRIDE]; self.dim]);
         };
         let dim = self.dim;
         let mut min = vec![[f32::INFINITY; KEY_STRIDE]; dim];
@@ -134,7 +136,7 @@ impl LooseLane {
             }
         }
         let scale: Vec<[f32; KEY_STRIDE]> = (0..dim)
-            .map(|c| std::array::from_fn(|j| (max[c][j] - min[c][j]) / 65535.0))
+            .map(|c| std::array::from_fn(|j| crate::quant::step_of(min[c][j], max[c][j])))
             .collect();
         let mut error = vec![[0.0f32; KEY_STRIDE]; dim];
         let q = keys
@@ -150,13 +152,17 @@ impl LooseLane {
                         0
                     };
                     let e = &mut error[c][j];
-                    *e = e.max((lo + f32::from(q) * s - k[j]).abs());
+                    *e = crate::quant::worse(*e, (lo + f32::from(q) * s - k[j]).abs());
                     q
                 })
             })
             .collect();
+        let finite = |v: &[[f32; KEY_STRIDE]]| v.iter().flatten().all(|x| x.is_finite());
+        if !(finite(&min) && finite(&scale) && finite(&error)) {
+            return None;
+        }
         self.keys = Keys::U16 { q, min, scale };
-        error
+        Some(error)
     }
 
     /// `[P0, P1, M0, M1]` of each component from keys `ka` and `kb` (see

@@ -26,6 +26,19 @@
 
 use wide::{f32x8, i32x8, u16x8};
 
+/// The 16-bit step of a range `lo ..= hi` (halved first: `hi - lo`
+/// overflows f32 for a range spanning it). One formula for groups and
+/// loose lanes.
+pub(crate) fn step_of(lo: f32, hi: f32) -> f32 {
+    (hi / 2.0 - lo / 2.0) / 32767.5
+}
+
+/// The larger of `e` and `x`, NaN kept (`f32::max` would drop it, and a
+/// lane whose error is NaN would claim none).
+pub(crate) fn worse(e: f32, x: f32) -> f32 {
+    if x.is_nan() || x > e { x } else { e }
+}
+
 /// What errors `[e_P, e_TO, e_TI]` in a segment's stored controls can move
 /// a sample inside it: `e_P + 4/27 (e_TO + e_TI)` (module docs).
 pub(crate) fn sample_bound(e: [f32; 3]) -> f32 {
@@ -49,8 +62,15 @@ impl Quantized {
     /// Quantize `packed` (the f32 layout of [`crate::store`]: key `k`'s
     /// `P` and `TO` from `at[k][0]`, its `TI` at `at[k][1]`, `planes`
     /// vectors each). Also returns, per control (`P`, `TO`, `TI`), plane
-    /// and lane, the largest error on any key.
-    pub fn new(packed: &[f32x8], at: &[[u32; 2]], planes: usize) -> (Self, [Vec<[f32; 8]>; 3]) {
+    /// and lane, the largest error on any key; `None` where some lane's
+    /// range or error is not finite (values or tangents beyond f32), so
+    /// that its group stays in f32 rather than state a bound it does not
+    /// keep.
+    pub fn new(
+        packed: &[f32x8],
+        at: &[[u32; 2]],
+        planes: usize,
+    ) -> Option<(Self, [Vec<[f32; 8]>; 3])> {
         // Section start of control j at key k.
         let start = |k: usize, j: usize| match j {
             0 => at[k][0] as usize,
@@ -72,10 +92,7 @@ impl Quantized {
                     }
                 }
                 min.push(f32x8::new(lo));
-                // Halved first: `hi - lo` overflows f32 for a range spanning it.
-                scale.push(f32x8::new(std::array::from_fn(|l| {
-                    (hi[l] / 2.0 - lo[l] / 2.0) / 32767.5
-                })));
+                scale.push(f32x8::new(std::array::from_fn(|l| step_of(lo[l], hi[l]))));
             }
         }
         let mut q = Quantized {
@@ -104,13 +121,15 @@ impl Quantized {
                     });
                     for (l, e) in error.iter_mut().enumerate() {
                         let back = lo[l] + f32::from(v[l]) * s[l];
-                        *e = e.max((back - x[l]).abs());
+                        *e = worse(*e, (back - x[l]).abs());
                     }
                     q.data[i] = u16x8::new(v);
                 }
             }
         }
-        (q, error)
+        let finite = |v: &[f32x8]| v.iter().all(|x| x.to_array().iter().all(|y| y.is_finite()));
+        let errors_finite = error.iter().flatten().flatten().all(|e| e.is_finite());
+        (finite(&q.min) && finite(&q.scale) && errors_finite).then_some((q, error))
     }
 
     /// Expand the section (`planes` vectors) starting at `at` into `out`:

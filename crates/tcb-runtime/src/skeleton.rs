@@ -22,7 +22,7 @@ use tcb_core::skeleton::{Skeleton, Transform};
 /// let clip = Arc::new(tcb_runtime::Clip::compile(&loaded.clip));
 /// let binding = tcb_runtime::SkeletonBinding::new(loaded.skeleton.unwrap(), &clip);
 /// let mut instance = tcb_runtime::Instance::new(clip);
-/// let mut local = vec![Default::default(); binding.skeleton().joints.len()];
+/// let mut local = vec![Default::default(); binding.skeleton().joints().len()];
 /// let mut model = vec![glam::Affine3A::IDENTITY; local.len()];
 /// binding.model_transforms(instance.sample(1.0), &mut local, &mut model);
 /// assert!(model.iter().all(|m| m.is_finite()));

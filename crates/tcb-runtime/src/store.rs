@@ -129,7 +129,16 @@ impl KeyStore {
             };
             return (store, None);
         }
-        let (q, error) = Quantized::new(&data, &at, planes);
+        let Some((q, error)) = Quantized::new(&data, &at, planes) else {
+            // A range 16 bits cannot span within a finite bound: kept in f32.
+            let store = KeyStore {
+                planes,
+                at,
+                data: Data::F32(data),
+                packed: None,
+            };
+            return (store, None);
+        };
         let store = KeyStore {
             planes,
             at,

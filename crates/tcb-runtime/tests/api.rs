@@ -215,10 +215,63 @@ fn quantizing_extreme_ranges() {
         &CompileOptions::default().quantize(true),
     ));
     let id = c.track("v").unwrap();
-    let mut i = Instance::new(c);
-    for t in [0.0, 0.5, 1.0] {
-        let p = i.sample(t);
-        assert!(p.vec3(id).is_some());
+    let plain = Arc::new(Clip::compile(&src));
+    keeps_its_bound(&c, &plain, id);
+}
+
+/// Issue 29, class 4: a quantized track samples within the bound it states
+/// (finite), or is kept in f32 and says so (`Clip::is_quantized`); a NaN or
+/// infinite bound is never dropped by a `max`.
+fn keeps_its_bound(q: &Arc<Clip>, plain: &Arc<Clip>, id: tcb_runtime::TrackId) {
+    let bound = q.quantization_error(id).unwrap();
+    assert!(bound.is_finite(), "stated bound {bound}");
+    let (mut a, mut b) = (Instance::new(q.clone()), Instance::new(plain.clone()));
+    for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
+        let (x, y) = (a.sample(t).vec3(id).unwrap(), b.sample(t).vec3(id).unwrap());
+        if !y.is_finite() {
+            continue; // tangents beyond f32 (max - min of two keys): no f32 value to keep
+        }
+        assert!(x.is_finite(), "at {t}: {x} (f32: {y})");
+        let off = (x - y).abs().max_element();
+        assert!(off <= bound * 1.0001, "at {t}: {off} off, bound {bound}");
+    }
+    if q.is_quantized(id) == Some(false) {
+        assert_eq!(bound, 0.0, "kept in f32: no quantization error");
+    }
+}
+
+/// Ranges beyond f32 on a loose lane and in a group: each track samples
+/// within its stated bound or is kept in f32.
+#[test]
+fn quantizing_ranges_beyond_f32() {
+    let times = vec![0.0, 0.25, 0.75, 1.0];
+    let track = |name: String, v: [f32; 4]| NamedTrack {
+        name,
+        data: TrackData::Vec3(
+            Track::new(
+                times.clone(),
+                v.map(Vec3::splat).to_vec(),
+                Vec::new(),
+                &TrackSettings::default(),
+            )
+            .expect("finite values"),
+        ),
+    };
+    // A range of 3.6e38 (beyond f32::MAX) whose chords and tangents are not.
+    let extreme = [-1.8e38, 0.0, 1.8e38, 1.8e38];
+    for others in [0, 3] {
+        // One track alone is a loose lane; with 3 more (12 channels) a group.
+        let mut tracks = vec![track("v".into(), extreme)];
+        tracks.extend((0..others).map(|i| track(format!("o{i}"), [0.0, 1.0, 2.0, 1.0])));
+        let src = tcb_core::Clip::new("q", tracks).expect("unique names");
+        let q = Arc::new(Clip::compile_with(
+            &src,
+            &CompileOptions::default().quantize(true),
+        ));
+        let plain = Arc::new(Clip::compile(&src));
+        for id in q.layout().ids() {
+            keeps_its_bound(&q, &plain, id);
+        }
     }
 }
 

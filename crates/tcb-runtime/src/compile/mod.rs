@@ -126,6 +126,7 @@ struct PoseBlocks {
 struct PerTrack {
     slots: Vec<TrackSlot>,
     quant_error: Vec<f32>,
+    quantized: Vec<bool>,
 }
 
 impl Clip {
@@ -194,6 +195,7 @@ pub(crate) fn compile_impl(
             })
             .collect(),
         quant_error: vec![0.0f32; source.tracks().len()],
+        quantized: vec![false; source.tracks().len()],
     };
     let mut blocks = PoseBlocks::default();
     let Grouping {
@@ -225,6 +227,7 @@ pub(crate) fn compile_impl(
         loose_rot_tracks,
         time_range: source.time_range(),
         quant_error: per_track.quant_error,
+        quantized: per_track.quantized,
         packed: None,
     }
 }
@@ -356,13 +359,7 @@ fn build_group(
     };
     let (keys, err) = pack_keys(&grid, vectors, rotations, vec_blocks, hq_blocks, options);
     if let Some(err) = err {
-        bound_quantization(
-            &err,
-            vectors,
-            rotations,
-            vec_blocks,
-            &mut per_track.quant_error,
-        );
+        bound_quantization(&err, vectors, rotations, vec_blocks, per_track);
     }
     let controls: Vec<&RotationControls> = rotations.iter().map(|r| &r.controls).collect();
     Group {
@@ -454,21 +451,23 @@ fn bound_quantization(
     vectors: &[VectorRow],
     rotations: &[RotationRow],
     vec_blocks: usize,
-    quant_error: &mut [f32],
+    per_track: &mut PerTrack,
 ) {
     let bound = |lane: usize, plane: usize| {
         quant::sample_bound(std::array::from_fn(|j| err[j][plane][lane % 8]))
     };
     for (lane, row) in vectors.iter().enumerate() {
-        let e = &mut quant_error[row.track];
-        *e = e.max(bound(lane, lane / 8));
+        let e = &mut per_track.quant_error[row.track];
+        *e = quant::worse(*e, bound(lane, lane / 8));
+        per_track.quantized[row.track] = true;
     }
     for (lane, row) in rotations.iter().enumerate() {
         let b = (0..4)
             .map(|c| bound(lane, vec_blocks + 4 * (lane / 8) + c))
-            .fold(0.0f32, f32::max);
-        let e = &mut quant_error[row.track];
-        *e = e.max(b * normalize_gain(&row.controls));
+            .fold(0.0f32, quant::worse);
+        let e = &mut per_track.quant_error[row.track];
+        *e = quant::worse(*e, b * normalize_gain(&row.controls));
+        per_track.quantized[row.track] = true;
     }
 }
 
@@ -484,13 +483,17 @@ fn build_loose(
     blocks: &mut PoseBlocks,
 ) -> (Loose, Loose, usize) {
     let mut quantize_lane = |track: usize, lane: &mut LooseLane, gain: f32| {
-        if options.quantize {
-            let bound = lane
-                .quantize()
+        if !options.quantize {
+            return;
+        }
+        // `None`: a range 16 bits cannot span, kept in f32 (no error).
+        if let Some(errors) = lane.quantize() {
+            let bound = errors
                 .into_iter()
                 .map(quant::sample_bound)
-                .fold(0.0f32, f32::max);
+                .fold(0.0f32, quant::worse);
             per_track.quant_error[track] = gain * bound;
+            per_track.quantized[track] = true;
         }
     };
     for (track, lane) in &mut loose.vectors {
