@@ -844,7 +844,12 @@ fn write_tracks(
             settings.pre.name(),
             settings.post.name()
         )?;
-        if quantize {
+        if quantize && runtime.is_quantized(id) == Some(false) {
+            writeln!(
+                out,
+                "    kept in f32: its keys span more than 16 bits can within a finite error"
+            )?;
+        } else if quantize {
             let e = runtime.quantization_error(id).unwrap_or(0.0);
             writeln!(out, "    quantization error at most {e:e}")?;
         }

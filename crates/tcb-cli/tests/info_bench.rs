@@ -123,3 +123,33 @@ fn bench_and_info_refuse_bad_input() {
         assert!(o.stdout.is_empty(), "{args:?} printed {}", stdout(&o));
     }
 }
+
+/// `tcb info --quantize` says which tracks it keeps in f32 (a range beyond
+/// what 16 bits span within a finite error) instead of stating a bound the
+/// 16-bit keys would not keep (issue 29, class 4).
+#[test]
+fn info_says_which_tracks_quantizing_keeps_in_f32() {
+    let dir = common::scratch("info-kept-f32");
+    let path = dir.join("wide-range.json");
+    std::fs::write(
+        &path,
+        r#"{"format": "tcb-clip/1", "tracks": [
+          {"name": "huge", "kind": "scalar", "times": [0, 0.25, 0.75, 1], "values": [-1.8e38, 0, 1.8e38, 1.8e38]},
+          {"name": "small", "kind": "scalar", "times": [0, 1], "values": [0, 1]}]}"#,
+    )
+    .unwrap();
+    let o = tcb(&["info", path.to_str().unwrap(), "--quantize"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert_eq!(out.matches("kept in f32").count(), 1, "{out}");
+    assert_eq!(
+        out.matches("quantization error at most").count(),
+        1,
+        "{out}"
+    );
+    let huge = out.find("huge").unwrap();
+    assert!(
+        out[huge..].find("kept in f32") < out[huge..].find("small"),
+        "{out}"
+    );
+}
