@@ -180,6 +180,8 @@ pub fn blend(
     layers: &[(&Pose, f32)],
     masks: Option<&[&BlendMask]>,
 ) -> Result<(), BlendError> {
+    // Hot (every frame of a blended character) and kept whole: its loops
+    // share the layers' weights and sums, which steps would pass around.
     let layout = out.layout.clone();
     if let Some(i) = (0..layers.len()).find(|&i| !same_layout(&layers[i].0.layout, &layout)) {
         return Err(BlendError::Layout { layer: i });

@@ -149,6 +149,8 @@ impl TimeGrid {
     /// kernels' loop needs (+1 instruction per block in `wide`).
     #[inline(never)]
     pub fn frame(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
+        // Hot (once per group per frame), kept whole: the fast path for a
+        // time inside the keys returns before the table's rows below.
         let n = self.times.len();
         let (t0, tn) = (self.times[0], self.times[n - 1]);
         // Most frames are inside the keys, where every mode passes the time

@@ -746,6 +746,8 @@ fn inside(eased: bool, half: &[Half; 2], rate: f32x8, time: f64) -> (f32x8, f32x
 /// time left their window.
 #[inline(never)]
 fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: bool) -> Rows {
+    // Hot (a block whose lanes left their keys, per frame), kept whole:
+    // two halves of 4 lanes in f64 feed one f32x8 row computation.
     let t = f64x4::splat(time);
     let zero = f64x4::ZERO;
     let one = f64x4::ONE;

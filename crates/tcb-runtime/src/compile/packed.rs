@@ -36,88 +36,12 @@ impl Clip {
     }
 
     /// [`from_packed`](Self::from_packed) of a clip whose structure and
-    /// head are checked.
+    /// head are checked: the end keys' reference compiled, its tables kept,
+    /// the grid made the clip's own.
     fn from_checked(packed: Arc<Packed>) -> Result<Clip, PackError> {
-        let head = packed.head();
-        let n = head.keys;
-        let at: Vec<usize> = if n <= 2 * END_KEYS {
-            (0..n).collect()
-        } else {
-            (0..END_KEYS).chain(n - END_KEYS..n).collect()
-        };
-        let ints = packed.decode_keys(&at)?;
-        let mut ends = head.clone();
-        let mut lanes = ints.into_iter();
-        for t in &mut ends.tracks {
-            t.values = lanes.by_ref().take(t.stored()).collect();
-        }
-        let times = head.times();
-        let end_times: Vec<f64> = at.iter().map(|&k| times[k]).collect();
-        let reference = ends.reference(&end_times)?;
-        let mut clip = compile_impl(&reference, &CompileOptions::default(), true);
-        if clip.groups.len() != 1 {
-            return err(format!(
-                "a packed clip compiles to one group, not {}",
-                clip.groups.len()
-            ));
-        }
-        let g = &clip.groups[0];
-        let (np, m) = (g.keys.planes(), at.len());
-        if !(g.grid.eases.is_empty() && g.grid.steps.is_empty() && g.exact.entries.is_empty()) {
-            return err("a packed clip's keys have no eases, steps or exact segments");
-        }
-        let mut lane_slot = Vec::with_capacity(head.lanes());
-        let mut step = vec![[0.0f32; 8]; np];
-        let mut weights = vec![[[0.0f32; 8]; 4]; np];
-        let mut rebuild = vec![[true; 8]; g.hq_blocks];
-        let rot_from = g.vec_blocks;
-        for (t, slot) in head.tracks.iter().zip(clip.layout.tracks()) {
-            // Every interior key's weights are key 1's (`PackSource::validate`).
-            let w = if n > 2 {
-                key_weights(&times, t, 1)
-            } else {
-                [0.0; 4]
-            };
-            for c in 0..t.kind.dim() {
-                let at = slot.index[c];
-                let (p, l) = (at / 8, at % 8);
-                if c < t.stored() {
-                    lane_slot.push(at as u32);
-                    step[p][l] = t.step;
-                }
-                for (j, wj) in w.iter().enumerate() {
-                    weights[p][j][l] = *wj;
-                }
-            }
-            if t.kind == TrackKind::Quat {
-                let at = slot.index[0];
-                let b = (at / 8 - rot_from) / 4;
-                rebuild[b][at % 8] = t.rebuild_w;
-            }
-        }
-        // The first and last keys, then the 4 sentinel pseudo-keys (see
-        // `crate::store::per_key`): what the decoder does not make.
-        let f32_key = |k: usize| g.keys.f32_key(k).expect("compiled in f32");
-        let mut table = Vec::with_capacity(18 * np);
-        for e in [0, m - 1, m, m + 1, m + 2, m + 3] {
-            for section in f32_key(e) {
-                table.extend_from_slice(section);
-            }
-        }
-        let keys = PackedKeys {
-            packed: packed.clone(),
-            keys: n,
-            planes: np,
-            lane_slot,
-            step: step.into_iter().map(f32x8::new).collect(),
-            weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
-            rot_from,
-            rebuild: rebuild
-                .into_iter()
-                .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))
-                .collect(),
-            table,
-        };
+        let times = packed.head().times();
+        let mut clip = compile_ends(&packed, &times)?;
+        let keys = packed_keys(&packed, &clip, &times);
         let g = &mut clip.groups[0];
         g.grid = TimeGrid {
             times,
@@ -216,5 +140,101 @@ impl Clip {
     pub fn from_bytes(bytes: &[u8]) -> Result<Clip, PackError> {
         // `read` checks the structure and the head.
         Clip::from_checked(Arc::new(Packed::read(bytes)?))
+    }
+}
+
+/// The reference of the stream's first and last `END_KEYS` keys (all of
+/// them for a short clip), at their real times, compiled into one group.
+fn compile_ends(packed: &Packed, times: &[f64]) -> Result<Clip, PackError> {
+    let head = packed.head();
+    let n = head.keys;
+    let at: Vec<usize> = if n <= 2 * END_KEYS {
+        (0..n).collect()
+    } else {
+        (0..END_KEYS).chain(n - END_KEYS..n).collect()
+    };
+    let ints = packed.decode_keys(&at)?;
+    let mut ends = head.clone();
+    let mut lanes = ints.into_iter();
+    for t in &mut ends.tracks {
+        t.values = lanes.by_ref().take(t.stored()).collect();
+    }
+    let end_times: Vec<f64> = at.iter().map(|&k| times[k]).collect();
+    let reference = ends.reference(&end_times)?;
+    let clip = compile_impl(&reference, &CompileOptions::default(), true);
+    if clip.groups.len() != 1 {
+        return err(format!(
+            "a packed clip compiles to one group, not {}",
+            clip.groups.len()
+        ));
+    }
+    let g = &clip.groups[0];
+    if !(g.grid.eases.is_empty() && g.grid.steps.is_empty() && g.exact.entries.is_empty()) {
+        return err("a packed clip's keys have no eases, steps or exact segments");
+    }
+    Ok(clip)
+}
+
+/// The decoder's tables for `clip`'s one group (compiled by
+/// [`compile_ends`]): per lane its slot, step and chord weights, the
+/// rotations whose `w` is rebuilt, and the controls no decoded key gives
+/// (keys 0 and n-1, the sentinels).
+fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
+    let head = packed.head();
+    let n = head.keys;
+    let g = &clip.groups[0];
+    let np = g.keys.planes();
+    let m = g.grid.times.len();
+    let mut lane_slot = Vec::with_capacity(head.lanes());
+    let mut step = vec![[0.0f32; 8]; np];
+    let mut weights = vec![[[0.0f32; 8]; 4]; np];
+    let mut rebuild = vec![[true; 8]; g.hq_blocks];
+    let rot_from = g.vec_blocks;
+    for (t, slot) in head.tracks.iter().zip(clip.layout.tracks()) {
+        // Every interior key's weights are key 1's (`PackSource::validate`).
+        let w = if n > 2 {
+            key_weights(times, t, 1)
+        } else {
+            [0.0; 4]
+        };
+        for c in 0..t.kind.dim() {
+            let at = slot.index[c];
+            let (p, l) = (at / 8, at % 8);
+            if c < t.stored() {
+                lane_slot.push(at as u32);
+                step[p][l] = t.step;
+            }
+            for (j, wj) in w.iter().enumerate() {
+                weights[p][j][l] = *wj;
+            }
+        }
+        if t.kind == TrackKind::Quat {
+            let at = slot.index[0];
+            let b = (at / 8 - rot_from) / 4;
+            rebuild[b][at % 8] = t.rebuild_w;
+        }
+    }
+    // The first and last keys, then the 4 sentinel pseudo-keys (see
+    // `crate::store::per_key`): what the decoder does not make.
+    let f32_key = |k: usize| g.keys.f32_key(k).expect("compiled in f32");
+    let mut table = Vec::with_capacity(18 * np);
+    for e in [0, m - 1, m, m + 1, m + 2, m + 3] {
+        for section in f32_key(e) {
+            table.extend_from_slice(section);
+        }
+    }
+    PackedKeys {
+        packed: packed.clone(),
+        keys: n,
+        planes: np,
+        lane_slot,
+        step: step.into_iter().map(f32x8::new).collect(),
+        weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
+        rot_from,
+        rebuild: rebuild
+            .into_iter()
+            .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))
+            .collect(),
+        table,
     }
 }

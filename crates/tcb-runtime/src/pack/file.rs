@@ -54,6 +54,49 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
+    /// Track `i`'s head: name, kind, settings, tension, continuity, bias,
+    /// step and whether `w` is rebuilt (its integers are the stream's).
+    fn track(&mut self, i: usize) -> Result<PackTrack, PackError> {
+        let r = self;
+        let name = r.str(&format!("track {i}'s name"))?;
+        let what = |f: &str| format!("track {name}: {f}");
+        let kind = r.pick(&KINDS, &what("kind"))?;
+        let tangent_rule = r.pick(TangentRule::ALL, &what("tangent rule"))?;
+        let ends = r.pick(Ends::ALL, &what("ends"))?;
+        let match_speed = r.pick(&[false, true], &what("match_speed"))?;
+        let continuity_fade = r.pick(&[false, true], &what("continuity_fade"))?;
+        let pre = r.pick(Extrapolation::ALL, &what("pre"))?;
+        let post = r.pick(Extrapolation::ALL, &what("post"))?;
+        let rotation = r.pick(RotationMode::ALL, &what("rotation mode"))?;
+        let hemisphere = r.pick(Hemisphere::ALL, &what("hemisphere"))?;
+        let rebuild_w = r.pick(&[false, true], &what("rebuild_w"))?;
+        let tcb = Tcb::new(
+            r.f64(&what("tension"))?,
+            r.f64(&what("continuity"))?,
+            r.f64(&what("bias"))?,
+        );
+        let step = r.f32(&what("step"))?;
+        let settings = TrackSettings {
+            tangent_rule,
+            ends,
+            match_speed,
+            continuity_fade,
+            pre,
+            post,
+            rotation,
+            hemisphere,
+        };
+        Ok(PackTrack {
+            name,
+            kind,
+            settings,
+            tcb,
+            step,
+            rebuild_w,
+            values: Vec::new(),
+        })
+    }
+
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], PackError> {
         let left = self.bytes.len() - self.at;
         if n > left {
@@ -170,27 +213,7 @@ impl Packed {
     /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
     /// decoding every key takes a few).
     pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
-        if bytes.len() < HEADER || bytes[..8] != MAGIC {
-            return err("not a .tcbc file (no TCBC magic number)");
-        }
-        let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-        if version != VERSION {
-            return err(format!(
-                ".tcbc version {version}; this build reads version {VERSION}"
-            ));
-        }
-        let total = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-        if total != bytes.len() as u64 {
-            return err(format!(
-                "truncated or padded: the header says {total} bytes, the file has {}",
-                bytes.len()
-            ));
-        }
-        let crc = u32::from_le_bytes(bytes[20..24].try_into().expect("4 bytes"));
-        let body = &bytes[HEADER..];
-        if crc32fast::hash(body) != crc {
-            return err("checksum mismatch: the file is corrupted");
-        }
+        let body = checked_body(bytes)?;
         let mut r = Reader { bytes: body, at: 0 };
         let name = r.str("the clip's name")?;
         let note = r.str("the note")?;
@@ -217,43 +240,7 @@ impl Packed {
         }
         let mut tracks = Vec::with_capacity(count);
         for i in 0..count {
-            let name = r.str(&format!("track {i}'s name"))?;
-            let what = |f: &str| format!("track {name}: {f}");
-            let kind = r.pick(&KINDS, &what("kind"))?;
-            let tangent_rule = r.pick(TangentRule::ALL, &what("tangent rule"))?;
-            let ends = r.pick(Ends::ALL, &what("ends"))?;
-            let match_speed = r.pick(&[false, true], &what("match_speed"))?;
-            let continuity_fade = r.pick(&[false, true], &what("continuity_fade"))?;
-            let pre = r.pick(Extrapolation::ALL, &what("pre"))?;
-            let post = r.pick(Extrapolation::ALL, &what("post"))?;
-            let rotation = r.pick(RotationMode::ALL, &what("rotation mode"))?;
-            let hemisphere = r.pick(Hemisphere::ALL, &what("hemisphere"))?;
-            let rebuild_w = r.pick(&[false, true], &what("rebuild_w"))?;
-            let tcb = Tcb::new(
-                r.f64(&what("tension"))?,
-                r.f64(&what("continuity"))?,
-                r.f64(&what("bias"))?,
-            );
-            let step = r.f32(&what("step"))?;
-            let settings = TrackSettings {
-                tangent_rule,
-                ends,
-                match_speed,
-                continuity_fade,
-                pre,
-                post,
-                rotation,
-                hemisphere,
-            };
-            tracks.push(PackTrack {
-                name,
-                kind,
-                settings,
-                tcb,
-                step,
-                rebuild_w,
-                values: Vec::new(),
-            });
+            tracks.push(r.track(i)?);
         }
         if tracks.is_empty() || keys.saturating_mul(count) > super::MAX_TRACK_KEYS {
             return err(format!(
@@ -314,4 +301,31 @@ impl Packed {
         packed.check_structure()?;
         Ok(packed)
     }
+}
+
+/// The body of `.tcbc` bytes after their header, once the magic number,
+/// version, length and checksum hold.
+fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
+    if bytes.len() < HEADER || bytes[..8] != MAGIC {
+        return err("not a .tcbc file (no TCBC magic number)");
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != VERSION {
+        return err(format!(
+            ".tcbc version {version}; this build reads version {VERSION}"
+        ));
+    }
+    let total = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+    if total != bytes.len() as u64 {
+        return err(format!(
+            "truncated or padded: the header says {total} bytes, the file has {}",
+            bytes.len()
+        ));
+    }
+    let crc = u32::from_le_bytes(bytes[20..24].try_into().expect("4 bytes"));
+    let body = &bytes[HEADER..];
+    if crc32fast::hash(body) != crc {
+        return err("checksum mismatch: the file is corrupted");
+    }
+    Ok(body)
 }
