@@ -77,10 +77,7 @@ pub fn run_extra(name: &str, bvh: &Path) -> Result<(), Box<dyn std::error::Error
     match name {
         "blend" => {
             let load = |mode| {
-                let options = tcb_io::ImportOptions {
-                    rotation: mode,
-                    ..Default::default()
-                };
+                let options = tcb_io::ImportOptions::default().rotation(mode);
                 tcb_io::load_with(bvh, &options)
             };
             let a = load(tcb_core::RotationMode::Hermite)?;

@@ -231,10 +231,7 @@ fn frames(end: f64, fps: f64) -> Vec<f64> {
 }
 
 fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::Clip, usize), tcb_io::Error> {
-    let options = tcb_io::ImportOptions {
-        rotation,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(rotation);
     let loaded = tcb_io::load_with(bvh, &options)?;
     let joints = animated_joints(&loaded);
     Ok((loaded.clip, joints))
@@ -320,16 +317,11 @@ pub fn character_compressed(bvh: &Path, acl: bool) -> Result<Scenario, tcb_io::E
 /// with `acl`), what the compressed scenarios play and `--icount` hands to
 /// the counted process as a file.
 pub fn compress_cmu(bvh: &Path, acl: bool) -> Result<tcb_runtime::Packed, tcb_io::Error> {
-    let options = tcb_io::ImportOptions {
-        rotation: RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(RotationMode::Hermite);
     let loaded = tcb_io::load_with(bvh, &options)?;
-    let options = tcb_fit::CompressOptions {
-        tolerance: acl.then_some(ACL_TARGET.0),
-        shell: acl.then_some(ACL_TARGET.1),
-        ..Default::default()
-    };
+    let options = tcb_fit::CompressOptions::default()
+        .tolerance(acl.then_some(ACL_TARGET.0))
+        .shell(acl.then_some(ACL_TARGET.1));
     let c = tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, &|_, _| {})
         .map_err(|e| tcb_io::Error::import(e.to_string()).in_file(bvh))?;
     Ok(c.packed)
@@ -374,10 +366,7 @@ pub fn reduced_doc(bvh: &Path) -> Result<tcb_io::ClipDoc, tcb_io::Error> {
 }
 
 fn reduce_cmu(bvh: &Path) -> Result<(tcb_io::Loaded, tcb_fit::Reduced), tcb_io::Error> {
-    let options = tcb_io::ImportOptions {
-        rotation: RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(RotationMode::Hermite);
     let loaded = tcb_io::load_with(bvh, &options)?;
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,

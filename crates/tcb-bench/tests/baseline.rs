@@ -19,10 +19,7 @@ fn clips() -> Vec<(String, tcb_core::Clip)> {
         }
     }
     for mode in [RotationMode::Squad, RotationMode::Hermite] {
-        let options = tcb_io::ImportOptions {
-            rotation: mode,
-            ..Default::default()
-        };
+        let options = tcb_io::ImportOptions::default().rotation(mode);
         let path = format!("{root}/data/cmu-01_01.bvh");
         out.push((
             format!("cmu {mode:?}"),
@@ -75,10 +72,7 @@ fn baseline_equals_the_reference() {
 #[test]
 fn splines_agree_on_even_keys_with_tcb_zero() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-    let options = tcb_io::ImportOptions {
-        rotation: RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(RotationMode::Hermite);
     let clip = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;

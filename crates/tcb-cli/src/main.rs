@@ -52,10 +52,8 @@ fn load(path: &std::path::Path) -> Result<tcb_io::Loaded, tcb_io::Error> {
 }
 
 fn import_options_plain() -> tcb_io::ImportOptions {
-    tcb_io::ImportOptions {
-        allow_outside_paths: ALLOW_OUTSIDE_PATHS.load(std::sync::atomic::Ordering::Relaxed),
-        ..Default::default()
-    }
+    tcb_io::ImportOptions::default()
+        .allow_outside_paths(ALLOW_OUTSIDE_PATHS.load(std::sync::atomic::Ordering::Relaxed))
 }
 
 #[derive(Subcommand)]
@@ -395,11 +393,9 @@ fn import_options(
         }
         _ => {}
     }
-    Ok(tcb_io::ImportOptions {
-        rotation: rotation.unwrap_or_default(),
-        animation: animation.cloned(),
-        ..import_options_plain()
-    })
+    Ok(import_options_plain()
+        .rotation(rotation.unwrap_or_default())
+        .animation(animation.cloned()))
 }
 
 fn import(args: &ImportArgs) -> Result<(), BoxError> {
@@ -440,10 +436,9 @@ fn export(args: &ExportArgs) -> Result<(), BoxError> {
     }
     let rename = renames(&args.rename)?;
     let (clip, skeleton) = load_any(&args.clip, &import_options_plain())?;
-    let options = tcb_io::gltf_export::ExportOptions {
-        max_error: args.max_error,
-        rename,
-    };
+    let options = tcb_io::gltf_export::ExportOptions::default()
+        .max_error(args.max_error)
+        .rename(rename);
     let report =
         tcb_io::gltf_export::export_file(&clip, skeleton.as_ref(), &args.output, &options)?;
     warn(&report.notes);
@@ -540,13 +535,12 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
         .rotation
         .or((extension(&args.input) == "bvh").then_some(tcb_core::RotationMode::Hermite));
     let loaded = load_input(&args.input, rotation, args.animation.as_ref())?;
-    let options = tcb_fit::CompressOptions {
-        tolerance: args.error.tolerance,
-        shell: args.error.shell,
-        metric: args.error.metric,
-        rotation_tolerance: args.error.rotation_tolerance,
-        seek_keys: Some(args.seek_keys),
-    };
+    let options = tcb_fit::CompressOptions::default()
+        .tolerance(args.error.tolerance)
+        .shell(args.error.shell)
+        .metric(args.error.metric)
+        .rotation_tolerance(args.error.rotation_tolerance)
+        .seek_keys(Some(args.seek_keys));
     let c = with_progress("tcb: measuring {bar:30} {pos}/{len} clips", |progress| {
         tcb_fit::compress(&loaded.clip, loaded.skeleton.as_ref(), &options, progress)
     })?;
@@ -667,14 +661,13 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
     output_folder_exists(&args.output)?;
     let started = std::time::Instant::now();
     let loaded = load_input(&args.input, args.rotation, args.animation.as_ref())?;
-    let options = tcb_fit::ReduceOptions {
-        tolerance: args.error.tolerance,
-        shell: args.error.shell,
-        metric: args.error.metric,
-        rotation_tolerance: args.error.rotation_tolerance,
-        knots: args.knots,
-        tangents: args.tangents,
-    };
+    let options = tcb_fit::ReduceOptions::default()
+        .tolerance(args.error.tolerance)
+        .shell(args.error.shell)
+        .metric(args.error.metric)
+        .rotation_tolerance(args.error.rotation_tolerance)
+        .knots(args.knots)
+        .tangents(args.tangents);
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,

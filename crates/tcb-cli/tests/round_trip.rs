@@ -40,12 +40,9 @@ fn difference(read: &tcb_io::ClipDoc, written: &tcb_io::ClipDoc) -> Option<Strin
 fn a_reduced_clip_written_then_read_is_the_clip_verified() {
     let input = short_cmu(400);
     let loaded = tcb_io::load(&input).unwrap();
-    let options = tcb_fit::ReduceOptions {
-        // Tight: most frames stay keys, among them frame times that a
-        // reader that is not round-trip exact misreads.
-        tolerance: Some(0.005),
-        ..Default::default()
-    };
+    // Tight: most frames stay keys, among them frame times that a
+    // reader that is not round-trip exact misreads.
+    let options = tcb_fit::ReduceOptions::default().tolerance(Some(0.005));
     let reduced = tcb_fit::reduce(
         tcb_fit::reduce::Input {
             doc: &loaded.doc,

@@ -28,7 +28,30 @@ use tcb_core::{Clip, TrackKind};
 use tcb_runtime::{KeyValues, Packed};
 
 /// Options of [`compress`]; `None` takes the contract's default.
+///
+/// Start from [`Default`] and set fields with the builder methods, so that
+/// a field added later does not break the code that builds these:
+///
+/// ```
+/// use tcb_fit::CompressOptions;
+/// let options = CompressOptions::default()
+///     .tolerance(Some(0.01))
+///     .seek_keys(Some(16));
+/// assert_eq!(options.tolerance, Some(0.01));
+/// assert_eq!(options.seek_keys, Some(16));
+/// ```
+///
+/// The struct is `#[non_exhaustive]`: a struct literal does not compile
+/// outside this crate.
+///
+/// ```compile_fail
+/// let options = tcb_fit::CompressOptions {
+///     tolerance: Some(0.01),
+///     ..Default::default()
+/// };
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct CompressOptions {
     /// `--tolerance E`.
     pub tolerance: Option<f64>,
@@ -41,6 +64,43 @@ pub struct CompressOptions {
     /// `--seek-keys N`: keys per block (a seek decodes up to N - 1 keys);
     /// default [`tcb_runtime::pack::BLOCK_KEYS`].
     pub seek_keys: Option<usize>,
+}
+
+impl CompressOptions {
+    /// These options with [`tolerance`](Self::tolerance) set to `tolerance` (`None`: the default).
+    #[must_use]
+    pub fn tolerance(mut self, tolerance: Option<f64>) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// These options with [`shell`](Self::shell) set to `radius` (`None`: the default).
+    #[must_use]
+    pub fn shell(mut self, radius: Option<f64>) -> Self {
+        self.shell = radius;
+        self
+    }
+
+    /// These options with [`metric`](Self::metric) set to `metric` (`None`: the default).
+    #[must_use]
+    pub fn metric(mut self, metric: Option<Metric>) -> Self {
+        self.metric = metric;
+        self
+    }
+
+    /// These options with [`rotation_tolerance`](Self::rotation_tolerance) set to `degrees` (`None`: the default).
+    #[must_use]
+    pub fn rotation_tolerance(mut self, degrees: Option<f64>) -> Self {
+        self.rotation_tolerance = degrees;
+        self
+    }
+
+    /// These options with [`seek_keys`](Self::seek_keys) set to `keys` (`None`: the default).
+    #[must_use]
+    pub fn seek_keys(mut self, keys: Option<usize>) -> Self {
+        self.seek_keys = keys;
+        self
+    }
 }
 
 /// The packed clip and what was measured.

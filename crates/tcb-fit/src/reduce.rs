@@ -116,7 +116,31 @@ impl FromStr for Knots {
 }
 
 /// Options of [`reduce`]; `None` takes the contract's default.
+///
+/// Start from [`Default`] and set fields with the builder methods, so that
+/// a field added later does not break the code that builds these:
+///
+/// ```
+/// use tcb_fit::{Knots, Metric, ReduceOptions};
+/// let options = ReduceOptions::default()
+///     .tolerance(Some(0.01))
+///     .metric(Some(Metric::Value))
+///     .knots(Knots::Clip);
+/// assert_eq!(options.tolerance, Some(0.01));
+/// assert_eq!(options.knots, Knots::Clip);
+/// ```
+///
+/// The struct is `#[non_exhaustive]`: a struct literal does not compile
+/// outside this crate.
+///
+/// ```compile_fail
+/// let options = tcb_fit::ReduceOptions {
+///     tolerance: Some(0.01),
+///     ..Default::default()
+/// };
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct ReduceOptions {
     /// `--tolerance E` (model-space distance for `shell`, track units for `value`).
     pub tolerance: Option<f64>,
@@ -130,6 +154,50 @@ pub struct ReduceOptions {
     pub knots: Knots,
     /// Stored or derived tangents (`--tangents`).
     pub tangents: Tangents,
+}
+
+impl ReduceOptions {
+    /// These options with [`tolerance`](Self::tolerance) set to `tolerance` (`None`: the default).
+    #[must_use]
+    pub fn tolerance(mut self, tolerance: Option<f64>) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// These options with [`shell`](Self::shell) set to `radius` (`None`: the default).
+    #[must_use]
+    pub fn shell(mut self, radius: Option<f64>) -> Self {
+        self.shell = radius;
+        self
+    }
+
+    /// These options with [`metric`](Self::metric) set to `metric` (`None`: the default).
+    #[must_use]
+    pub fn metric(mut self, metric: Option<Metric>) -> Self {
+        self.metric = metric;
+        self
+    }
+
+    /// These options with [`rotation_tolerance`](Self::rotation_tolerance) set to `degrees` (`None`: the default).
+    #[must_use]
+    pub fn rotation_tolerance(mut self, degrees: Option<f64>) -> Self {
+        self.rotation_tolerance = degrees;
+        self
+    }
+
+    /// These options with [`knots`](Self::knots) set to `knots`.
+    #[must_use]
+    pub fn knots(mut self, knots: Knots) -> Self {
+        self.knots = knots;
+        self
+    }
+
+    /// These options with [`tangents`](Self::tangents) set to `tangents`.
+    #[must_use]
+    pub fn tangents(mut self, tangents: Tangents) -> Self {
+        self.tangents = tangents;
+        self
+    }
 }
 
 /// What [`reduce`] reads.

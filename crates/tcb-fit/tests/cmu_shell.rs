@@ -161,12 +161,10 @@ fn reduced_cmu_is_within_the_shell_tolerance_at_three_tolerances() {
     let h = rest_height(&rig);
     let (default_e, radius) = (6e-5 * h, 0.018 * h);
     for scale in [1.0, 10.0, 0.1] {
-        let options = ReduceOptions {
-            tolerance: (scale != 1.0).then_some(scale * default_e),
-            knots: Knots::Track,
-            tangents: Tangents::Derived,
-            ..ReduceOptions::default()
-        };
+        let options = ReduceOptions::default()
+            .tolerance((scale != 1.0).then_some(scale * default_e))
+            .knots(Knots::Track)
+            .tangents(Tangents::Derived);
         let input = tcb_fit::reduce::Input {
             doc: &loaded.doc,
             clip: &loaded.clip,

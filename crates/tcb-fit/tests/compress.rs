@@ -6,10 +6,7 @@ use tcb_fit::CompressOptions;
 const BVH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
 
 fn cmu() -> tcb_io::Loaded {
-    let options = tcb_io::ImportOptions {
-        rotation: RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(RotationMode::Hermite);
     tcb_io::load_with(BVH, &options).unwrap()
 }
 

@@ -165,20 +165,22 @@ pub fn reduce(data: &[u8]) {
             _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
         }
     };
-    let options = ReduceOptions {
-        tolerance: number(&mut u),
-        shell: number(&mut u),
-        metric: *u
-            .choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
-            .unwrap_or(&None),
-        rotation_tolerance: number(&mut u),
-        knots: *u
-            .choose(&[Knots::Track, Knots::Joint, Knots::Clip])
-            .unwrap_or(&Knots::Track),
-        tangents: *u
-            .choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
-            .unwrap_or(&Tangents::Best),
-    };
+    let options = ReduceOptions::default()
+        .tolerance(number(&mut u))
+        .shell(number(&mut u))
+        .metric(
+            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
+                .unwrap_or(&None),
+        )
+        .rotation_tolerance(number(&mut u))
+        .knots(
+            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
+                .unwrap_or(&Knots::Track),
+        )
+        .tangents(
+            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
+                .unwrap_or(&Tangents::Best),
+        );
     let input = tcb_fit::reduce::Input {
         doc: &doc,
         clip: &clip,

@@ -12,7 +12,29 @@ use tcb_core::RotationMode;
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 1 << 30;
 
 /// Choices for importing other formats (see [`load_with`](crate::load_with)).
+///
+/// Start from [`Default`] and set fields with the builder methods, so that
+/// a field added later does not break the code that builds these:
+///
+/// ```
+/// let options = tcb_io::ImportOptions::default()
+///     .animation(Some("walk".to_string()))
+///     .allow_outside_paths(true);
+/// assert_eq!(options.animation.as_deref(), Some("walk"));
+/// assert!(options.allow_outside_paths);
+/// ```
+///
+/// The struct is `#[non_exhaustive]`: a struct literal does not compile
+/// outside this crate.
+///
+/// ```compile_fail
+/// let options = tcb_io::ImportOptions {
+///     allow_outside_paths: true,
+///     ..Default::default()
+/// };
+/// ```
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct ImportOptions {
     /// Rotation mode of BVH rotation tracks (default `squad`).
     pub rotation: RotationMode,
@@ -34,6 +56,36 @@ impl Default for ImportOptions {
             max_file_bytes: DEFAULT_MAX_FILE_BYTES,
             allow_outside_paths: false,
         }
+    }
+}
+
+impl ImportOptions {
+    /// These options with [`rotation`](Self::rotation) set to `mode`.
+    #[must_use]
+    pub fn rotation(mut self, mode: RotationMode) -> Self {
+        self.rotation = mode;
+        self
+    }
+
+    /// These options with [`animation`](Self::animation) set to `name` (`None`: the first).
+    #[must_use]
+    pub fn animation(mut self, name: Option<String>) -> Self {
+        self.animation = name;
+        self
+    }
+
+    /// These options with [`max_file_bytes`](Self::max_file_bytes) set to `bytes`.
+    #[must_use]
+    pub fn max_file_bytes(mut self, bytes: u64) -> Self {
+        self.max_file_bytes = bytes;
+        self
+    }
+
+    /// These options with [`allow_outside_paths`](Self::allow_outside_paths) set to `on`.
+    #[must_use]
+    pub fn allow_outside_paths(mut self, on: bool) -> Self {
+        self.allow_outside_paths = on;
+        self
     }
 }
 

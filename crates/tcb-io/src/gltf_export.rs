@@ -381,7 +381,30 @@ fn target(name: &str, data: &TrackData) -> Result<(String, &'static str, usize),
 }
 
 /// Choices for [`export`].
+///
+/// Start from [`Default`] and set fields with the builder methods, so that
+/// a field added later does not break the code that builds these:
+///
+/// ```
+/// use tcb_io::gltf_export::ExportOptions;
+/// let options = ExportOptions::default()
+///     .max_error(1e-4)
+///     .rename(vec![("ball.position".into(), "ball.translation".into())]);
+/// assert_eq!(options.max_error, 1e-4);
+/// assert_eq!(options.rename.len(), 1);
+/// ```
+///
+/// The struct is `#[non_exhaustive]`: a struct literal does not compile
+/// outside this crate.
+///
+/// ```compile_fail
+/// let options = tcb_io::gltf_export::ExportOptions {
+///     max_error: 1e-4,
+///     ..Default::default()
+/// };
+/// ```
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct ExportOptions {
     /// Largest error allowed where a curve must be resampled (relative to
     /// max(1, |value|)); default 1e-5.
@@ -397,6 +420,22 @@ impl Default for ExportOptions {
             max_error: 1e-5,
             rename: Vec::new(),
         }
+    }
+}
+
+impl ExportOptions {
+    /// These options with [`max_error`](Self::max_error) set to `error`.
+    #[must_use]
+    pub fn max_error(mut self, error: f64) -> Self {
+        self.max_error = error;
+        self
+    }
+
+    /// These options with [`rename`](Self::rename) set to `renames`, `(from, to)`.
+    #[must_use]
+    pub fn rename(mut self, renames: Vec<(String, String)>) -> Self {
+        self.rename = renames;
+        self
     }
 }
 

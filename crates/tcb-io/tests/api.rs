@@ -131,19 +131,16 @@ fn options_out_of_range() {
     };
     let clip = doc.build().unwrap();
     for max_error in [f64::NAN, -1.0, 0.0, f64::INFINITY] {
-        let options = ExportOptions {
-            max_error,
-            rename: vec![("t".into(), "t".into()), ("u".into(), "t".into())],
-        };
+        let options = ExportOptions::default()
+            .max_error(max_error)
+            .rename(vec![("t".into(), "t".into()), ("u".into(), "t".into())]);
         for container in [Container::Gltf, Container::Glb] {
             let _ = export(&clip, None, container, &options);
         }
     }
-    let options = ImportOptions {
-        max_file_bytes: 0,
-        animation: Some("no such animation".into()),
-        ..ImportOptions::default()
-    };
+    let options = ImportOptions::default()
+        .max_file_bytes(0)
+        .animation(Some("no such animation".into()));
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
     for file in ["simple_skin.gltf", "cmu-01_01.bvh"] {
         let err = tcb_io::load_with(data.join(file), &options)
@@ -153,10 +150,7 @@ fn options_out_of_range() {
     }
     let err = tcb_io::load_with(
         data.join("simple_skin.gltf"),
-        &ImportOptions {
-            animation: Some("no such animation".into()),
-            ..ImportOptions::default()
-        },
+        &ImportOptions::default().animation(Some("no such animation".into())),
     )
     .unwrap_err()
     .to_string();

@@ -74,10 +74,7 @@ fn cmu_every_frame_reproduced() {
         let text = std::fs::read_to_string(&path).unwrap();
         let (joints, rows, dt) = raw(&text);
         assert_eq!(rows.len(), 2752);
-        let options = ImportOptions {
-            rotation: mode,
-            ..Default::default()
-        };
+        let options = ImportOptions::default().rotation(mode);
         let loaded = load_with(&path, &options).unwrap();
         assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
         let clip = &loaded.clip;
@@ -292,10 +289,7 @@ fn files_above_the_size_limit_are_refused_unread() {
             text.contains("2147483648 bytes; files above 1073741824 bytes are refused"),
             "{text}"
         );
-        let small = ImportOptions {
-            max_file_bytes: 1000,
-            ..Default::default()
-        };
+        let small = ImportOptions::default().max_file_bytes(1000);
         std::fs::write(&path, vec![b' '; 2000]).unwrap();
         let e = load_with(&path, &small).expect_err("refused");
         assert!(e.to_string().contains("files above 1000 bytes"), "{e}");

@@ -20,10 +20,7 @@ fn round_trip(
     container: Container,
     max_error: f64,
 ) -> (tcb_core::Clip, tcb_io::gltf_export::ExportReport) {
-    let options = tcb_io::gltf_export::ExportOptions {
-        max_error,
-        ..Default::default()
-    };
+    let options = tcb_io::gltf_export::ExportOptions::default().max_error(max_error);
     let (bytes, report) = export(clip, None, container, &options).unwrap();
     let back = import(&bytes, None, None, "rt").unwrap();
     (back.doc.build().unwrap(), report)
@@ -116,10 +113,7 @@ fn exact_tracks_round_trip_and_resampled_ones_hold_their_bound() {
 #[test]
 fn cmu_hermite_round_trips_as_it_is_and_within_its_report() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
-    let options = tcb_io::ImportOptions {
-        rotation: tcb_core::RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
     let clip = tcb_io::load_with(path, &options).unwrap().clip;
     let (back, report) = round_trip(&clip, Container::Glb, 1e-5);
     // Every curve is written as it is; the frame times (k * 0.0083333) are

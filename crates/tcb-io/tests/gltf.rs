@@ -398,10 +398,7 @@ fn buffer_uris_stay_inside_the_assets_folder() {
     let load = |name: &str, uri: &str, allow: bool| {
         let path = asset.join(name);
         std::fs::write(&path, with_uri(uri)).unwrap();
-        let options = tcb_io::ImportOptions {
-            allow_outside_paths: allow,
-            ..Default::default()
-        };
+        let options = tcb_io::ImportOptions::default().allow_outside_paths(allow);
         tcb_io::load_with(&path, &options)
             .map(|_| ())
             .map_err(|e| e.to_string())

@@ -200,10 +200,7 @@ fn benches(c: &mut Criterion) {
 /// (`packed/f32`).
 fn packed(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
-    let options = tcb_io::ImportOptions {
-        rotation: RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(RotationMode::Hermite);
     let clip = tcb_io::load_with(path, &options).unwrap().clip;
     let steps = vec![1.0 / 4096.0; clip.tracks().len()];
     let source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();

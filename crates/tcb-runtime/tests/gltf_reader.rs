@@ -196,10 +196,7 @@ impl Scene {
 /// The bundled CMU clip, rotations in `mode`.
 fn load_cmu(mode: tcb_core::RotationMode) -> tcb_io::Loaded {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
-    let options = tcb_io::ImportOptions {
-        rotation: mode,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(mode);
     tcb_io::load_with(std::path::Path::new(path), &options).unwrap()
 }
 
@@ -208,10 +205,7 @@ fn load_cmu(mode: tcb_core::RotationMode) -> tcb_io::Loaded {
 fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
     let loaded = load_cmu(mode);
     let skeleton = loaded.skeleton.clone().expect("BVH has a skeleton");
-    let export = tcb_io::gltf_export::ExportOptions {
-        max_error,
-        ..Default::default()
-    };
+    let export = tcb_io::gltf_export::ExportOptions::default().max_error(max_error);
     let (glb, _) = tcb_io::gltf_export::export(
         &loaded.clip,
         Some(&skeleton),

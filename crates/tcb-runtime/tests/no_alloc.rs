@@ -66,10 +66,7 @@ fn steady_playback_and_blending_allocate_nothing() {
         clips.push(Arc::new(tcb_runtime::Clip::compile_with(&clip, &quantize)));
     }
     // A packed clip (decoded as playback crosses keys, seeks included).
-    let options = tcb_io::ImportOptions {
-        rotation: tcb_core::RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
     let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;
@@ -143,10 +140,7 @@ fn steady_playback_and_blending_allocate_nothing() {
 #[test]
 fn loading_a_packed_clip_allocates_no_keys() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-    let options = tcb_io::ImportOptions {
-        rotation: tcb_core::RotationMode::Hermite,
-        ..Default::default()
-    };
+    let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
     let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
         .unwrap()
         .clip;
