@@ -60,13 +60,12 @@ impl Group {
         values: &mut [f32x8],
         velocities: Option<&mut [f32x8]>,
     ) {
-        let f = self.grid.frame(time, cursor);
-        let (ka, kb) = self.grid.key_pair(f.segment);
         let Some((keys, state)) = self.keys.packed(cache) else {
             unreachable!("every group of a packed clip is packed")
         };
-        let controls = keys.segment(ka, kb, state);
-        sample_segment(self, f, controls, values, velocities);
+        let f = self.grid.frame(time, cursor);
+        let (ka, kb) = self.grid.key_pair(f.segment);
+        sample_segment(self, f, keys.segment(ka, kb, state), values, velocities);
     }
 }
 

@@ -120,17 +120,14 @@ impl KeyStore {
             };
             at.push([offset(start), offset(ti_at)]);
         }
-        if !quantize {
-            let store = KeyStore {
-                planes,
-                at,
-                data: Data::F32(data),
-                packed: None,
-            };
-            return (store, None);
-        }
-        let Some((q, error)) = Quantized::new(&data, &at, planes) else {
-            // A range 16 bits cannot span within a finite bound: kept in f32.
+        // Quantized unless asked not to, or where a range 16 bits cannot
+        // span within a finite bound (then kept in f32).
+        let quantized = if quantize {
+            Quantized::new(&data, &at, planes)
+        } else {
+            None
+        };
+        let Some((q, error)) = quantized else {
             let store = KeyStore {
                 planes,
                 at,
