@@ -74,11 +74,11 @@ impl PackedKeys {
             next: 0,
             first: 0,
             reads: vec![LaneRead::default(); lanes],
-            res: vec![0; SEGMENT_KEYS * 8 * self.planes],
+            res: vec![i32x8::ZERO; SEGMENT_KEYS * self.planes],
             trend: vec![i32x8::ZERO; self.planes],
             abs: vec![0; lanes],
             delta: vec![0; lanes],
-            flat: vec![0; 8 * self.planes],
+            flat: vec![i32x8::ZERO; self.planes],
             x0: vec![i32x8::ZERO; self.planes],
             x1: vec![i32x8::ZERO; self.planes],
             p: vec![f32x8::ZERO; 4 * self.planes],
@@ -159,8 +159,8 @@ pub(crate) struct PackCache {
     /// Per stream lane: its plane slot and this segment's width.
     reads: Vec<LaneRead>,
     /// This segment's residuals, zigzag-coded: per key of the segment, per
-    /// plane lane (a key's row is contiguous, in the group's planes).
-    res: Vec<i32>,
+    /// plane (a key's row is contiguous, in the group's planes).
+    res: Vec<i32x8>,
     /// Per plane: all ones in lanes predicted by the line through their
     /// last two values (order 2), zeros in lanes predicted by the last.
     trend: Vec<i32x8>,
@@ -168,7 +168,7 @@ pub(crate) struct PackCache {
     abs: Vec<i32>,
     delta: Vec<i32>,
     /// Integers of one key in the group's planes (scratch).
-    flat: Vec<i32>,
+    flat: Vec<i32x8>,
     /// The predictor: the last two keys' integers, per plane.
     x0: Vec<i32x8>,
     x1: Vec<i32x8>,
@@ -210,40 +210,41 @@ impl PackCache {
         if k.is_multiple_of(SEGMENT_KEYS) {
             self.enter_segment(g, k, in_block == 0);
         }
-        // This key's integers (block start, delta, or residual) per plane.
-        let flat = &mut self.flat;
-        let ints: &[i32] = match in_block {
-            0 => {
-                scatter(&g.lane_slot, &self.abs, flat);
-                flat
-            }
-            1 => {
-                scatter(&g.lane_slot, &self.delta, flat);
-                flat
-            }
-            _ => {
-                // The key's row of residuals, unzigzagged below.
-                let row = (k % SEGMENT_KEYS) * 8 * np;
-                &self.res[row..row + 8 * np]
-            }
-        };
         let ring = (k & 3) * np;
-        let (x0, x1) = (&mut self.x0, &mut self.x1);
-        let planes = ints.chunks_exact(8).zip(x0.iter_mut().zip(x1.iter_mut()));
-        let lanes = planes.zip(&g.step).zip(&self.trend);
-        for ((((r, (x0, x1)), step), trend), out) in lanes.zip(&mut self.p[ring..ring + np]) {
-            let r = i32x8::new(r.try_into().expect("8 lanes"));
-            let x = match in_block {
-                0 => r,
-                1 => *x1 + r,
-                // Unzigzag (widths below 32: the shift's sign bit is 0).
-                _ => *x1 + ((*x1 - *x0) & *trend) + ((r >> 1) ^ (i32x8::ZERO - (r & 1))),
+        let out = &mut self.p[ring..ring + np];
+        let (x0, x1) = (&mut self.x0[..np], &mut self.x1[..np]);
+        let step = &g.step[..np];
+        if in_block < 2 {
+            // The block's start values, then its deltas.
+            let from = if in_block == 0 {
+                &self.abs
+            } else {
+                &self.delta
             };
-            *x0 = *x1;
-            *x1 = x;
-            *out = super::dequantize_lanes(x, *step);
+            scatter(&g.lane_slot, from, bytemuck::cast_slice_mut(&mut self.flat));
+            let start = i32x8::splat(-i32::from(in_block == 0));
+            for p in 0..np {
+                let x = (x1[p] & !start) + self.flat[p];
+                x0[p] = x1[p];
+                x1[p] = x;
+                out[p] = super::dequantize_lanes(x, step[p]);
+            }
+        } else {
+            // The key's row of residuals: the prediction (the last value,
+            // plus the last difference where the order is 2) plus the
+            // unzigzagged residual (widths below 32: the shift's sign bit
+            // is 0).
+            let row = &self.res[(k % SEGMENT_KEYS) * np..][..np];
+            let trend = &self.trend[..np];
+            for p in 0..np {
+                let (a, b, r) = (x0[p], x1[p], row[p]);
+                let x = b + ((b - a) & trend[p]) + ((r >> 1) ^ (i32x8::ZERO - (r & 1)));
+                x0[p] = b;
+                x1[p] = x;
+                out[p] = super::dequantize_lanes(x, step[p]);
+            }
         }
-        let rot = &mut self.p[ring + g.rot_from..ring + np];
+        let rot = &mut out[g.rot_from..];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
             let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
             block[3] = (*mask & w) | (!*mask & block[3]);
@@ -258,7 +259,7 @@ impl PackCache {
     fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
         let s: &[u64] = &g.packed.stream;
         let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
-        let flat = &mut self.flat;
+        let flat: &mut [i32] = bytemuck::cast_slice_mut(&mut self.flat);
         for (r, &slot) in self.reads.iter_mut().zip(&g.lane_slot) {
             let before = if block { 0 } else { r.width };
             let (order, w, used) = read_header(s, pos, before);
@@ -266,9 +267,7 @@ impl PackCache {
             *r = LaneRead { slot, width: w };
             flat[slot as usize] = if order == 2 { -1 } else { 0 };
         }
-        for (m, f) in self.trend.iter_mut().zip(flat.chunks_exact(8)) {
-            *m = i32x8::new(f.try_into().expect("8 lanes"));
-        }
+        self.trend.copy_from_slice(&self.flat);
         if block {
             for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
                 *x = unzigzag(read_bits(s, pos, u32::from(w)));
@@ -287,7 +286,7 @@ impl PackCache {
             pos,
             &self.reads,
             first..end - k,
-            &mut self.res,
+            bytemuck::cast_slice_mut(&mut self.res),
             8 * g.planes,
         );
     }
@@ -309,32 +308,47 @@ fn read_segment(
     stride: usize,
 ) {
     let count = rows.len();
+    if count == 0 {
+        return;
+    }
     for r in reads {
         let (w, slot) = (r.width as usize, r.slot as usize);
         let first = rows.start * stride + slot;
         // Every store below lands in `res` (checked once, not per value).
-        if count == 0 || first + (count - 1) * stride >= res.len() {
+        let Some(lane) = res.get_mut(first..=first + (count - 1) * stride) else {
             continue;
-        }
-        let lane = &mut res[first..=first + (count - 1) * stride];
+        };
         if w == 0 {
             lane.iter_mut().step_by(stride).for_each(|x| *x = 0);
             continue;
         }
-        let (per, mask) = (64 / w, (1u64 << w) - 1);
-        let mut at = 0;
-        while at < lane.len() {
-            let mut win = window(words, pos);
-            let end = (at + per * stride).min(lane.len());
-            while at < end {
-                lane[at] = (win & mask) as i32;
+        let (per, mask) = (PER_WINDOW[w] as usize, (1u64 << w) - 1);
+        let end = pos + count * w;
+        let (mut at, mut i) = (pos, 0);
+        while i < lane.len() {
+            let mut win = window(words, at);
+            let stop = (i + per * stride).min(lane.len());
+            while i < stop {
+                lane[i] = (win & mask) as i32;
                 win >>= w;
-                at += stride;
-                pos += w;
+                i += stride;
             }
+            at += per * w;
         }
+        pos = end;
     }
 }
+
+/// `64 / w`: the values of width `w` one 64-bit window holds.
+const PER_WINDOW: [u8; 33] = {
+    let mut t = [0u8; 33];
+    let mut w = 1;
+    while w <= 32 {
+        t[w] = (64 / w) as u8;
+        w += 1;
+    }
+    t
+};
 
 /// Stream lanes' integers into their plane lanes.
 #[inline(always)]
