@@ -54,6 +54,67 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
+    /// The track count and the tracks (a count the file cannot hold is
+    /// refused before anything is allocated for it).
+    fn tracks(&mut self, file_len: usize) -> Result<Vec<PackTrack>, PackError> {
+        let count = self.u32("the track count")? as usize;
+        // A track takes at least 42 bytes (an empty name's length, 10 bytes
+        // of settings, tension, continuity, bias and step): refuse counts
+        // the file cannot hold.
+        if count > self.bytes.len() / 42 {
+            return err(format!(
+                "{count} tracks claimed in a file of {file_len} bytes"
+            ));
+        }
+        (0..count).map(|i| self.track(i)).collect()
+    }
+
+    /// The lane count (which must be the `stored` components of the
+    /// tracks) and per lane the widths of block start values and deltas.
+    fn block_widths(&mut self, stored: usize) -> Result<(Vec<u8>, Vec<u8>), PackError> {
+        let lanes = self.u32("the lane count")? as usize;
+        if lanes != stored {
+            return err(format!(
+                "{lanes} lanes for tracks that store {stored} components"
+            ));
+        }
+        let abs_bits = self.take(lanes, "the block widths")?.to_vec();
+        let delta_bits = self.take(lanes, "the block widths")?.to_vec();
+        if let Some(b) = abs_bits.iter().chain(&delta_bits).find(|b| **b > 31) {
+            return err(format!("a block width of {b} bits (at most 31)"));
+        }
+        Ok((abs_bits, delta_bits))
+    }
+
+    /// The segment table and the stream of `keys` keys of `lanes` lanes:
+    /// the table's first bits, the stream as words and its length in
+    /// bytes.
+    fn stream(
+        &mut self,
+        keys: usize,
+        lanes: usize,
+    ) -> Result<(Vec<u32>, Vec<u64>, usize), PackError> {
+        let segments = self.u32("the segment count")? as usize;
+        if keys < 2 || segments != keys.div_ceil(SEGMENT_KEYS) + 1 {
+            return err(format!("{segments} segment entries for {keys} keys"));
+        }
+        let table = self.take(4 * segments, "the segment table")?;
+        let seg_at: Vec<u32> = table
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect();
+        let len = self.u32("the stream length")? as usize;
+        let stream = super::to_words(self.take(len, "the stream")?);
+        // Every segment spends at least 2 bits per lane on its header: a
+        // file cannot describe more keys than that.
+        if (segments - 1).saturating_mul(lanes).saturating_mul(2) > 8 * len {
+            return err(format!(
+                "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
+            ));
+        }
+        Ok((seg_at, stream, len))
+    }
+
     /// Track `i`'s head: name, kind, settings, tension, continuity, bias,
     /// step and whether `w` is rebuilt (its integers are the stream's).
     fn track(&mut self, i: usize) -> Result<PackTrack, PackError> {
@@ -228,58 +289,19 @@ impl Packed {
         }
         let block = block as usize;
         check_block(block)?;
-        let count = r.u32("the track count")? as usize;
-        // A track takes at least 42 bytes (an empty name's length, 10 bytes
-        // of settings, tension, continuity, bias and step): refuse counts
-        // the file cannot hold.
-        if count > body.len() / 42 {
+        let tracks = r.tracks(bytes.len())?;
+        if tracks.is_empty() || keys.saturating_mul(tracks.len()) > super::MAX_TRACK_KEYS {
             return err(format!(
-                "{count} tracks claimed in a file of {} bytes",
-                bytes.len()
-            ));
-        }
-        let mut tracks = Vec::with_capacity(count);
-        for i in 0..count {
-            tracks.push(r.track(i)?);
-        }
-        if tracks.is_empty() || keys.saturating_mul(count) > super::MAX_TRACK_KEYS {
-            return err(format!(
-                "{keys} keys of {count} tracks: a packed clip has 1 to {} track keys",
+                "{keys} keys of {} tracks: a packed clip has 1 to {} track keys",
+                tracks.len(),
                 super::MAX_TRACK_KEYS
             ));
         }
-        let lanes = r.u32("the lane count")? as usize;
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
-        if lanes != stored {
-            return err(format!(
-                "{lanes} lanes for tracks that store {stored} components"
-            ));
-        }
-        let abs_bits = r.take(lanes, "the block widths")?.to_vec();
-        let delta_bits = r.take(lanes, "the block widths")?.to_vec();
-        if let Some(b) = abs_bits.iter().chain(&delta_bits).find(|b| **b > 31) {
-            return err(format!("a block width of {b} bits (at most 31)"));
-        }
-        let segments = r.u32("the segment count")? as usize;
-        if keys < 2 || segments != keys.div_ceil(SEGMENT_KEYS) + 1 {
-            return err(format!("{segments} segment entries for {keys} keys"));
-        }
-        let table = r.take(4 * segments, "the segment table")?;
-        let seg_at: Vec<u32> = table
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect();
-        let len = r.u32("the stream length")? as usize;
-        let stream = super::to_words(r.take(len, "the stream")?);
+        let (abs_bits, delta_bits) = r.block_widths(stored)?;
+        let (seg_at, stream, len) = r.stream(keys, stored)?;
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
-        }
-        // Every segment spends at least 2 bits per lane on its header: a
-        // file cannot describe more keys than that.
-        if (segments - 1).saturating_mul(lanes).saturating_mul(2) > 8 * len {
-            return err(format!(
-                "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
-            ));
         }
         let packed = Packed {
             block,

@@ -620,6 +620,46 @@ impl BitWriter {
     }
 }
 
+/// Per lane, the widths of its blocks' start values and deltas (the
+/// largest over the clip's blocks).
+fn block_start_widths(lanes: &[&Vec<i32>], n: usize, block: usize) -> (Vec<u8>, Vec<u8>) {
+    let mut abs_bits = vec![0u8; lanes.len()];
+    let mut delta_bits = vec![0u8; lanes.len()];
+    for (l, x) in lanes.iter().enumerate() {
+        for b in (0..n).step_by(block) {
+            abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b, 2, block))) as u8);
+            if b + 1 < n {
+                delta_bits[l] = delta_bits[l].max(bits_of(zigzag(code(x, b + 1, 2, block))) as u8);
+            }
+        }
+    }
+    (abs_bits, delta_bits)
+}
+
+/// Per lane, the prediction order whose residuals over the segment of
+/// `keys` take fewer bits (2 on a tie), and that width.
+fn segment_orders(lanes: &[&Vec<i32>], keys: Range<usize>, block: usize) -> Vec<(u32, u32)> {
+    let width = |x: &[i32], order| {
+        keys.clone()
+            .filter(|k| k % block >= 2)
+            .map(|k| bits_of(zigzag(code(x, k, order, block))))
+            .max()
+            .unwrap_or(0)
+    };
+    lanes
+        .iter()
+        .map(|x| {
+            let (w2, w1) = (width(x, 2), width(x, 1));
+            if w1 < w2 { (1, w1) } else { (2, w2) }
+        })
+        .collect()
+}
+
+/// The one error of a stream that stops before its values do.
+fn ends_early<T>() -> Result<T, PackError> {
+    err("the packed stream ends early")
+}
+
 /// `w` bits (at most 32) at bit `pos` of `words` (bit `p` is bit `p % 64`
 /// of word `p / 64`), which end with two words of padding.
 #[inline(always)]
@@ -739,17 +779,7 @@ impl Packed {
         source.validate()?;
         let n = source.keys;
         let lanes: Vec<&Vec<i32>> = source.tracks.iter().flat_map(|t| t.values.iter()).collect();
-        let mut abs_bits = vec![0u8; lanes.len()];
-        let mut delta_bits = vec![0u8; lanes.len()];
-        for (l, x) in lanes.iter().enumerate() {
-            for b in (0..n).step_by(block) {
-                abs_bits[l] = abs_bits[l].max(bits_of(zigzag(code(x, b, 2, block))) as u8);
-                if b + 1 < n {
-                    delta_bits[l] =
-                        delta_bits[l].max(bits_of(zigzag(code(x, b + 1, 2, block))) as u8);
-                }
-            }
-        }
+        let (abs_bits, delta_bits) = block_start_widths(&lanes, n, block);
         let mut w = BitWriter {
             bytes: Vec::new(),
             bits: 0,
@@ -761,22 +791,7 @@ impl Packed {
         };
         for s in (0..n).step_by(SEGMENT_KEYS) {
             seg_at.push(bit_offset(w.bits)?);
-            let end = (s + SEGMENT_KEYS).min(n);
-            let rows = || (s..end).filter(|k| k % block >= 2);
-            // Per lane the order whose residuals take fewer bits (2 on a tie).
-            let width = |x: &[i32], order| {
-                rows()
-                    .map(|k| bits_of(zigzag(code(x, k, order, block))))
-                    .max()
-                    .unwrap_or(0)
-            };
-            let chosen: Vec<(u32, u32)> = lanes
-                .iter()
-                .map(|x| {
-                    let (w2, w1) = (width(x, 2), width(x, 1));
-                    if w1 < w2 { (1, w1) } else { (2, w2) }
-                })
-                .collect();
+            let chosen = segment_orders(&lanes, s..(s + SEGMENT_KEYS).min(n), block);
             for (l, &(order, wd)) in chosen.iter().enumerate() {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
@@ -799,8 +814,9 @@ impl Packed {
                 }
             }
             // Lane by lane: a lane's residuals of the segment are contiguous.
+            let end = (s + SEGMENT_KEYS).min(n);
             for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
-                for k in rows() {
+                for k in (s..end).filter(|k| k % block >= 2) {
                     w.put(zigzag(code(x, k, order, block)), wd);
                 }
             }
@@ -894,17 +910,106 @@ impl Packed {
         debug_assert!(first_key.is_multiple_of(self.block));
         let mut widths = vec![0u32; lanes];
         let mut orders = vec![2u32; lanes];
-        let bits = self.stream_len * 8;
         // From the table's entry, but the stream's first segment from bit 0.
         let mut pos = if segs.start == 0 {
             0
         } else {
             self.seg_at[segs.start] as usize
         };
-        fn ends_early<T>() -> Result<T, PackError> {
-            err("the packed stream ends early")
+        for j in segs.clone() {
+            if pos != self.seg_at[j] as usize {
+                return err(format!(
+                    "segment {j} starts at bit {pos}, the table says {}",
+                    self.seg_at[j]
+                ));
+            }
+            self.segment_headers(j, &mut pos, &mut widths, &mut orders)?;
+            let s = j * SEGMENT_KEYS;
+            let keys = s..(s + SEGMENT_KEYS).min(n);
+            match x.as_deref_mut() {
+                Some(x) => self.segment_keys(keys, first_key, &widths, &orders, &mut pos, x)?,
+                None => self.skip_segment(keys, &widths, &mut pos)?,
+            }
         }
-        let take = |pos: &mut usize, w: u32| -> Result<u32, PackError> {
+        if pos != self.seg_at[segs.end] as usize {
+            return err("the packed stream's length disagrees with its table");
+        }
+        Ok(())
+    }
+
+    /// Segment `j`'s headers from bit `pos`: each lane's prediction order
+    /// and width (coded against the segment before, except at a block's
+    /// start), checked.
+    fn segment_headers(
+        &self,
+        j: usize,
+        pos: &mut usize,
+        widths: &mut [u32],
+        orders: &mut [u32],
+    ) -> Result<(), PackError> {
+        let bits = self.stream_len * 8;
+        let block_start = (j * SEGMENT_KEYS).is_multiple_of(self.block);
+        for (wd, order) in widths.iter_mut().zip(orders.iter_mut()) {
+            if *pos > bits {
+                return ends_early();
+            }
+            let before = if block_start { 0 } else { *wd };
+            let (o, w, used) = read_header(&self.stream, *pos, before);
+            if block_start && used != 3 + WIDTH_BITS as usize {
+                return err(format!("segment {j} starts a block with a relative width"));
+            }
+            if w >= 1 << WIDTH_BITS {
+                return err(format!("segment {j}: a width out of range"));
+            }
+            (*order, *wd) = (o, w);
+            *pos += used;
+            if *pos > bits {
+                return ends_early();
+            }
+        }
+        Ok(())
+    }
+
+    /// Keys of a segment coded as residuals (not a block's first two).
+    fn residual_keys(&self, keys: &Range<usize>) -> usize {
+        keys.clone().filter(|k| k % self.block >= 2).count()
+    }
+
+    /// Step `pos` over the values of the segment of `keys`, checked.
+    fn skip_segment(
+        &self,
+        keys: Range<usize>,
+        widths: &[u32],
+        pos: &mut usize,
+    ) -> Result<(), PackError> {
+        let rows = self.residual_keys(&keys);
+        let mut skip = widths.iter().map(|w| *w as usize * rows).sum::<usize>();
+        if keys.start.is_multiple_of(self.block) {
+            let sum = |b: &[u8]| b.iter().map(|b| usize::from(*b)).sum::<usize>();
+            skip += sum(&self.abs_bits) + sum(&self.delta_bits);
+        }
+        *pos += skip;
+        if *pos > self.stream_len * 8 {
+            return ends_early();
+        }
+        Ok(())
+    }
+
+    /// Decode the values of the segment of `keys` from bit `pos` onto each
+    /// lane of `x` (whose first entry is key `first_key`): a block's start
+    /// values and deltas, then the residuals on the prediction.
+    fn segment_keys(
+        &self,
+        keys: Range<usize>,
+        first_key: usize,
+        widths: &[u32],
+        orders: &[u32],
+        pos: &mut usize,
+        x: &mut [Vec<i32>],
+    ) -> Result<(), PackError> {
+        let (n, bits) = (self.head.keys, self.stream_len * 8);
+        let s = keys.start;
+        let mut take = |w: u32| -> Result<u32, PackError> {
             if *pos + w as usize > bits {
                 return ends_early();
             }
@@ -912,79 +1017,30 @@ impl Packed {
             *pos += w as usize;
             Ok(v)
         };
-        for j in segs.clone() {
-            let s = j * SEGMENT_KEYS;
-            if pos != self.seg_at[j] as usize {
-                return err(format!(
-                    "segment {j} starts at bit {pos}, the table says {}",
-                    self.seg_at[j]
-                ));
-            }
-            let block_start = s.is_multiple_of(self.block);
-            for (wd, order) in widths.iter_mut().zip(orders.iter_mut()) {
-                if pos > bits {
-                    return ends_early();
-                }
-                let before = if block_start { 0 } else { *wd };
-                let (o, w, used) = read_header(&self.stream, pos, before);
-                if block_start && used != 3 + WIDTH_BITS as usize {
-                    return err(format!("segment {j} starts a block with a relative width"));
-                }
-                if w >= 1 << WIDTH_BITS {
-                    return err(format!("segment {j}: a width out of range"));
-                }
-                (*order, *wd) = (o, w);
-                pos += used;
-                if pos > bits {
-                    return ends_early();
-                }
-            }
-            let end = (s + SEGMENT_KEYS).min(n);
-            // Keys of the segment coded as residuals (not a block's first two).
-            let rows = (s..end).filter(|k| k % self.block >= 2).count();
-            let Some(x) = x.as_deref_mut() else {
-                let mut skip = widths.iter().map(|w| *w as usize * rows).sum::<usize>();
-                if block_start {
-                    let sum = |b: &[u8]| b.iter().map(|b| usize::from(*b)).sum::<usize>();
-                    skip += sum(&self.abs_bits) + sum(&self.delta_bits);
-                }
-                pos += skip;
-                if pos > bits {
-                    return ends_early();
-                }
-                continue;
-            };
-            if block_start {
-                for (l, xl) in x.iter_mut().enumerate() {
-                    xl.push(unzigzag(take(&mut pos, u32::from(self.abs_bits[l]))?));
-                }
-                for (l, xl) in x.iter_mut().enumerate() {
-                    let d = unzigzag(take(&mut pos, u32::from(self.delta_bits[l]))?);
-                    if s + 1 < n {
-                        let v = xl[s - first_key].wrapping_add(d);
-                        xl.push(v);
-                    }
-                }
+        if s.is_multiple_of(self.block) {
+            for (l, xl) in x.iter_mut().enumerate() {
+                xl.push(unzigzag(take(u32::from(self.abs_bits[l]))?));
             }
             for (l, xl) in x.iter_mut().enumerate() {
-                for k in s..end {
-                    if k % self.block < 2 {
-                        continue;
-                    }
-                    let r = unzigzag(take(&mut pos, widths[l])?);
-                    let i = k - first_key;
-                    let trend = if orders[l] == 2 {
-                        xl[i - 1].wrapping_sub(xl[i - 2])
-                    } else {
-                        0
-                    };
-                    let v = xl[i - 1].wrapping_add(trend).wrapping_add(r);
+                let d = unzigzag(take(u32::from(self.delta_bits[l]))?);
+                if s + 1 < n {
+                    let v = xl[s - first_key].wrapping_add(d);
                     xl.push(v);
                 }
             }
         }
-        if pos != self.seg_at[segs.end] as usize {
-            return err("the packed stream's length disagrees with its table");
+        for (l, xl) in x.iter_mut().enumerate() {
+            for k in keys.clone().filter(|k| k % self.block >= 2) {
+                let r = unzigzag(take(widths[l])?);
+                let i = k - first_key;
+                let trend = if orders[l] == 2 {
+                    xl[i - 1].wrapping_sub(xl[i - 2])
+                } else {
+                    0
+                };
+                let v = xl[i - 1].wrapping_add(trend).wrapping_add(r);
+                xl.push(v);
+            }
         }
         Ok(())
     }
