@@ -310,20 +310,7 @@ impl Loose {
         };
         let pre = modes(|l| l.grid.pre);
         let post = modes(|l| l.grid.post);
-        let mut delta = vec![f32x8::ZERO; 4 * blocks];
-        for b in 0..blocks {
-            for c in 0..4 {
-                delta[4 * b + c] = f32x8::new(std::array::from_fn(|l| {
-                    lane(8 * b + l).map_or(0.0, |x| {
-                        if c >= x.dim {
-                            return 0.0;
-                        }
-                        let n = x.grid.times.len();
-                        x.key((n - 1) * x.dim + c)[0] - x.key(c)[0]
-                    })
-                }));
-            }
-        }
+        let delta = offset_deltas(&lanes, blocks);
         let block_lanes = |b: usize| (8 * b..8 * b + 8).filter_map(lane);
         let mut ctl_planes = 0;
         let block: Vec<Block> = (0..blocks)
@@ -346,24 +333,12 @@ impl Loose {
             let g = &lane.grid;
             lane.plain = g.eases.iter().all(|e| e.is_none()) && !g.steps.contains(&true);
         }
-        let mut order: Vec<(f64, u32, u32)> = lanes
-            .iter()
-            .enumerate()
-            .flat_map(|(l, x)| {
-                let t = &x.grid.times;
-                (1..=t.len()).map(move |seg| (t[seg - 1], index_u32(l), index_u32(seg)))
-            })
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let seek_after = match (order.first(), order.last()) {
-            (Some(a), Some(b)) => (b.0 - a.0) * (2 * lanes.len() + 64) as f64 / order.len() as f64,
-            _ => f64::INFINITY,
-        };
+        let (order, seek_after) = key_order(&lanes);
         Loose {
             seek_after,
             block,
             ctl_planes,
-            order: order.into_iter().map(|(_, l, s)| [l, s]).collect(),
+            order,
             lanes,
             blocks,
             out,
@@ -899,4 +874,47 @@ fn normalize(values: &mut [f32x8], vel: Option<&mut [f32x8]>, out: std::ops::Ran
     }
     let vel = vel.map(|v| block(v, out.clone()));
     crate::kernel::normalize_block(block(values, out), vel);
+}
+
+/// `P_{n-1} - P_0` of each lane and component, per block of 8 lanes and
+/// plane (what `offset-repeat` adds per cycle).
+fn offset_deltas(lanes: &[LooseLane], blocks: usize) -> Vec<f32x8> {
+    let mut delta = vec![f32x8::ZERO; 4 * blocks];
+    for b in 0..blocks {
+        for c in 0..4 {
+            delta[4 * b + c] = f32x8::new(std::array::from_fn(|l| {
+                lanes.get(8 * b + l).map_or(0.0, |x| {
+                    if c >= x.dim {
+                        return 0.0;
+                    }
+                    let n = x.grid.times.len();
+                    x.key((n - 1) * x.dim + c)[0] - x.key(c)[0]
+                })
+            }));
+        }
+    }
+    delta
+}
+
+/// Every lane's segments `[lane, segment]` in the order forward playback
+/// first needs them (by the segment's start time, then lane), and the
+/// time after which a jump is a seek rather than a walk along them.
+fn key_order(lanes: &[LooseLane]) -> (Vec<[u32; 2]>, f64) {
+    let mut order: Vec<(f64, u32, u32)> = lanes
+        .iter()
+        .enumerate()
+        .flat_map(|(l, x)| {
+            let t = &x.grid.times;
+            (1..=t.len()).map(move |seg| (t[seg - 1], index_u32(l), index_u32(seg)))
+        })
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let seek_after = match (order.first(), order.last()) {
+        (Some(a), Some(b)) => (b.0 - a.0) * (2 * lanes.len() + 64) as f64 / order.len() as f64,
+        _ => f64::INFINITY,
+    };
+    (
+        order.into_iter().map(|(_, l, s)| [l, s]).collect(),
+        seek_after,
+    )
 }

@@ -274,44 +274,7 @@ pub(crate) fn split_rotation(
     };
     for k in 0..n - 1 {
         let (t0, t1) = (grid.times[k], grid.times[k + 1]);
-        let pieces = rot.exact[k + 1]
-            .filter(|_| grid.ease(k).is_none() && !grid.is_step(k))
-            .filter(|_| !(on_group && rot.velocity_only[k + 1]))
-            .and_then(|c| {
-                [2usize, 4, 8, 16].into_iter().find_map(|m| {
-                    let w = 1.0 / m as f64;
-                    // Split times strictly increasing (not so in f64 on
-                    // keys a few ulps apart).
-                    let at = |j: usize| split_time(t0, t1, j, m);
-                    if (1..=m).any(|j| at(j) <= at(j - 1)) {
-                        return None;
-                    }
-                    (0..m)
-                        .map(|j| {
-                            let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
-                            let (qa, da) = tcb_core::simd::squad::squad_with_derivative(&c, a);
-                            let (qb, db) = tcb_core::simd::squad::squad_with_derivative(&c, b);
-                            let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
-                                // The segment's own ends stay its keys.
-                                let p0 = if j == 0 {
-                                    rot.comps[i][k + 1][0]
-                                } else {
-                                    qa[i] as f32
-                                };
-                                let p1 = if j + 1 == m {
-                                    rot.comps[i][k + 1][1]
-                                } else {
-                                    qb[i] as f32
-                                };
-                                [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
-                            });
-                            let holds = cubic_holds(&c, &ctl, 2.0 / (w * (t1 - t0)), (a, b));
-                            let enough = if on_group { holds.values } else { holds.both() };
-                            enough.then_some((ctl, [a, w]))
-                        })
-                        .collect::<Option<Vec<_>>>()
-                })
-            });
+        let pieces = split_pieces(grid, rot, k, on_group);
         let Some(pieces) = pieces else {
             times.push(t1);
             eases.push(grid.ease(k));
@@ -344,6 +307,60 @@ pub(crate) fn split_rotation(
         post: grid.post,
     };
     (grid.compact(), out)
+}
+
+/// A piece of a split segment: its controls per component, and `[a, w]`
+/// (where it starts in the segment, and its width).
+type Piece = ([[f32; 4]; 4], [f64; 2]);
+
+/// Stored segment `k + 1` of `rot` (from key `k` of `grid`) as the fewest
+/// equal pieces (2, 4, 8 or 16) whose cubics hold squad (values, and
+/// velocities unless `on_group`): each piece's controls and `[a, w]`, where
+/// it starts in the segment and its width. None where the segment is not
+/// exact, eased, a step, too short to split, or 16 pieces still miss.
+fn split_pieces(
+    grid: &TimeGrid,
+    rot: &RotationControls,
+    k: usize,
+    on_group: bool,
+) -> Option<Vec<Piece>> {
+    let (t0, t1) = (grid.times[k], grid.times[k + 1]);
+    let c = rot.exact[k + 1]
+        .filter(|_| grid.ease(k).is_none() && !grid.is_step(k))
+        .filter(|_| !(on_group && rot.velocity_only[k + 1]))?;
+    [2usize, 4, 8, 16].into_iter().find_map(|m| {
+        let w = 1.0 / m as f64;
+        // Split times strictly increasing (not so in f64 on keys a few ulps
+        // apart).
+        let at = |j: usize| split_time(t0, t1, j, m);
+        if (1..=m).any(|j| at(j) <= at(j - 1)) {
+            return None;
+        }
+        (0..m)
+            .map(|j| {
+                let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
+                let (qa, da) = tcb_core::simd::squad::squad_with_derivative(&c, a);
+                let (qb, db) = tcb_core::simd::squad::squad_with_derivative(&c, b);
+                let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
+                    // The segment's own ends stay its keys.
+                    let p0 = if j == 0 {
+                        rot.comps[i][k + 1][0]
+                    } else {
+                        qa[i] as f32
+                    };
+                    let p1 = if j + 1 == m {
+                        rot.comps[i][k + 1][1]
+                    } else {
+                        qb[i] as f32
+                    };
+                    [p0, p1, (w * da[i]) as f32, (w * db[i]) as f32]
+                });
+                let holds = cubic_holds(&c, &ctl, 2.0 / (w * (t1 - t0)), (a, b));
+                let enough = if on_group { holds.values } else { holds.both() };
+                enough.then_some((ctl, [a, w]))
+            })
+            .collect::<Option<Vec<_>>>()
+    })
 }
 
 /// Time `j` of `m` (`t0` at 0, `t1` exactly at `m`) splitting `[t0, t1]`
