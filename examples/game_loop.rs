@@ -77,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &[(c.walk.pose(), 1.0 - w), (c.run.pose(), w)],
                 None,
             )?;
-            binding.model_transforms(&pose, &mut local, &mut model);
+            binding.model_transforms(&pose, &mut local, &mut model)?;
             head_height = head_height.max(model[head].translation.y);
         }
         spent += started.elapsed();

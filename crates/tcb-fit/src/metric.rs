@@ -118,9 +118,15 @@ pub fn shell_error(
     let mut worst = Worst::none();
     let mut each = vec![0.0f64; n];
     for &t in times {
-        bind_a.local_transforms(ia.sample(t), &mut local);
+        // Both bindings were made for their instance's clip, and `local`
+        // has a transform per joint.
+        bind_a
+            .local_transforms(ia.sample(t), &mut local)
+            .expect("bound to its clip");
         skeleton.model_transforms_f64(&local, &mut ma);
-        bind_b.local_transforms(ib.sample(t), &mut local);
+        bind_b
+            .local_transforms(ib.sample(t), &mut local)
+            .expect("bound to its clip");
         skeleton.model_transforms_f64(&local, &mut mb);
         for (j, joint) in skeleton.joints().iter().enumerate() {
             let e = point_error(&ma[j], &mb[j], radius);

@@ -81,7 +81,7 @@ pub use pack::{KeyValues, PackError, PackSource, PackTrack, Packed};
 pub use mint;
 pub use pose::Pose;
 pub use rig::{Rig, RigError, RigTrack};
-pub use skeleton::SkeletonBinding;
+pub use skeleton::{BindingError, SkeletonBinding};
 
 /// The README's examples, compiled as doctests so that they stay true
 /// (here, where every crate they use is a dependency).

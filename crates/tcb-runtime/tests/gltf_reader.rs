@@ -238,7 +238,9 @@ fn cmu_worst(mode: tcb_core::RotationMode, max_error: f64) -> f64 {
     // Off the keys (120 fps keys, 97 ms apart here) and on the last one.
     for i in 0..=236 {
         let t = (i as f64 * 0.0973).min(end);
-        binding.model_transforms(instance.sample(t), &mut local, &mut model);
+        binding
+            .model_transforms(instance.sample(t), &mut local, &mut model)
+            .unwrap();
         let theirs = scene.model(t);
         for (j, &node) in nodes.iter().enumerate() {
             let got = DVec3::from(model[j].translation.to_array().map(f64::from));
@@ -292,7 +294,9 @@ fn threejs_positions_match_skeleton_binding() {
     let mut model = vec![glam::Affine3A::IDENTITY; n];
     let (mut worst, mut compared) = (0.0f64, 0);
     for (t, joints) in doc.as_object().unwrap() {
-        binding.model_transforms(instance.sample(t.parse().unwrap()), &mut local, &mut model);
+        binding
+            .model_transforms(instance.sample(t.parse().unwrap()), &mut local, &mut model)
+            .unwrap();
         for (j, joint) in skeleton.joints().iter().enumerate() {
             let p = &joints[joint.name.as_str()];
             let theirs = DVec3::new(
