@@ -74,7 +74,13 @@ fn figure(panels: &[Panel], plot: &Plot, range: (f64, f64)) -> Result<String, Pl
     let charts: Vec<Vec<chart::Chart>> = panels
         .iter()
         .map(|p| {
-            let caption = if several { p.kind.caption() } else { &title };
+            // Small multiples (one track a panel, as paths are) are
+            // captioned by their track.
+            let caption = match (several, p.tracks.as_slice()) {
+                (false, _) => title.as_str(),
+                (true, [one]) if matches!(plot.mode, Mode::Path { .. }) => one.name.as_str(),
+                (true, _) => p.kind.caption(),
+            };
             panel::charts(p, plot, caption, range)
         })
         .collect();

@@ -91,6 +91,9 @@ pub(crate) fn select<'a>(clip: &'a Clip, plot: &Plot) -> Result<Selection<'a>, P
     if plot.tracks.is_empty() {
         notes.extend(keep_first(&mut panels));
     }
+    if matches!(plot.mode, Mode::Path { .. }) {
+        panels = one_per_track(panels);
+    }
     Ok(Selection { panels, notes })
 }
 
@@ -190,6 +193,20 @@ fn by_kind(tracks: Vec<&NamedTrack>) -> Vec<Panel<'_>> {
     }
     panels.sort_by_key(|p| p.kind);
     panels
+}
+
+/// A panel per track (paths: several drawn on one pair of axes hide each
+/// other where they run close, as the careen figure's three did).
+fn one_per_track(panels: Vec<Panel<'_>>) -> Vec<Panel<'_>> {
+    panels
+        .into_iter()
+        .flat_map(|p| {
+            p.tracks.into_iter().map(move |t| Panel {
+                kind: p.kind,
+                tracks: vec![t],
+            })
+        })
+        .collect()
 }
 
 /// Each panel's first tracks up to [`DEFAULT_CHANNELS`] channels (at

@@ -60,7 +60,10 @@ fn text_x(svg: &str, label: &str) -> f64 {
     let tag = svg
         .match_indices("<text ")
         .map(|(i, _)| &svg[i..i + svg[i..].find("</text>").unwrap()])
-        .find(|t| t[t.find('>').unwrap() + 1..].trim() == label)
+        .filter(|t| t[t.find('>').unwrap() + 1..].trim() == label)
+        // The last: a panel's caption may say the same as its legend, which
+        // is drawn after it.
+        .last()
         .unwrap_or_else(|| panic!("no text {label}"));
     attr(tag, "x").unwrap().parse().unwrap()
 }
@@ -134,6 +137,24 @@ fn a_big_clip_shows_the_first_tracks_of_each_kind_and_says_so() {
     );
     assert!(r.svg.contains("Hips.translation.x") && r.svg.contains("angle of LeftLeg.rotation"));
     assert!(!r.svg.contains("angle of RightLeg.rotation"));
+}
+
+#[test]
+fn paths_are_small_multiples_one_panel_a_track() {
+    // Three paths of one ball drawn on one pair of axes hid each other.
+    let careen = load("examples/clips/careen.json");
+    let svg = render_with_notes(&careen, &plot(Mode::Path { components: [0, 1] }))
+        .unwrap()
+        .svg;
+    for name in ["ball.path", "ball.path_overshoot", "ball.path_stop"] {
+        // Its panel's caption and its legend.
+        let texts = svg
+            .match_indices("<text ")
+            .map(|(i, _)| &svg[i..i + svg[i..].find("</text>").unwrap()])
+            .filter(|t| t[t.find('>').unwrap() + 1..].trim() == name)
+            .count();
+        assert_eq!(texts, 2, "{name}");
+    }
 }
 
 #[test]
