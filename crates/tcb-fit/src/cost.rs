@@ -118,3 +118,93 @@ fn loose_keys(source: &Clip) -> usize {
         .map(|g| g.2)
         .sum()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn clip(tracks: &[String]) -> Clip {
+        let text = format!(
+            r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
+            tracks.join(",")
+        );
+        tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()
+    }
+
+    fn track(name: &str, kind: &str, times: &str, value: &str, keys: usize) -> String {
+        let values = vec![value; keys].join(",");
+        format!(
+            r#"{{"name": "{name}", "kind": "{kind}", "times": [{times}], "values": [{values}]}}"#
+        )
+    }
+
+    /// `loose_keys` finds the tracks the compiler plays as loose lanes.
+    #[test]
+    fn loose_tracks_are_those_the_compiler_leaves_loose() {
+        let cases: Vec<(Vec<String>, usize, usize)> = vec![
+            // (tracks, loose tracks, their keys)
+            // 9 scalars on one grid: a group.
+            (
+                (0..9)
+                    .map(|i| track(&format!("s{i}"), "scalar", "0, 1, 2", "0", 3))
+                    .collect(),
+                0,
+                0,
+            ),
+            // 7 scalars on one grid, 2 on another: all loose.
+            (
+                (0..9)
+                    .map(|i| {
+                        let times = if i < 7 { "0, 1, 2" } else { "0, 2" };
+                        track(
+                            &format!("s{i}"),
+                            "scalar",
+                            times,
+                            "0",
+                            3 - usize::from(i >= 7),
+                        )
+                    })
+                    .collect(),
+                9,
+                7 * 3 + 2 * 2,
+            ),
+            // A vector and a rotation on one grid: a group.
+            (
+                vec![
+                    track("t", "vec3", "0, 1", "[0, 0, 0]", 2),
+                    track("r", "quat", "0, 1", "[0, 0, 0, 1]", 2),
+                ],
+                0,
+                0,
+            ),
+            // 8 rotations on one grid, a ninth on its own: 1 loose.
+            (
+                (0..9)
+                    .map(|i| {
+                        let times = if i < 8 { "0, 1, 2" } else { "0, 1.5, 2" };
+                        track(&format!("r{i}"), "quat", times, "[0, 0, 0, 1]", 3)
+                    })
+                    .collect(),
+                1,
+                3,
+            ),
+        ];
+        for (tracks, loose, keys) in cases {
+            let source = clip(&tracks);
+            let compiled = tcb_runtime::Clip::compile(&source);
+            assert_eq!(compiled.loose_track_count(), loose, "{tracks:?}");
+            assert_eq!(loose_keys(&source), keys, "{tracks:?}");
+        }
+    }
+
+    /// The model on the dense CMU clip: one group of 1 vector and 4
+    /// rotation blocks, 1084 instructions a frame, as counted.
+    #[test]
+    fn the_dense_cmu_clip_costs_what_callgrind_counted() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+        let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
+        let source = tcb_io::load_with(path, &options).unwrap().clip;
+        let compiled = tcb_runtime::Clip::compile(&source);
+        assert_eq!(frame_cost(&compiled, &source), 1084.0);
+    }
+}
