@@ -716,7 +716,7 @@ fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
         "tcb: estimated runtime cost: input {c0:.0}, output {c1:.0} instructions per frame ({:.2}x){}",
         c1 / c0,
         if c1 > c0 {
-            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (docs/reduce.md)"
+            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (docs/benchmarks.md)"
         } else {
             ""
         }
