@@ -708,8 +708,8 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
 
 /// On stderr: the input's and output's estimated runtime instructions per
 /// frame (`tcb_fit::cost`), and, unless `ms` is 0, their ns per animated
-/// joint per frame at 60 fps timed in one run (alternating rounds, medians,
-/// about `ms` milliseconds in all: a quick timing).
+/// joint per frame at 60 fps timed in one run (alternating rounds, medians
+/// ± MAD, about `ms` milliseconds in all: a quick timing).
 fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
     let (c0, c1) = (reduced.before_cost, reduced.after_cost);
     eprintln!(
@@ -732,25 +732,29 @@ fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
     if ms == 0 {
         return;
     }
-    let (t0, t1) = quick_timing(input, &reduced.clip, std::time::Duration::from_millis(ms));
+    let [(t0, s0), (t1, s1)] =
+        quick_timing(input, &reduced.clip, std::time::Duration::from_millis(ms));
     let joints = animated_joints(input);
     let per_joint = |s: f64| s * 1e9 / joints.max(1) as f64;
     eprintln!(
-        "tcb: a quick timing ({ms} ms, one run{}): input {:.2}, output {:.2} ns per joint per frame ({:.2}x), {joints} animated joints at 60 fps",
+        "tcb: a quick timing ({ms} ms, one run{}): input {:.2} ± {:.2}, output {:.2} ± {:.2} ns per joint per frame ({:.2}x), {joints} animated joints at 60 fps",
         if cfg!(debug_assertions) {
             ", a debug build"
         } else {
             ""
         },
         per_joint(t0),
+        per_joint(s0),
         per_joint(t1),
+        per_joint(s1),
         t1 / t0
     );
 }
 
 /// Seconds per frame of `a` and `b` compiled, played forward at 60 fps over
-/// `a`'s keys: medians of rounds timed alternately, in about `budget`.
-fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> (f64, f64) {
+/// `a`'s keys: medians of rounds timed alternately, in about `budget`, and
+/// the rounds' MAD (median absolute deviation).
+fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> [(f64, f64); 2] {
     use std::sync::Arc;
     let (start, end) = a.time_range().unwrap_or((0.0, 0.0));
     let frames: Vec<f64> = (0..=((end - start) * 60.0).floor() as usize)
@@ -781,8 +785,14 @@ fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> (f64, f64) {
     const ROUNDS: usize = 11;
     let slice = budget.div_f64(2.0 * (ROUNDS as f64 + 0.25));
     let rounds = tcb_bench::measure::rounds_seconds(&mut subjects, ROUNDS, slice);
-    let per_frame = |i: usize| tcb_bench::noise::median(&rounds[i]) / frames.len() as f64;
-    (per_frame(0), per_frame(1))
+    let n = frames.len() as f64;
+    let per_frame = |i: usize| {
+        (
+            tcb_bench::noise::median(&rounds[i]) / n,
+            tcb_bench::noise::mad(&rounds[i]) / n,
+        )
+    };
+    [per_frame(0), per_frame(1)]
 }
 
 /// The distinct `<joint>` of a clip's `<joint>.<part>` track names.
