@@ -207,6 +207,15 @@ struct ReduceArgs {
     /// glTF input: the animation to reduce, by name or index (default: the first).
     #[arg(long, value_name = "NAME_OR_INDEX")]
     animation: Option<String>,
+    /// Take tracks off the input's shared key grid even where the clip then
+    /// plays slower than the input (by the estimate of instructions per
+    /// frame printed on stderr): the fewest bytes.
+    #[arg(long)]
+    allow_slower: bool,
+    /// Milliseconds for the quick timing of input and output that follows
+    /// the reduction (ns per joint per frame, both from one run; 0: none).
+    #[arg(long, value_name = "MS", default_value_t = 300)]
+    timing_ms: u64,
 }
 
 /// The error a result is held to (`reduce` and `compress`, docs/reduce.md).
@@ -667,7 +676,8 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         .metric(args.error.metric)
         .rotation_tolerance(args.error.rotation_tolerance)
         .knots(args.knots)
-        .tangents(args.tangents);
+        .tangents(args.tangents)
+        .allow_slower(args.allow_slower);
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,
@@ -691,8 +701,110 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
             reduced.after.bytes, reduced.before.bytes
         );
     }
+    report_speed(&loaded.clip, &reduced, args.timing_ms);
     println!("{}", reduced.summary_line());
     Ok(())
+}
+
+/// On stderr: the input's and output's estimated runtime instructions per
+/// frame (`tcb_fit::cost`), and, unless `ms` is 0, their ns per animated
+/// joint per frame at 60 fps timed in one run (alternating rounds, medians
+/// ± MAD, about `ms` milliseconds in all: a quick timing).
+fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
+    let (c0, c1) = (reduced.before_cost, reduced.after_cost);
+    eprintln!(
+        "tcb: estimated runtime cost: input {c0:.0}, output {c1:.0} instructions per frame ({:.2}x){}",
+        c1 / c0,
+        if c1 > c0 {
+            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (docs/benchmarks.md)"
+        } else {
+            ""
+        }
+    );
+    if let Some((smaller, cost)) = &reduced.declined {
+        eprintln!(
+            "tcb: fits put back on the input's key grid to play no slower than the input: \
+             the fewest bytes found ({} keys, {} bytes) would cost {cost:.0} instructions per frame \
+             (--allow-slower keeps them)",
+            smaller.keys, smaller.bytes
+        );
+    }
+    if ms == 0 {
+        return;
+    }
+    let [(t0, s0), (t1, s1)] =
+        quick_timing(input, &reduced.clip, std::time::Duration::from_millis(ms));
+    let joints = animated_joints(input);
+    let per_joint = |s: f64| s * 1e9 / joints.max(1) as f64;
+    eprintln!(
+        "tcb: a quick timing ({ms} ms, one run{}): input {:.2} ± {:.2}, output {:.2} ± {:.2} ns per joint per frame ({:.2}x), {joints} animated joints at 60 fps",
+        if cfg!(debug_assertions) {
+            ", a debug build"
+        } else {
+            ""
+        },
+        per_joint(t0),
+        per_joint(s0),
+        per_joint(t1),
+        per_joint(s1),
+        t1 / t0
+    );
+}
+
+/// Seconds per frame of `a` and `b` compiled, played forward at 60 fps over
+/// `a`'s keys: medians of rounds timed alternately, in about `budget`, and
+/// the rounds' MAD (median absolute deviation).
+fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> [(f64, f64); 2] {
+    use std::sync::Arc;
+    let (start, end) = a.time_range().unwrap_or((0.0, 0.0));
+    let frames: Vec<f64> = (0..=((end - start) * 60.0).floor() as usize)
+        .map(|i| start + i as f64 / 60.0)
+        .collect();
+    let pass = |clip: &Clip| {
+        let mut instance = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(clip)));
+        let frames = &frames;
+        Box::new(move || {
+            for &t in frames {
+                std::hint::black_box(instance.sample(t));
+            }
+        }) as Box<dyn FnMut() + '_>
+    };
+    let mut subjects = [
+        tcb_bench::measure::Subject {
+            name: "input",
+            samples: frames.len() as f64,
+            run: pass(a),
+        },
+        tcb_bench::measure::Subject {
+            name: "output",
+            samples: frames.len() as f64,
+            run: pass(b),
+        },
+    ];
+    // Each subject is calibrated for a quarter slice, then timed once a round.
+    const ROUNDS: usize = 11;
+    let slice = budget.div_f64(2.0 * (ROUNDS as f64 + 0.25));
+    let rounds = tcb_bench::measure::rounds_seconds(&mut subjects, ROUNDS, slice);
+    let n = frames.len() as f64;
+    let per_frame = |i: usize| {
+        (
+            tcb_bench::noise::median(&rounds[i]) / n,
+            tcb_bench::noise::mad(&rounds[i]) / n,
+        )
+    };
+    [per_frame(0), per_frame(1)]
+}
+
+/// The distinct `<joint>` of a clip's `<joint>.<part>` track names.
+fn animated_joints(clip: &Clip) -> usize {
+    let mut names: Vec<&str> = clip
+        .tracks()
+        .iter()
+        .map(|t| t.name.rsplit_once('.').map_or(t.name.as_str(), |p| p.0))
+        .collect();
+    names.sort_unstable();
+    names.dedup();
+    names.len()
 }
 
 /// Bytes as MB with three decimals.

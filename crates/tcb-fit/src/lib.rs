@@ -10,6 +10,7 @@
 //! | [`fit`] | least-squares Hermite fits with greedy key insertion and removal |
 //! | [`metric`] | check times, playing clips on the runtime, the `shell` and `value` errors |
 //! | [`mod@reduce`] | the whole job: tolerances per track, knot sharing, verification, the written clip |
+//! | [`cost`] | a compiled clip's estimated instructions per frame, so that a reduced clip plays no slower than its source |
 //!
 //! ```
 //! // A dense track: one key per frame of a smooth motion, 120 fps for 2 s.
@@ -38,6 +39,7 @@
 
 mod band;
 pub mod compress;
+pub mod cost;
 pub mod fit;
 pub mod metric;
 pub mod reduce;

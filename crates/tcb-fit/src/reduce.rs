@@ -29,12 +29,20 @@
 //!    twice a shared grid's bytes per key) are put back on the input's
 //!    keys, those keeping the largest share first, where the compiled clip
 //!    gets smaller and still holds.
+//! 6. Speed: a fit taken off the input's shared key grid plays as a loose
+//!    lane, dearer per frame than its lane in the grid's blocks
+//!    ([`crate::cost`]). Unless the clip's estimated cost per frame is at
+//!    most the input's, fitted tracks (not those of 2 keys) are put back on
+//!    the input's keys where that brings it within the input's cost, with
+//!    the fewest bytes; where nothing does, the fewest bytes are kept and
+//!    the cost reported ([`ReduceOptions::allow_slower`] skips this step).
 //!
 //! Tracks the fitter does not take are kept as they are (exact): tracks
 //! whose `linear` or `offset-repeat` extrapolation is checked outside their
 //! keys, tracks no joint uses (under `shell`), and tracks whose fit would
 //! store as many numbers as they already do.
 
+use crate::cost;
 use crate::fit::{self, Fit, Norm, Series, Tangents};
 use crate::metric::{self, Worst};
 use rayon::prelude::*;
@@ -154,6 +162,11 @@ pub struct ReduceOptions {
     pub knots: Knots,
     /// Stored or derived tangents (`--tangents`).
     pub tangents: Tangents,
+    /// Take tracks off their shared key grid even where the clip then
+    /// plays slower than its source (`--allow-slower`): the fewest bytes
+    /// [`reduce`] finds. By default a reduced clip costs no more per frame
+    /// than its source by [`crate::cost::frame_cost`].
+    pub allow_slower: bool,
 }
 
 impl ReduceOptions {
@@ -196,6 +209,13 @@ impl ReduceOptions {
     #[must_use]
     pub fn tangents(mut self, tangents: Tangents) -> Self {
         self.tangents = tangents;
+        self
+    }
+
+    /// These options with [`allow_slower`](Self::allow_slower) set to `on`.
+    #[must_use]
+    pub fn allow_slower(mut self, on: bool) -> Self {
+        self.allow_slower = on;
         self
     }
 }
@@ -269,6 +289,15 @@ pub struct Reduced {
     pub before: Counts,
     /// The output's counts.
     pub after: Counts,
+    /// The input's estimated runtime instructions per frame
+    /// ([`crate::cost::frame_cost`]).
+    pub before_cost: f64,
+    /// The output's.
+    pub after_cost: f64,
+    /// The fewest bytes the fits gave, where they were declined for a
+    /// clip within the input's cost ([`ReduceOptions::allow_slower`] keeps
+    /// them): their counts and estimated cost.
+    pub declined: Option<(Counts, f64)>,
     /// The measured error of the output, by the metric, on the runtime.
     pub worst: Worst,
     /// Tracks kept as they were.
@@ -461,7 +490,20 @@ pub fn reduce(
     let mut cache: Vec<Option<(f64, Option<Fit>)>> = vec![None; plan.groups.len()];
     let (fitted, attempts) = fit_in_rounds(&plan, &mut cache, &verify, progress)?;
     let best = put_back_for_bytes(&plan, &cache, fitted, &verify)?;
+    let before_cost = cost::frame_cost(&reference.compiled, input.clip);
+    let (best, declined) = if options.allow_slower {
+        (best, None)
+    } else {
+        let smallest = (
+            counts(&best.doc, &best.compiled),
+            cost::frame_cost(&best.compiled, &best.clip),
+        );
+        let faster = put_back_for_speed(&plan, &cache, best, &verify, before_cost)?;
+        let declined = (counts(&faster.doc, &faster.compiled) != smallest.0).then_some(smallest);
+        (faster, declined)
+    };
     let after = counts(&best.doc, &best.compiled);
+    let after_cost = cost::frame_cost(&best.compiled, &best.clip);
     let kept = (0..best.kept.len())
         .filter(|&i| best.kept[i])
         .map(|i| input.clip.tracks()[i].name.clone())
@@ -472,6 +514,9 @@ pub fn reduce(
         settings,
         before,
         after,
+        before_cost,
+        after_cost,
+        declined,
         worst: best.worst,
         kept,
         attempts,
@@ -674,6 +719,92 @@ fn put_back_for_bytes(
     };
     let (doc, kept) = plan.write_fits(cache, &revert(size));
     let (clip, compiled) = build(&doc)?;
+    let measured = verify(&compiled);
+    if measured.worst.ratio > 1.0 {
+        return Ok(fitted);
+    }
+    Ok(Candidate {
+        doc,
+        clip,
+        compiled,
+        worst: measured.worst,
+        kept,
+    })
+}
+
+/// Step 6, speed: the runtime samples every lane every frame, so a track
+/// taken off a key grid it shared moves from a group's block to a loose
+/// lane, which costs more per frame than the group's (several times more
+/// per lane: [`crate::cost`]); a clip whose tracks mostly stay dense can so
+/// play slower than its source. Unless `fitted` costs no more per frame
+/// than `limit` (the source's cost), its fitted tracks of more than 2 keys
+/// (docs/reduce.md: "a constant track becomes 2 keys") are put back on the
+/// input's keys, those keeping the largest share of their keys first, in
+/// every prefix (up to 48 tracks; beyond, 32 prefixes evenly spaced and
+/// all of them), and the prefix of fewest bytes within `limit` is taken.
+/// Where none is within it (tracks of 2 keys alone cost a loose block: the
+/// CMU clip's four constant rotations), `fitted` is kept: the fewest bytes,
+/// its cost reported by [`Reduced::after_cost`].
+fn put_back_for_speed(
+    plan: &Plan,
+    cache: &[Option<(f64, Option<Fit>)>],
+    fitted: Candidate,
+    verify: &dyn Fn(&Arc<tcb_runtime::Clip>) -> metric::Measured,
+    limit: f64,
+) -> Result<Candidate, ReduceError> {
+    if cost::frame_cost(&fitted.compiled, &fitted.clip) <= limit {
+        return Ok(fitted);
+    }
+    let (doc, input) = (&fitted.doc, plan.input.doc);
+    let mut order: Vec<(f64, usize)> = (0..fitted.kept.len())
+        .filter(|&i| !fitted.kept[i] && doc.tracks[i].times.len() > 2)
+        .map(|i| {
+            let share = doc.tracks[i].times.len() as f64 / input.tracks[i].times.len() as f64;
+            (share, i)
+        })
+        .collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let revert = |size: usize| {
+        let mut r = fitted.kept.clone();
+        for &(_, i) in &order[..size] {
+            r[i] = true;
+        }
+        r
+    };
+    let n = order.len();
+    if n == 0 {
+        return Ok(fitted);
+    }
+    let sizes: Vec<usize> = if n <= 48 {
+        (1..=n).collect()
+    } else {
+        let mut s: Vec<usize> = (1..=32).map(|k| k * n / 32).collect();
+        s.dedup();
+        s
+    };
+    type Built = (ClipDoc, Vec<bool>, Clip, Arc<tcb_runtime::Clip>);
+    let build_at = |size: usize| -> Result<Built, ReduceError> {
+        let (doc, kept) = plan.write_fits(cache, &revert(size));
+        let (clip, compiled) = build(&doc)?;
+        Ok((doc, kept, clip, compiled))
+    };
+    // Only bytes and costs are kept: one compiled clip per thread at a time.
+    let tried: Vec<(usize, usize)> = sizes
+        .par_iter()
+        .map(|&size| {
+            let (_, _, clip, compiled) = build_at(size)?;
+            let within = cost::frame_cost(&compiled, &clip) <= limit;
+            Ok(within.then(|| (compiled.memory_bytes(), size)))
+        })
+        .collect::<Result<Vec<_>, ReduceError>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    // Fewest bytes, then fewest tracks put back.
+    let Some((_, size)) = tried.into_iter().min() else {
+        return Ok(fitted);
+    };
+    let (doc, kept, clip, compiled) = build_at(size)?;
     let measured = verify(&compiled);
     if measured.worst.ratio > 1.0 {
         return Ok(fitted);
