@@ -207,11 +207,12 @@ struct ReduceArgs {
     /// glTF input: the animation to reduce, by name or index (default: the first).
     #[arg(long, value_name = "NAME_OR_INDEX")]
     animation: Option<String>,
-    /// Take tracks off the input's shared key grid even where the clip then
-    /// plays slower than the input (by the estimate of instructions per
-    /// frame printed on stderr): the fewest bytes.
+    /// Put fitted tracks back on the input's shared key grid where the
+    /// reduced clip would otherwise play slower than the input (by the
+    /// estimate of instructions per frame printed on stderr), at the cost of
+    /// bytes. Default: the fewest bytes.
     #[arg(long)]
-    allow_slower: bool,
+    never_slower: bool,
     /// Milliseconds for the quick timing of input and output that follows
     /// the reduction (ns per joint per frame, both from one run; 0: none).
     #[arg(long, value_name = "MS", default_value_t = 300)]
@@ -677,7 +678,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         .rotation_tolerance(args.error.rotation_tolerance)
         .knots(args.knots)
         .tangents(args.tangents)
-        .allow_slower(args.allow_slower);
+        .never_slower(args.never_slower);
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,
@@ -716,7 +717,7 @@ fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
         "tcb: estimated runtime cost: input {c0:.0}, output {c1:.0} instructions per frame ({:.2}x){}",
         c1 / c0,
         if c1 > c0 {
-            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (docs/benchmarks.md)"
+            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (--never-slower trades bytes for it; docs/benchmarks.md)"
         } else {
             ""
         }
@@ -725,7 +726,7 @@ fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
         eprintln!(
             "tcb: fits put back on the input's key grid to play no slower than the input: \
              the fewest bytes found ({} keys, {} bytes) would cost {cost:.0} instructions per frame \
-             (--allow-slower keeps them)",
+             (without --never-slower: kept)",
             smaller.keys, smaller.bytes
         );
     }

@@ -29,13 +29,13 @@
 //!    twice a shared grid's bytes per key) are put back on the input's
 //!    keys, those keeping the largest share first, where the compiled clip
 //!    gets smaller and still holds.
-//! 6. Speed: a fit taken off the input's shared key grid plays as a loose
-//!    lane, dearer per frame than its lane in the grid's blocks
-//!    ([`crate::cost`]). Unless the clip's estimated cost per frame is at
-//!    most the input's, fitted tracks (not those of 2 keys) are put back on
-//!    the input's keys where that brings it within the input's cost, with
-//!    the fewest bytes; where nothing does, the fewest bytes are kept and
-//!    the cost reported ([`ReduceOptions::allow_slower`] skips this step).
+//! 6. Speed, with [`ReduceOptions::never_slower`]: a fit taken off the
+//!    input's shared key grid plays as a loose lane, dearer per frame than
+//!    its lane in the grid's blocks ([`crate::cost`]). Unless the clip's
+//!    estimated cost per frame is at most the input's, fitted tracks (not
+//!    those of 2 keys) are put back on the input's keys where that brings it
+//!    within the input's cost, with the fewest bytes; where nothing does,
+//!    the fewest bytes are kept. Either way both costs are reported.
 //!
 //! Tracks the fitter does not take are kept as they are (exact): tracks
 //! whose `linear` or `offset-repeat` extrapolation is checked outside their
@@ -162,11 +162,12 @@ pub struct ReduceOptions {
     pub knots: Knots,
     /// Stored or derived tangents (`--tangents`).
     pub tangents: Tangents,
-    /// Take tracks off their shared key grid even where the clip then
-    /// plays slower than its source (`--allow-slower`): the fewest bytes
-    /// [`reduce`] finds. By default a reduced clip costs no more per frame
-    /// than its source by [`crate::cost::frame_cost`].
-    pub allow_slower: bool,
+    /// Put fitted tracks back on their input's shared key grid where the
+    /// reduced clip would otherwise cost more per frame than its source by
+    /// [`crate::cost::frame_cost`] (`--never-slower`), at the cost of
+    /// bytes. Off by default: the fewest bytes [`reduce`] finds, with both
+    /// costs reported ([`Reduced::before_cost`], [`Reduced::after_cost`]).
+    pub never_slower: bool,
 }
 
 impl ReduceOptions {
@@ -212,10 +213,10 @@ impl ReduceOptions {
         self
     }
 
-    /// These options with [`allow_slower`](Self::allow_slower) set to `on`.
+    /// These options with [`never_slower`](Self::never_slower) set to `on`.
     #[must_use]
-    pub fn allow_slower(mut self, on: bool) -> Self {
-        self.allow_slower = on;
+    pub fn never_slower(mut self, on: bool) -> Self {
+        self.never_slower = on;
         self
     }
 }
@@ -295,8 +296,8 @@ pub struct Reduced {
     /// The output's.
     pub after_cost: f64,
     /// The fewest bytes the fits gave, where they were declined for a
-    /// clip within the input's cost ([`ReduceOptions::allow_slower`] keeps
-    /// them): their counts and estimated cost.
+    /// clip within the input's cost (with [`ReduceOptions::never_slower`]):
+    /// their counts and estimated cost.
     pub declined: Option<(Counts, f64)>,
     /// The measured error of the output, by the metric, on the runtime.
     pub worst: Worst,
@@ -491,7 +492,7 @@ pub fn reduce(
     let (fitted, attempts) = fit_in_rounds(&plan, &mut cache, &verify, progress)?;
     let best = put_back_for_bytes(&plan, &cache, fitted, &verify)?;
     let before_cost = cost::frame_cost(&reference.compiled, input.clip);
-    let (best, declined) = if options.allow_slower {
+    let (best, declined) = if !options.never_slower {
         (best, None)
     } else {
         let smallest = (

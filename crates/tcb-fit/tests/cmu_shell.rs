@@ -164,10 +164,7 @@ fn reduced_cmu_is_within_the_shell_tolerance_at_three_tolerances() {
         let options = ReduceOptions::default()
             .tolerance((scale != 1.0).then_some(scale * default_e))
             .knots(Knots::Track)
-            .tangents(Tangents::Derived)
-            // The fits themselves are under test: kept even where the
-            // clip plays slower than the input (tests/speed.rs).
-            .allow_slower(true);
+            .tangents(Tangents::Derived);
         let input = tcb_fit::reduce::Input {
             doc: &loaded.doc,
             clip: &loaded.clip,

@@ -1,6 +1,7 @@
-//! A reduced clip plays no slower than its source (issue 33, item 3): the
-//! reducer takes tracks off a shared key grid only where the runtime's
-//! layout does not get dearer by `tcb_fit::cost`'s estimate.
+//! With `never_slower`, a reduced clip plays no slower than its source
+//! (issue 33, item 3): the reducer takes tracks off a shared key grid only
+//! where the runtime's layout does not get dearer by `tcb_fit::cost`'s
+//! estimate.
 
 use tcb_core::RotationMode;
 use tcb_fit::{ReduceOptions, cost};
@@ -24,7 +25,8 @@ fn reduce(doc: &tcb_io::ClipDoc, clip: &tcb_core::Clip) -> tcb_fit::Reduced {
         clip,
         skeleton: None,
     };
-    tcb_fit::reduce(input, &ReduceOptions::default(), &|_, _| {}).unwrap()
+    let options = ReduceOptions::default().never_slower(true);
+    tcb_fit::reduce(input, &options, &|_, _| {}).unwrap()
 }
 
 fn cost_of(clip: &tcb_core::Clip) -> f64 {
@@ -108,7 +110,8 @@ fn reduced_cmu_keeps_its_constant_tracks_at_two_keys_and_its_fewest_bytes() {
         clip: &loaded.clip,
         skeleton: loaded.skeleton.as_ref(),
     };
-    let reduced = tcb_fit::reduce(input, &ReduceOptions::default(), &|_, _| {}).unwrap();
+    let options = ReduceOptions::default().never_slower(true);
+    let reduced = tcb_fit::reduce(input, &options, &|_, _| {}).unwrap();
     let line = reduced.summary_line();
     for name in ["LHipJoint", "RHipJoint", "LeftShoulder", "RightShoulder"] {
         let name = format!("{name}.rotation");
