@@ -27,6 +27,10 @@ pub(crate) struct Group {
     pub delta: Vec<f32x8>,
     /// Rotation blocks evaluated exactly on some stored segments.
     pub exact: ExactTable,
+    /// Whether a vector channel stores a non-finite control (a tangent that
+    /// overflowed f32): at a segment's end its value is then copied, not
+    /// summed (`0 x inf`).
+    pub unbounded: bool,
 }
 
 impl Group {
@@ -85,6 +89,11 @@ fn sample_segment(
     if g.vec_blocks > 0 {
         let out = &mut values[g.vec_out..g.vec_out + g.vec_blocks];
         kernel::vectors(cv, h, out);
+        if g.unbounded && f.h == [0.0, 1.0, 0.0, 0.0] {
+            // At the segment's end the value is its key, as the reference
+            // has it, even beside a tangent that overflowed f32 (0 x inf).
+            out.copy_from_slice(&cv.p1[..out.len()]);
+        }
         if f.cycles != 0.0 && !g.delta.is_empty() {
             kernel::offset(&g.delta, f32x8::splat(f.cycles), out);
         }

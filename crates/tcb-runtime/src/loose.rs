@@ -32,6 +32,7 @@ use tcb_core::Extrapolation;
 use tcb_core::ease::{SegmentEase, ease};
 use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use tcb_core::simd::extrapolate::{ModeLanes, map_lanes};
+use tcb_core::simd::lane::Lane;
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 
@@ -217,6 +218,8 @@ fn put_controls<const N: usize>(
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Loose {
     pub lanes: Vec<LooseLane>,
+    /// Whether any block stores a non-finite control (`Block::unbounded`).
+    unbounded: bool,
     pub blocks: usize,
     /// First pose block (4 planes per block).
     pub out: usize,
@@ -250,6 +253,10 @@ struct Block {
     inner: [f64; 2],
     /// Whether any lane has an eased segment.
     eased: bool,
+    /// Whether any lane stores a non-finite control (a tangent that
+    /// overflowed f32): at a segment's end its value is then selected, not
+    /// summed (`0 x inf`).
+    unbounded: bool,
     /// Its planes in the instance's controls (`[P0, P1, M0, M1]` per
     /// component in use, the widest track's dimension).
     ctl: std::ops::Range<usize>,
@@ -323,6 +330,11 @@ impl Loose {
                         block_lanes(b).map(last).fold(f64::INFINITY, f64::min),
                     ],
                     eased: block_lanes(b).any(|l| l.grid.eases.iter().any(|e| !e.is_none())),
+                    unbounded: block_lanes(b).any(|l| match &l.keys {
+                        Keys::F32(k) => k.iter().flatten().any(|x| !x.is_finite()),
+                        // Quantized lanes are finite (quant keeps the rest in f32).
+                        Keys::U16 { .. } => false,
+                    }),
                     ctl: ctl_planes - planes..ctl_planes,
                 }
             })
@@ -335,6 +347,7 @@ impl Loose {
         }
         let (order, seek_after) = key_order(&lanes);
         Loose {
+            unbounded: block.iter().any(|b| b.unbounded),
             seek_after,
             block,
             ctl_planes,
@@ -809,7 +822,26 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
 ///
 /// `ROTATIONS`: the lanes are rotations, each block normalized
 /// ([`crate::kernel::normalize_block`]) as soon as it is evaluated.
+#[inline(always)]
 pub(crate) fn sample<const ROTATIONS: bool>(
+    loose: &Loose,
+    st: &mut LooseState,
+    time: f64,
+    values: &mut [f32x8],
+    velocities: Option<&mut [f32x8]>,
+) {
+    // Once per frame, so that the blocks' loop of the usual set (finite
+    // controls) has no test for the other.
+    if loose.unbounded {
+        sample_blocks::<ROTATIONS, true>(loose, st, time, values, velocities);
+    } else {
+        sample_blocks::<ROTATIONS, false>(loose, st, time, values, velocities);
+    }
+}
+
+/// [`sample`], with `UNBOUNDED` where some block stores a non-finite
+/// control.
+fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool>(
     loose: &Loose,
     st: &mut LooseState,
     time: f64,
@@ -836,6 +868,14 @@ pub(crate) fn sample<const ROTATIONS: bool>(
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
                 *o = hermite(&h, k[0], k[1], k[2], k[3]);
+            }
+            if UNBOUNDED && info.unbounded {
+                // At a segment's end the value is its key, as the reference
+                // has it, even beside a tangent that overflowed f32 (0 x inf).
+                let at_end = Lane::eq(s, f32x8::ONE);
+                for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
+                    *o = Lane::select(at_end, k[1], *o);
+                }
             }
             if let Some(vel) = velocities.as_deref_mut() {
                 let dh = hermite_basis_derivative(s);

@@ -362,7 +362,11 @@ fn build_group(
         bound_quantization(&err, vectors, rotations, vec_blocks, per_track);
     }
     let controls: Vec<&RotationControls> = rotations.iter().map(|r| &r.controls).collect();
+    let unbounded = vectors
+        .iter()
+        .any(|r| r.controls.iter().flatten().any(|x| !x.is_finite()));
     Group {
+        unbounded,
         vector_channels: vectors.len(),
         rotations: rotations.len(),
         exact: exact_table(&controls, segments),
