@@ -25,6 +25,13 @@
 #define TCB_LOAD_EXACT_VELOCITIES 2
 
 /**
+ * `tcb_clip_load_*` flag: import BVH rotations as `hermite` tracks (one
+ * cubic per segment, the fastest to sample) rather than the default
+ * `squad` (`tcb import --rotation hermite`). Other formats keep theirs.
+ */
+#define TCB_LOAD_HERMITE_ROTATIONS 4
+
+/**
  * `tcb_instance_new*` flag: sample velocities (d/dt of every channel) as
  * well as values, for `tcb_instance_sample_with_velocities` (about twice
  * the work per sample).
@@ -48,6 +55,12 @@
  * matrix, column-major.
  */
 #define TCB_MATRIX_FLOATS 16
+
+/**
+ * Floats per joint in `tcb_skeleton_local_transforms`'s output:
+ * translation `x y z`, rotation `x y z w`, scale `x y z`.
+ */
+#define TCB_TRANSFORM_FLOATS 10
 
 /**
  * What a call did. Every function that can fail returns one; on anything
@@ -230,6 +243,23 @@ extern "C" {
  * writing a pointer.
  */
 enum TcbStatus tcb_clip_load_file(const char *path, uint32_t flags, struct TcbClip **out);
+
+/**
+ * `tcb_clip_load_file` of one animation of a glTF file: `animation` is its
+ * name or its index as text (`"walk"`, `"2"`); NULL takes the first, as
+ * `tcb_clip_load_file` does. A name the file lacks is
+ * `TCB_STATUS_INVALID_DATA`, with the file's animations in the message.
+ * Other formats ignore `animation`.
+ *
+ * # Safety
+ *
+ * `path` is NULL or a NUL-terminated string; `animation` is NULL or a
+ * NUL-terminated string; `out` is NULL or valid for writing a pointer.
+ */
+enum TcbStatus tcb_clip_load_file_animation(const char *path,
+                                            const char *animation,
+                                            uint32_t flags,
+                                            struct TcbClip **out);
 
 /**
  * Load a clip from `len` bytes in memory and compile it. `format` names
@@ -800,6 +830,39 @@ enum TcbStatus tcb_skeleton_model_matrices_pose(struct TcbSkeleton *skeleton,
                                                 const struct TcbPose *pose,
                                                 float *out,
                                                 size_t len);
+
+/**
+ * Write every joint's transform relative to its parent, from `instance`'s
+ * last sample, into `out`: per joint in joint order 10 floats,
+ * translation `x y z`, rotation quaternion `x y z w`, scale `x y z` (parts
+ * no track animates: the joint's rest values), for an engine that composes
+ * its own hierarchy. `len` must be 10 times `tcb_skeleton_joint_count`.
+ * Errors as `tcb_skeleton_model_matrices`; allocates nothing.
+ *
+ * # Safety
+ *
+ * `skeleton` is NULL or a live skeleton used by no other thread;
+ * `instance` is NULL or a live instance not sampled during the call; `out`
+ * is NULL or valid for `len` floats of writes.
+ */
+enum TcbStatus tcb_skeleton_local_transforms(struct TcbSkeleton *skeleton,
+                                             const struct TcbInstance *instance,
+                                             float *out,
+                                             size_t len);
+
+/**
+ * `tcb_skeleton_local_transforms` of a pose (a blend's output).
+ *
+ * # Safety
+ *
+ * `skeleton` is NULL or a live skeleton used by no other thread; `pose` is
+ * NULL or a live pose not written during the call; `out` is NULL or valid
+ * for `len` floats of writes.
+ */
+enum TcbStatus tcb_skeleton_local_transforms_pose(struct TcbSkeleton *skeleton,
+                                                  const struct TcbPose *pose,
+                                                  float *out,
+                                                  size_t len);
 
 #ifdef __cplusplus
 }  // extern "C"

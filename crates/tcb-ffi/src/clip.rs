@@ -19,6 +19,11 @@ pub const TCB_LOAD_QUANTIZE: u32 = 1;
 /// velocities with another implementation). Ignored for `.tcbc` files.
 pub const TCB_LOAD_EXACT_VELOCITIES: u32 = 2;
 
+/// `tcb_clip_load_*` flag: import BVH rotations as `hermite` tracks (one
+/// cubic per segment, the fastest to sample) rather than the default
+/// `squad` (`tcb import --rotation hermite`). Other formats keep theirs.
+pub const TCB_LOAD_HERMITE_ROTATIONS: u32 = 4;
+
 /// A compiled clip, ready to be played by instances, and the skeleton its
 /// file carried (if any). Immutable once loaded: one clip may be used by
 /// any number of instances on any threads at once. Instances, rigs and
@@ -29,7 +34,7 @@ pub struct TcbClip {
 }
 
 fn compile_options(flags: u32) -> Result<CompileOptions> {
-    let known = TCB_LOAD_QUANTIZE | TCB_LOAD_EXACT_VELOCITIES;
+    let known = TCB_LOAD_QUANTIZE | TCB_LOAD_EXACT_VELOCITIES | TCB_LOAD_HERMITE_ROTATIONS;
     if flags & !known != 0 {
         return Err(Failure::invalid(format!(
             "unknown load flags {:#x}",
@@ -58,7 +63,16 @@ fn compiled(clip: &tcb_core::Clip, skeleton: Option<Skeleton>, flags: u32) -> Re
     })
 }
 
-fn load_file(path: &str, flags: u32) -> Result<TcbClip> {
+/// The BVH rotation mode `flags` ask for.
+fn rotation(flags: u32) -> tcb_core::RotationMode {
+    if flags & TCB_LOAD_HERMITE_ROTATIONS != 0 {
+        tcb_core::RotationMode::Hermite
+    } else {
+        tcb_core::RotationMode::default()
+    }
+}
+
+fn load_file(path: &str, animation: Option<&str>, flags: u32) -> Result<TcbClip> {
     let path = Path::new(path);
     let ext = path
         .extension()
@@ -81,7 +95,10 @@ fn load_file(path: &str, flags: u32) -> Result<TcbClip> {
         let bytes = std::fs::read(path).map_err(io)?;
         return packed(&bytes, &path.display().to_string());
     }
-    let loaded = tcb_io::load(path)?;
+    let options = tcb_io::ImportOptions::default()
+        .rotation(rotation(flags))
+        .animation(animation.map(str::to_string));
+    let loaded = tcb_io::load_with(path, &options)?;
     compiled(&loaded.clip, loaded.skeleton, flags)
 }
 
@@ -101,7 +118,7 @@ fn load_memory(bytes: &[u8], format: &str, flags: u32) -> Result<TcbClip> {
         }
         "bvh" => {
             let bvh = tcb_io::bvh::Bvh::parse(text()?)?;
-            let doc = bvh.to_clip_doc("clip", tcb_core::RotationMode::default())?;
+            let doc = bvh.to_clip_doc("clip", rotation(flags))?;
             (doc.build()?, doc.skeleton)
         }
         "gltf" | "glb" => {
@@ -144,7 +161,41 @@ pub unsafe extern "C" fn tcb_clip_load_file(
         unsafe { ptr::clear_out(out, "out")? };
         // SAFETY: `path` is NULL or NUL-terminated, as the caller promises.
         let path = unsafe { ptr::str(path, "path")? };
-        let clip = load_file(path, flags)?;
+        let clip = load_file(path, None, flags)?;
+        // SAFETY: checked by `clear_out` above.
+        unsafe { ptr::give(out, clip) };
+        Ok(())
+    })
+}
+
+/// `tcb_clip_load_file` of one animation of a glTF file: `animation` is its
+/// name or its index as text (`"walk"`, `"2"`); NULL takes the first, as
+/// `tcb_clip_load_file` does. A name the file lacks is
+/// `TCB_STATUS_INVALID_DATA`, with the file's animations in the message.
+/// Other formats ignore `animation`.
+///
+/// # Safety
+///
+/// `path` is NULL or a NUL-terminated string; `animation` is NULL or a
+/// NUL-terminated string; `out` is NULL or valid for writing a pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn tcb_clip_load_file_animation(
+    path: *const c_char,
+    animation: *const c_char,
+    flags: u32,
+    out: *mut *mut TcbClip,
+) -> TcbStatus {
+    guard(|| {
+        // SAFETY: `out` is NULL or writable, as the caller promises.
+        unsafe { ptr::clear_out(out, "out")? };
+        // SAFETY: `path` is NULL or NUL-terminated, as the caller promises.
+        let path = unsafe { ptr::str(path, "path")? };
+        let animation = match animation.is_null() {
+            true => None,
+            // SAFETY: non-NULL and NUL-terminated, as the caller promises.
+            false => Some(unsafe { ptr::str(animation, "animation")? }),
+        };
+        let clip = load_file(path, animation, flags)?;
         // SAFETY: checked by `clear_out` above.
         unsafe { ptr::give(out, clip) };
         Ok(())

@@ -35,7 +35,8 @@
 //! vec3, `x y z w` for a rotation quaternion, one float for a scalar). A
 //! track's first float is its `TcbTrackInfo::offset` (`tcb_clip_find_track`,
 //! `tcb_rig_find_track`). Model matrices (`tcb_skeleton_model_matrices`)
-//! are 16 floats a joint, column-major.
+//! are 16 floats a joint, column-major; local transforms
+//! (`tcb_skeleton_local_transforms`) 10: translation, rotation, scale.
 //!
 //! ## The contract
 //!
@@ -67,10 +68,10 @@ mod rig;
 mod skeleton;
 
 pub use clip::{
-    TCB_LOAD_EXACT_VELOCITIES, TCB_LOAD_QUANTIZE, TcbClip, tcb_clip_channel_count,
-    tcb_clip_find_track, tcb_clip_free, tcb_clip_has_skeleton, tcb_clip_load_file,
-    tcb_clip_load_memory, tcb_clip_time_range, tcb_clip_track_count, tcb_clip_track_info,
-    tcb_clip_track_name,
+    TCB_LOAD_EXACT_VELOCITIES, TCB_LOAD_HERMITE_ROTATIONS, TCB_LOAD_QUANTIZE, TcbClip,
+    tcb_clip_channel_count, tcb_clip_find_track, tcb_clip_free, tcb_clip_has_skeleton,
+    tcb_clip_load_file, tcb_clip_load_file_animation, tcb_clip_load_memory, tcb_clip_time_range,
+    tcb_clip_track_count, tcb_clip_track_info, tcb_clip_track_name,
 };
 pub use error::{TcbStatus, tcb_last_error_message, tcb_version};
 pub use instance::{
@@ -89,8 +90,9 @@ pub use rig::{
     tcb_rig_from_skeleton, tcb_rig_track_count, tcb_rig_track_info, tcb_rig_track_name,
 };
 pub use skeleton::{
-    TCB_MATRIX_FLOATS, TcbSkeleton, tcb_skeleton_find_joint, tcb_skeleton_free,
-    tcb_skeleton_joint_count, tcb_skeleton_joint_name, tcb_skeleton_joint_parent,
+    TCB_MATRIX_FLOATS, TCB_TRANSFORM_FLOATS, TcbSkeleton, tcb_skeleton_find_joint,
+    tcb_skeleton_free, tcb_skeleton_joint_count, tcb_skeleton_joint_name,
+    tcb_skeleton_joint_parent, tcb_skeleton_local_transforms, tcb_skeleton_local_transforms_pose,
     tcb_skeleton_model_matrices, tcb_skeleton_model_matrices_pose, tcb_skeleton_new,
     tcb_skeleton_new_for_rig,
 };

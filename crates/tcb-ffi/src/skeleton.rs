@@ -16,6 +16,9 @@ use tcb_runtime::{Pose, PoseLayout, SkeletonBinding};
 /// Floats per joint in `tcb_skeleton_model_matrices`'s output: a 4x4
 /// matrix, column-major.
 pub const TCB_MATRIX_FLOATS: usize = 16;
+/// Floats per joint in `tcb_skeleton_local_transforms`'s output:
+/// translation `x y z`, rotation `x y z w`, scale `x y z`.
+pub const TCB_TRANSFORM_FLOATS: usize = 10;
 
 /// A joint hierarchy bound to the poses of one layout (a clip's or a
 /// rig's): each joint's `<joint>.translation`, `.rotation` and `.scale`
@@ -230,14 +233,27 @@ pub unsafe extern "C" fn tcb_skeleton_find_joint(
     })
 }
 
-/// Model-space matrices of `pose` into the caller's floats.
-fn matrices(s: &mut TcbSkeleton, pose: &Pose, out: &mut [f32]) -> Result<()> {
-    let want = TCB_MATRIX_FLOATS * s.model.len();
+/// What a skeleton writes per joint.
+#[derive(Clone, Copy)]
+enum Output {
+    /// `TCB_MATRIX_FLOATS`: model-space matrices.
+    Model,
+    /// `TCB_TRANSFORM_FLOATS`: local translation, rotation, scale.
+    Local,
+}
+
+/// Joint transforms of `pose` into the caller's floats.
+fn write(s: &mut TcbSkeleton, pose: &Pose, out: &mut [f32], what: Output) -> Result<()> {
+    let per = match what {
+        Output::Model => TCB_MATRIX_FLOATS,
+        Output::Local => TCB_TRANSFORM_FLOATS,
+    };
+    let want = per * s.model.len();
     if out.len() != want {
         return Err(Failure::new(
             TcbStatus::BufferLength,
             format!(
-                "out has {} floats; {} joints take {want} (16 each)",
+                "out has {} floats; {} joints take {want} ({per} each)",
                 out.len(),
                 s.model.len()
             ),
@@ -256,9 +272,21 @@ fn matrices(s: &mut TcbSkeleton, pose: &Pose, out: &mut [f32]) -> Result<()> {
         model,
         ..
     } = s;
-    binding.model_transforms(pose, local, model);
-    for (m, o) in model.iter().zip(out.chunks_exact_mut(TCB_MATRIX_FLOATS)) {
-        o.copy_from_slice(&Mat4::from(*m).to_cols_array());
+    match what {
+        Output::Model => {
+            binding.model_transforms(pose, local, model);
+            for (m, o) in model.iter().zip(out.chunks_exact_mut(per)) {
+                o.copy_from_slice(&Mat4::from(*m).to_cols_array());
+            }
+        }
+        Output::Local => {
+            binding.local_transforms(pose, local);
+            for (t, o) in local.iter().zip(out.chunks_exact_mut(per)) {
+                o[0..3].copy_from_slice(&t.translation.to_array());
+                o[3..7].copy_from_slice(&t.rotation.to_array());
+                o[7..10].copy_from_slice(&t.scale.to_array());
+            }
+        }
     }
     Ok(())
 }
@@ -295,7 +323,7 @@ pub unsafe extern "C" fn tcb_skeleton_model_matrices(
                 ptr::slice_mut(out, len, "out")?,
             )
         };
-        matrices(s, inst.inst.pose(), out)
+        write(s, inst.inst.pose(), out, Output::Model)
     })
 }
 
@@ -323,6 +351,67 @@ pub unsafe extern "C" fn tcb_skeleton_model_matrices_pose(
                 ptr::slice_mut(out, len, "out")?,
             )
         };
-        matrices(s, &pose.pose, out)
+        write(s, &pose.pose, out, Output::Model)
+    })
+}
+
+/// Write every joint's transform relative to its parent, from `instance`'s
+/// last sample, into `out`: per joint in joint order 10 floats,
+/// translation `x y z`, rotation quaternion `x y z w`, scale `x y z` (parts
+/// no track animates: the joint's rest values), for an engine that composes
+/// its own hierarchy. `len` must be 10 times `tcb_skeleton_joint_count`.
+/// Errors as `tcb_skeleton_model_matrices`; allocates nothing.
+///
+/// # Safety
+///
+/// `skeleton` is NULL or a live skeleton used by no other thread;
+/// `instance` is NULL or a live instance not sampled during the call; `out`
+/// is NULL or valid for `len` floats of writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn tcb_skeleton_local_transforms(
+    skeleton: *mut TcbSkeleton,
+    instance: *const TcbInstance,
+    out: *mut f32,
+    len: usize,
+) -> TcbStatus {
+    guard(|| {
+        // SAFETY: NULL or live handles (the skeleton used by no one else)
+        // and `len` writable floats, as the caller promises.
+        let (s, inst, out) = unsafe {
+            (
+                ptr::get_mut(skeleton, "skeleton")?,
+                ptr::get(instance, "instance")?,
+                ptr::slice_mut(out, len, "out")?,
+            )
+        };
+        write(s, inst.inst.pose(), out, Output::Local)
+    })
+}
+
+/// `tcb_skeleton_local_transforms` of a pose (a blend's output).
+///
+/// # Safety
+///
+/// `skeleton` is NULL or a live skeleton used by no other thread; `pose` is
+/// NULL or a live pose not written during the call; `out` is NULL or valid
+/// for `len` floats of writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn tcb_skeleton_local_transforms_pose(
+    skeleton: *mut TcbSkeleton,
+    pose: *const TcbPose,
+    out: *mut f32,
+    len: usize,
+) -> TcbStatus {
+    guard(|| {
+        // SAFETY: NULL or live handles (the skeleton used by no one else)
+        // and `len` writable floats, as the caller promises.
+        let (s, pose, out) = unsafe {
+            (
+                ptr::get_mut(skeleton, "skeleton")?,
+                ptr::get(pose, "pose")?,
+                ptr::slice_mut(out, len, "out")?,
+            )
+        };
+        write(s, &pose.pose, out, Output::Local)
     })
 }

@@ -135,6 +135,20 @@ fn cmu_rows_and_matrices_match_the_runtime() {
                 &glam::Mat4::from(*a).to_cols_array()
             );
         }
+        // Local transforms: translation, rotation, scale per joint.
+        binding.local_transforms(rust.pose(), &mut local);
+        let mut l = vec![0.0f32; joints * 10];
+        let status = tcb_skeleton_local_transforms(skel, inst, l.as_mut_ptr(), l.len());
+        assert_eq!(status, TcbStatus::Ok);
+        for (j, t) in local.iter().enumerate() {
+            let want: Vec<f32> = (t.translation.to_array().into_iter())
+                .chain(t.rotation.to_array())
+                .chain(t.scale.to_array())
+                .collect();
+            assert_eq!(&l[10 * j..10 * j + 10], &want[..], "joint {j}");
+        }
+        let status = tcb_skeleton_local_transforms(skel, inst, l.as_mut_ptr(), 16 * joints);
+        fails(status, TcbStatus::BufferLength, "(10 each)");
         // Joint queries.
         let mut head = 0usize;
         let name = c("Head");
@@ -789,5 +803,56 @@ fn rigs_blends_and_playback() {
         tcb_pose_free(pose);
         tcb_rig_free(clip_rig);
         tcb_clip_free(other);
+    }
+}
+
+/// glTF animations chosen by name or index; BVH rotations as hermite.
+#[test]
+fn import_options() {
+    let gltf = c(data("simple_skin.gltf").to_str().unwrap());
+    let load_animation = |animation: Option<&str>| {
+        let name = animation.map(c);
+        let mut clip = null_mut();
+        let a = name.as_ref().map_or(null(), |n| n.as_ptr());
+        // SAFETY: NUL-terminated strings or NULL, and a writable out pointer.
+        let status = unsafe { tcb_clip_load_file_animation(gltf.as_ptr(), a, 0, &mut clip) };
+        (status, clip)
+    };
+    for animation in [None, Some("0")] {
+        let (status, clip) = load_animation(animation);
+        assert_eq!(status, TcbStatus::Ok, "{}", message());
+        // SAFETY: a live clip.
+        unsafe {
+            assert!(tcb_clip_has_skeleton(clip));
+            assert!(tcb_clip_track_count(clip) > 0);
+            tcb_clip_free(clip);
+        }
+    }
+    let (status, clip) = load_animation(Some("nope"));
+    fails(status, TcbStatus::InvalidData, "nope");
+    assert!(clip.is_null());
+
+    let path = data("cmu-01_01.bvh");
+    let p = c(path.to_str().unwrap());
+    let mut clip = null_mut();
+    // SAFETY: a NUL-terminated path and a writable out pointer.
+    let status = unsafe { tcb_clip_load_file(p.as_ptr(), TCB_LOAD_HERMITE_ROTATIONS, &mut clip) };
+    assert_eq!(status, TcbStatus::Ok);
+    let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
+    let loaded = tcb_io::load_with(&path, &options).unwrap();
+    let mut rust = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(&loaded.clip)));
+    let inst = instance(clip, 0);
+    // SAFETY: live handles and rows of the lengths given.
+    unsafe {
+        let n = tcb_instance_channel_count(inst);
+        let (mut row, mut want) = (vec![0.0f32; n], vec![0.0f32; n]);
+        assert_eq!(
+            tcb_instance_sample(inst, 2.2, row.as_mut_ptr(), n),
+            TcbStatus::Ok
+        );
+        rust.sample_to(2.2, &mut want).unwrap();
+        assert_eq!(row, want);
+        tcb_instance_free(inst);
+        tcb_clip_free(clip);
     }
 }

@@ -81,6 +81,7 @@ fn per_frame_calls_allocate_nothing() {
         let rn = tcb_rig_channel_count(rig);
         let (mut row, mut velocity, mut rig_row) = (vec![0.0; n], vec![0.0; n], vec![0.0; rn]);
         let mut matrices = vec![0.0; 16 * tcb_skeleton_joint_count(skel)];
+        let mut locals = vec![0.0; 10 * tcb_skeleton_joint_count(skel)];
         let layers = [a as *const TcbInstance, b as *const TcbInstance];
         let name = CString::new("LeftHand.rotation").unwrap();
         let mut info = TcbTrackInfo::default();
@@ -103,6 +104,12 @@ fn per_frame_calls_allocate_nothing() {
                 plain,
                 matrices.as_mut_ptr(),
                 matrices.len(),
+            ));
+            ok(tcb_skeleton_local_transforms(
+                skel,
+                plain,
+                locals.as_mut_ptr(),
+                locals.len(),
             ));
             ok(tcb_instance_update(a, t));
             ok(tcb_instance_sample(b, t + 3.0, rig_row.as_mut_ptr(), rn));

@@ -64,6 +64,13 @@ int main(int argc, char **argv) {
     const float *m = matrices + hand * TCB_MATRIX_FLOATS;
     printf("LeftHand model position at %.2f s: %.4f %.4f %.4f (of %zu joints)\n", t, m[12],
            m[13], m[14], joints);
+    /* Or each joint's local translation, rotation, scale (10 floats a joint). */
+    float *locals = malloc(joints * TCB_TRANSFORM_FLOATS * sizeof *locals);
+    if (!locals) return 1;
+    CHECK(tcb_skeleton_local_transforms(skel, inst, locals, joints * TCB_TRANSFORM_FLOATS));
+    printf("Hips local rotation: %.4f %.4f %.4f %.4f\n", locals[3], locals[4], locals[5],
+           locals[6]);
+    free(locals);
 
     /* Cross-fade two instances through a rig into a pose of the rig. */
     TcbRig *rig = NULL;
