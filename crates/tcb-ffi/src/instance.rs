@@ -244,7 +244,27 @@ pub unsafe extern "C" fn tcb_instance_sample_with_velocities(
     guard(|| {
         // SAFETY: NULL or a live instance used by no one else, as the caller promises.
         let inst = unsafe { ptr::get_mut(instance, "instance")? };
-        // SAFETY: NULL or writable floats that do not overlap, as the caller promises.
+        for (p, len, what) in [
+            (values, values_len, "values"),
+            (velocities, velocities_len, "velocities"),
+        ] {
+            if p.is_null() && len > 0 {
+                return Err(Failure::new(
+                    TcbStatus::NullPointer,
+                    format!("{what} is NULL"),
+                ));
+            }
+        }
+        let (a, b) = (values as usize, velocities as usize);
+        let bytes = |len: usize| len.saturating_mul(size_of::<f32>());
+        if values_len > 0
+            && velocities_len > 0
+            && a < b.saturating_add(bytes(velocities_len))
+            && b < a.saturating_add(bytes(values_len))
+        {
+            return Err(Failure::invalid("values and velocities overlap"));
+        }
+        // SAFETY: NULL or writable floats, checked not to overlap above.
         let (values, velocities) = unsafe {
             (
                 ptr::slice_mut(values, values_len, "values")?,

@@ -409,9 +409,51 @@ fn wrong_lengths_write_nothing() {
             tcb_instance_sample_with_velocities(inst, 0.5, row.as_mut_ptr(), n, v.as_mut_ptr(), 2);
         fails(status, TcbStatus::BufferLength, "velocities");
         assert!(row.iter().chain(&v).all(|&x| x == -7.0));
+        let status = tcb_instance_sample_with_velocities(
+            inst,
+            0.5,
+            row.as_mut_ptr(),
+            n,
+            row.as_mut_ptr().add(1),
+            n,
+        );
+        fails(status, TcbStatus::InvalidArgument, "overlap");
         let status =
             tcb_instance_sample_with_velocities(inst, 0.5, row.as_mut_ptr(), n, v.as_mut_ptr(), n);
         assert_eq!(status, TcbStatus::Ok);
+        // The same as the Rust instance's, and as a blend of it alone.
+        let loaded = tcb_io::ClipDoc::parse(
+            &tcb_io::bvh::Bvh::parse(BVH)
+                .unwrap()
+                .to_clip_doc("clip", Default::default())
+                .unwrap()
+                .to_json(),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let mut rust = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(&loaded)))
+            .with_velocities();
+        let (mut want, mut want_v) = (vec![0.0f32; n], vec![0.0f32; n]);
+        rust.sample(0.5).write_row(&mut want, Some(&mut want_v));
+        assert_eq!((&row[..n], &v[..]), (&want[..], &want_v[..]));
+        let mut pose = null_mut();
+        assert_eq!(
+            tcb_pose_new_for_clip(clip, TCB_POSE_VELOCITIES, &mut pose),
+            TcbStatus::Ok
+        );
+        let layers = [inst as *const TcbInstance];
+        assert_eq!(
+            tcb_blend(pose, layers.as_ptr(), [1.0f32].as_ptr(), 1),
+            TcbStatus::Ok
+        );
+        let mut pv = vec![0.0f32; n];
+        assert_eq!(
+            tcb_pose_read_velocities(pose, pv.as_mut_ptr(), n),
+            TcbStatus::Ok
+        );
+        assert_eq!(pv, want_v);
+        tcb_pose_free(pose);
         assert!(v.iter().any(|&x| x != 0.0 && x != -7.0));
 
         let mut skel = null_mut();
