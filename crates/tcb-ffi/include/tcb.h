@@ -594,6 +594,23 @@ enum TcbStatus tcb_blend(struct TcbPose *out,
                          size_t count);
 
 /**
+ * `tcb_blend`, with each layer weighing only on the tracks its clip
+ * animates: for instances made with a rig, the tracks their clip lacks
+ * (which hold the rig's rest values) do not pull the blend towards the
+ * rest pose. A track no layer animates keeps the first layer's value.
+ * (Without a rig every track is animated, and this is `tcb_blend`.)
+ * Allocates nothing for up to `TCB_BLEND_STACK_LAYERS` layers.
+ *
+ * # Safety
+ *
+ * As `tcb_blend`.
+ */
+enum TcbStatus tcb_blend_covered(struct TcbPose *out,
+                                 const struct TcbInstance *const *layers,
+                                 const float *weights,
+                                 size_t count);
+
+/**
  * Add an additive layer to `pose` in place: `pose` plus `weight` times
  * (`layer`'s last sample minus `reference`'s), per track (rotations: the
  * rotation from the reference to the layer, scaled by `weight`, composed

@@ -6,7 +6,7 @@ use crate::error::{Failure, Result, TcbStatus, guard, guard_value};
 use crate::layout;
 use crate::ptr;
 use crate::rig::TcbRig;
-use tcb_runtime::{Instance, Playback};
+use tcb_runtime::{BlendMask, Instance, Playback};
 
 /// `tcb_instance_new*` flag: sample velocities (d/dt of every channel) as
 /// well as values, for `tcb_instance_sample_with_velocities` (about twice
@@ -33,6 +33,9 @@ pub enum TcbPlayback {
 /// may be sampled on distinct threads). Keeps its clip (and rig) alive.
 pub struct TcbInstance {
     pub(crate) inst: Instance,
+    /// Per track of its pose: 1 where its clip animates it, 0 where it
+    /// keeps the rig's rest value (`tcb_blend_covered`); made once here.
+    pub(crate) coverage: BlendMask,
 }
 
 fn flags_ok(flags: u32) -> Result<bool> {
@@ -47,7 +50,8 @@ fn flags_ok(flags: u32) -> Result<bool> {
 
 fn with_velocities(inst: Instance, on: bool) -> TcbInstance {
     let inst = if on { inst.with_velocities() } else { inst };
-    TcbInstance { inst }
+    let coverage = inst.coverage_mask();
+    TcbInstance { inst, coverage }
 }
 
 /// A new instance of `clip`, playing in `TCB_PLAYBACK_CLIP` mode at

@@ -82,8 +82,8 @@ pub use instance::{
 pub use layout::{TcbTrackInfo, TcbTrackKind};
 pub use pose::{
     TCB_BLEND_STACK_LAYERS, TCB_POSE_VELOCITIES, TcbPose, tcb_blend, tcb_blend_add,
-    tcb_pose_channel_count, tcb_pose_free, tcb_pose_new_for_clip, tcb_pose_new_for_rig,
-    tcb_pose_read, tcb_pose_read_velocities,
+    tcb_blend_covered, tcb_pose_channel_count, tcb_pose_free, tcb_pose_new_for_clip,
+    tcb_pose_new_for_rig, tcb_pose_read, tcb_pose_read_velocities,
 };
 pub use rig::{
     TcbRig, tcb_rig_channel_count, tcb_rig_find_track, tcb_rig_free, tcb_rig_from_clip,

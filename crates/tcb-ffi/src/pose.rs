@@ -202,6 +202,43 @@ pub unsafe extern "C" fn tcb_blend(
     weights: *const f32,
     count: usize,
 ) -> TcbStatus {
+    // SAFETY: as the caller promises.
+    unsafe { blend_layers(out, layers, weights, count, false) }
+}
+
+/// `tcb_blend`, with each layer weighing only on the tracks its clip
+/// animates: for instances made with a rig, the tracks their clip lacks
+/// (which hold the rig's rest values) do not pull the blend towards the
+/// rest pose. A track no layer animates keeps the first layer's value.
+/// (Without a rig every track is animated, and this is `tcb_blend`.)
+/// Allocates nothing for up to `TCB_BLEND_STACK_LAYERS` layers.
+///
+/// # Safety
+///
+/// As `tcb_blend`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn tcb_blend_covered(
+    out: *mut TcbPose,
+    layers: *const *const TcbInstance,
+    weights: *const f32,
+    count: usize,
+) -> TcbStatus {
+    // SAFETY: as the caller promises.
+    unsafe { blend_layers(out, layers, weights, count, true) }
+}
+
+/// `tcb_blend` and `tcb_blend_covered`.
+///
+/// # Safety
+///
+/// As `tcb_blend`.
+unsafe fn blend_layers(
+    out: *mut TcbPose,
+    layers: *const *const TcbInstance,
+    weights: *const f32,
+    count: usize,
+    covered: bool,
+) -> TcbStatus {
     guard(|| {
         // SAFETY: NULL or a live pose used by no one else, as the caller promises.
         let out = unsafe { ptr::get_mut(out, "out")? };
@@ -223,21 +260,24 @@ pub unsafe extern "C" fn tcb_blend(
         };
         // SAFETY: checked non-NULL above; live, as the caller promises.
         let first = unsafe { &*first };
-        let layer = |i: usize| {
-            // SAFETY: checked non-NULL in the loop above; live, as the caller promises.
-            let inst = unsafe { &*layers[i] };
-            (inst.inst.pose(), weights[i])
-        };
+        // SAFETY: checked non-NULL above; live, as the caller promises.
+        let inst = |i: usize| unsafe { &*layers[i] };
+        let layer = |i: usize| (inst(i).inst.pose(), weights[i]);
         let mismatch = |e: blend::BlendError| Failure::new(TcbStatus::Mismatch, e.to_string());
         if count <= TCB_BLEND_STACK_LAYERS {
             let mut stack = [(first.inst.pose(), 0.0); TCB_BLEND_STACK_LAYERS];
-            for (i, s) in stack.iter_mut().enumerate().take(count) {
-                *s = layer(i);
+            let mut masks = [&first.coverage; TCB_BLEND_STACK_LAYERS];
+            for i in 0..count {
+                stack[i] = layer(i);
+                masks[i] = &inst(i).coverage;
             }
-            blend(&mut out.pose, &stack[..count], None).map_err(mismatch)
+            let masks = covered.then_some(&masks[..count]);
+            blend(&mut out.pose, &stack[..count], masks).map_err(mismatch)
         } else {
             let all: Vec<_> = (0..count).map(layer).collect();
-            blend(&mut out.pose, &all, None).map_err(mismatch)
+            let masks: Vec<_> = (0..count).map(|i| &inst(i).coverage).collect();
+            let masks = covered.then_some(&masks[..]);
+            blend(&mut out.pose, &all, masks).map_err(mismatch)
         }
     })
 }

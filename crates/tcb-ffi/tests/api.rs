@@ -744,6 +744,48 @@ fn rigs_blends_and_playback() {
         out.write_row(&mut want, None);
         assert_eq!(row, want);
 
+        // Covered: a clip of the Spine rotation alone weighs only there.
+        let spine_json = r#"{"format": "tcb-clip/1", "tracks": [{"name": "Spine.rotation",
+            "kind": "quat", "times": [0, 1], "values": [[0, 0, 0, 1], [0, 0, 0.6, 0.8]]}]}"#;
+        let (_, spine_clip) = load_memory(spine_json.as_bytes(), "json");
+        let mut spine = null_mut();
+        let status = tcb_instance_new_with_rig(spine_clip, rig, 0, &mut spine);
+        assert_eq!(status, TcbStatus::Ok);
+        tcb_instance_update(spine, 0.5);
+        let covered = [a as *const _, spine as *const _];
+        let half = [0.5f32, 0.5];
+        let status = tcb_blend_covered(pose, covered.as_ptr(), half.as_ptr(), 2);
+        assert_eq!(status, TcbStatus::Ok);
+        assert_eq!(tcb_pose_read(pose, row.as_mut_ptr(), rn), TcbStatus::Ok);
+        let spine_rust = tcb_io::ClipDoc::parse(spine_json).unwrap().build().unwrap();
+        let mut rs = tcb_runtime::Instance::with_rig(
+            Arc::new(tcb_runtime::Clip::compile(&spine_rust)),
+            &rust_rig,
+        )
+        .unwrap();
+        rs.sample(0.5);
+        let masks = [&ra.coverage_mask(), &rs.coverage_mask()];
+        tcb_runtime::blend(
+            &mut out,
+            &[(ra.pose(), 0.5), (rs.pose(), 0.5)],
+            Some(&masks),
+        )
+        .unwrap();
+        out.write_row(&mut want, None);
+        assert_eq!(row, want);
+        // Hips.translation is a's alone; uncovered it would be pulled to rest.
+        let mut a_row = vec![0.0f32; rn];
+        tcb_instance_sample(a, 0.25, a_row.as_mut_ptr(), rn);
+        assert_eq!(&row[..3], &a_row[..3]);
+        assert_eq!(
+            tcb_blend(pose, covered.as_ptr(), half.as_ptr(), 2),
+            TcbStatus::Ok
+        );
+        assert_eq!(tcb_pose_read(pose, row.as_mut_ptr(), rn), TcbStatus::Ok);
+        assert_ne!(&row[..3], &a_row[..3]);
+        tcb_instance_free(spine);
+        tcb_clip_free(spine_clip);
+
         // More layers than the stack holds.
         let many: Vec<*const TcbInstance> = (0..20).map(|i| layers[i % 2]).collect();
         let w = [1.0f32; 20];

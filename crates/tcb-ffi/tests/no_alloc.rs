@@ -115,6 +115,7 @@ fn per_frame_calls_allocate_nothing() {
             ok(tcb_instance_sample(b, t + 3.0, rig_row.as_mut_ptr(), rn));
             let w = [0.3f32, 0.7];
             ok(tcb_blend(pose, layers.as_ptr(), w.as_ptr(), 2));
+            ok(tcb_blend_covered(pose, layers.as_ptr(), w.as_ptr(), 2));
             ok(tcb_blend_add(pose, b, a, 0.25));
             ok(tcb_pose_read(pose, rig_row.as_mut_ptr(), rn));
             ok(tcb_pose_read_velocities(pose, rig_row.as_mut_ptr(), rn));
