@@ -1,6 +1,6 @@
 //! What a compiled clip costs to play: an estimate of the runtime's
-//! instructions per frame, for [`crate::reduce`] to keep a reduced clip no
-//! slower than its source.
+//! instructions per frame, for [`crate::reduce()`] to keep a reduced clip
+//! no slower than its source (with `never_slower`).
 //!
 //! The runtime samples every channel every frame, so a clip's cost is set
 //! by its layout, not by its keys: each group of tracks sharing a key grid
