@@ -533,10 +533,11 @@ pub fn export(
         &scene.channels,
         container == Container::Glb,
     )?;
-    let report = ExportReport {
-        tracks: scene.tracks,
-        notes,
-    };
+    // Weight tracks were written after the others: the report lists them
+    // in clip order, as documented (names are unique in a clip).
+    let mut tracks = scene.tracks;
+    tracks.sort_by_key(|r| clip.tracks().iter().position(|t| t.name == r.name));
+    let report = ExportReport { tracks, notes };
     Ok((bytes, report))
 }
 
@@ -727,6 +728,13 @@ struct Written {
 fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written, Error> {
     check_times(name, data.times())?;
     let (sampler, fit) = track_sampler(data, max_error);
+    if let Some(x) = sampler.output.iter().find(|x| !x.is_finite()) {
+        return Err(Error::import(format!(
+            "track '{name}': a key or tangent is {x} in f32 (a tension, continuity or bias \
+             so large that a tangent overflows); glTF stores finite f32 numbers, so it cannot \
+             be exported: bring the parameter within a few units"
+        )));
+    }
     let largest_shift = sampler
         .source_times
         .iter()
