@@ -95,6 +95,12 @@ pub fn playback(data: &[u8]) {
         2 => f64::arbitrary(&mut u).unwrap_or(1.0),
         _ => f64::from(i16::arbitrary(&mut u).unwrap_or(1)) / 256.0,
     };
+    let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
+    if !speed.is_finite() {
+        let refused = Instance::new(compiled).set_playback(mode, speed);
+        assert!(refused.is_err(), "a speed of {speed} accepted");
+        return;
+    }
     let rigged = u.ratio(1, 3u8).unwrap_or(false);
     let rest = crate::value(&mut u).unwrap_or([0.5; 4]);
     // Edge times in clip time, then divided by the speed: instance times.
@@ -107,7 +113,6 @@ pub fn playback(data: &[u8]) {
             *t /= speed;
         }
     }
-    let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
     let make = || {
         let mut i = Instance::new(compiled.clone()).with_velocities();
         i.set_playback(mode, speed).expect("a finite speed");
