@@ -1,0 +1,124 @@
+//! Issue 29, class 6, as the `export` fuzz target found it on main: an
+//! export either reads back within what it reports (relative to max(1,
+//! |value|), rotations up to sign, plus 1e-5) or is refused with a
+//! message. Each clip here is a fuzz finding, its tracks renamed for glTF
+//! as the target names them.
+
+use tcb_io::gltf_export::{Container, ExportOptions, export};
+use tcb_io::gltf_import::import;
+
+/// Export `text`'s clip, import it, and return what is wrong: the import's
+/// error, or each track's largest difference beyond what was reported.
+fn read_back(text: &str, max_error: f64) -> Result<Vec<String>, String> {
+    let clip = tcb_io::ClipDoc::parse(text).unwrap().build().unwrap();
+    let options = ExportOptions::default().max_error(max_error);
+    let Ok((bytes, report)) = export(&clip, None, Container::Glb, &options) else {
+        return Ok(Vec::new()); // refused: allowed
+    };
+    let back = import(&bytes, None, None, "rt")
+        .map_err(|e| e.to_string())?
+        .doc
+        .build()
+        .map_err(|e| e.to_string())?;
+    let (mut va, mut vb) = (
+        vec![0.0f32; clip.channel_count()],
+        vec![0.0f32; back.channel_count()],
+    );
+    let mut bad = Vec::new();
+    for (i, track) in clip.tracks().iter().enumerate() {
+        let keys = track.data.times();
+        let (t0, t1) = (keys[0], keys[keys.len() - 1]);
+        let bt: usize = back
+            .tracks()
+            .iter()
+            .take_while(|o| o.name != track.name)
+            .map(|o| o.data.kind().dim())
+            .sum();
+        let at: usize = clip.tracks()[..i].iter().map(|o| o.data.kind().dim()).sum();
+        let dim = track.data.kind().dim();
+        let stated = report.tracks[i].error();
+        let mut worst = (0.0f64, 0.0);
+        for j in 0..=400 {
+            let t = t0 + (t1 - t0) * f64::from(j) / 400.0;
+            clip.sample_into(t, &mut va, None);
+            back.sample_into(t, &mut vb, None);
+            let d = |s: f32| {
+                (0..dim)
+                    .map(|c| {
+                        let (a, b) = (va[at + c], vb[bt + c]);
+                        f64::from((a - s * b).abs() / a.abs().max(1.0))
+                    })
+                    .fold(0.0, |m: f64, x| if x.is_nan() || x > m { x } else { m })
+            };
+            let e = if dim == 4 && track.data.kind() == tcb_core::TrackKind::Quat {
+                d(1.0).min(d(-1.0))
+            } else {
+                d(1.0)
+            };
+            if e.is_nan() || e > worst.0 {
+                worst = (e, t);
+            }
+        }
+        if worst.0.is_nan() || worst.0 > stated.unwrap_or(0.0) + 1e-5 {
+            bad.push(format!(
+                "{}: off by {:e} at {}, reported {stated:?}",
+                track.name, worst.0, worst.1
+            ));
+        }
+    }
+    Ok(bad)
+}
+
+/// A default tension of -9e305 makes the tangents overflow f32: the
+/// export writes an infinite CUBICSPLINE tangent, which `tcb import` (and
+/// any glTF reader) refuses.
+#[test]
+#[ignore = "issue 29 class 6: tangents beyond f32 are exported as infinities that import refuses"]
+fn tangents_beyond_f32_are_refused_or_read_back() {
+    let text = r#"{"format": "tcb-clip/1", "name": "fuzz",
+      "defaults": {"tangent_rule": "adjusted", "ends": "zero", "match_speed": true,
+        "continuity_fade": true, "tcb": [-8.979138023906251e305, -0.01, 0]},
+      "tracks": [{"name": "m.weights.0", "kind": "scalar", "times": [-1.375, 2.4609375, 6.296875],
+        "values": [4.6223145, -2.2070312, -2.5803223]}]}"#;
+    assert_eq!(read_back(text, 1e-5), Ok(Vec::new()));
+}
+
+/// A `hermite` rotation whose first segment is `step`, beside a scalar
+/// weight track: reported exact, it reads back 0.62 off at -7.530 (in its
+/// step segment, just before its second key; in the fuzz run 0.023 off at
+/// -9.909). Alone, the rotation reads back within 1e-5.
+#[test]
+#[ignore = "issue 29 class 6: beside a scalar track, a hermite rotation with a step segment is reported exact but reads back 0.62 off"]
+fn hermite_rotation_with_a_step_segment_is_not_exact() {
+    let text = r#"{"format": "tcb-clip/1", "name": "fuzz",
+      "defaults": {"tangent_rule": "parabolic", "ends": "natural", "match_speed": true,
+        "tcb": [1.2, 1.14, 1.15], "pre": "repeat", "post": "reset", "hemisphere": "nearest"},
+      "tracks": [{"name": "m.weights.0", "kind": "scalar", "times": [-3, -0.2734375, 2.453125, 5.1796875, 7.90625],
+        "values": [-5.0825195, -5.0825195, 0.0007324219, 6.090332, -1.4638672]},
+        {"name": "n1.rotation", "kind": "quat", "times": [-10.25, -7.5234375, -4.796875, -2.0703125],
+        "values": [[-1.4638672, 0.22753906, 1.8189894e-12, 4.7207853e-35], [-5.062744, -5.0825195, -5.772705, -5.772705],
+          [-5.772705, -5.772705, -5.772705, -5.772705], [-5.772705, -5.0825195, -5.0825195, -5.0825195]],
+        "keys": [{"interp": "step", "in": [-7.912604e-11, -5.0825195, -5.0825195, -6.7365723]}, {},
+          {"tcb": [-0.86, -0.86, -0.86]}, {}],
+        "post": "constant", "rotation": "hermite"}]}"#;
+    assert_eq!(read_back(text, 1e-7), Ok(Vec::new()));
+}
+
+/// An eased scalar whose middle key is -8.8e12 (resampled): reported 14.7
+/// off (relative to max(1, |value|)), it reads back 529 off in its first
+/// segment (in the fuzz run, beside a vec3 track, it was reported exact and
+/// read back 11.7 off).
+#[test]
+#[ignore = "issue 29 class 6: an eased scalar with a huge key reads back 529 (relative) off where 14.7 is reported"]
+fn eased_scalar_with_a_huge_key_is_not_exact() {
+    let text = r#"{"format": "tcb-clip/1", "name": "fuzz",
+      "defaults": {"tangent_rule": "parabolic", "ends": "natural", "match_speed": true,
+        "tcb": [0.19, -0.63, 7.914031820569321e-218], "pre": "offset-repeat"},
+      "tracks": [{"name": "m.weights.0", "kind": "scalar", "times": [14, 14.3359375, 16.671875],
+        "values": [6.1364746, -8796093000000, 0],
+        "keys": [{"ease": [0.921875, 0.265625], "out": -0.6904297}, {"in": -0.94873047, "out": 1.175293},
+          {"tcb": [1.12, -0.02, 0.37], "interp": "linear"}],
+        "ends": "zero", "match_speed": false, "continuity_fade": true, "tcb": [-0.33, 0.55, -0.33],
+        "post": "constant", "rotation": "hermite", "hemisphere": "nearest"}]}"#;
+    assert_eq!(read_back(text, 1e-7), Ok(Vec::new()));
+}
