@@ -36,7 +36,12 @@ fn read_back(text: &str, max_error: f64) -> Result<Vec<String>, String> {
             .sum();
         let at: usize = clip.tracks()[..i].iter().map(|o| o.data.kind().dim()).sum();
         let dim = track.data.kind().dim();
-        let stated = report.tracks[i].error();
+        let stated = report
+            .tracks
+            .iter()
+            .find(|r| r.name == track.name)
+            .expect("every track reported")
+            .error();
         let mut worst = (0.0f64, 0.0);
         for j in 0..=400 {
             let t = t0 + (t1 - t0) * f64::from(j) / 400.0;
@@ -83,13 +88,13 @@ fn tangents_beyond_f32_are_refused_or_read_back() {
     assert_eq!(read_back(text, 1e-5), Ok(Vec::new()));
 }
 
-/// A `hermite` rotation whose first segment is `step`, beside a scalar
-/// weight track: reported exact, it reads back 0.62 off at -7.530 (in its
-/// step segment, just before its second key; in the fuzz run 0.023 off at
-/// -9.909). Alone, the rotation reads back within 1e-5.
+/// `ExportReport::tracks` is documented as "every track, in clip order";
+/// with a weight track before a rotation, the rotation is listed first. A
+/// caller that pairs the report with the clip's tracks by position (as the
+/// `export` fuzz target first did) reads one track's error as another's.
 #[test]
-#[ignore = "issue 29 class 6: beside a scalar track, a hermite rotation with a step segment is reported exact but reads back 0.62 off"]
-fn hermite_rotation_with_a_step_segment_is_not_exact() {
+#[ignore = "issue 29 class 6: ExportReport::tracks is not in clip order (weight tracks after the others), as its docs say"]
+fn the_report_lists_tracks_in_clip_order() {
     let text = r#"{"format": "tcb-clip/1", "name": "fuzz",
       "defaults": {"tangent_rule": "parabolic", "ends": "natural", "match_speed": true,
         "tcb": [1.2, 1.14, 1.15], "pre": "repeat", "post": "reset", "hemisphere": "nearest"},
@@ -101,6 +106,14 @@ fn hermite_rotation_with_a_step_segment_is_not_exact() {
         "keys": [{"interp": "step", "in": [-7.912604e-11, -5.0825195, -5.0825195, -6.7365723]}, {},
           {"tcb": [-0.86, -0.86, -0.86]}, {}],
         "post": "constant", "rotation": "hermite"}]}"#;
+    let clip = tcb_io::ClipDoc::parse(text).unwrap().build().unwrap();
+    let (_, report) = export(&clip, None, Container::Glb, &ExportOptions::default()).unwrap();
+    let names = |v: Vec<&str>| v.join(", ");
+    assert_eq!(
+        names(report.tracks.iter().map(|t| t.name.as_str()).collect()),
+        names(clip.tracks().iter().map(|t| t.name.as_str()).collect())
+    );
+    // Matched by name, it reads back within what it reports.
     assert_eq!(read_back(text, 1e-7), Ok(Vec::new()));
 }
 
