@@ -18,6 +18,20 @@ use tcb_core::{
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 use tcb_runtime::{BlendMask, Instance, PackSource, Packed, Playback};
 
+mod edges;
+mod export;
+mod playback;
+mod quantize;
+mod reduce_readback;
+mod roundtrip;
+
+pub use edges::{edge_time, edge_times, f32_ulps, ulps};
+pub use export::export;
+pub use playback::{clip_time, playback};
+pub use quantize::quantize;
+pub use reduce_readback::reduce_readback;
+pub use roundtrip::roundtrip;
+
 /// `tcb-clip/1` JSON: parse, build, then play what builds.
 pub fn clip_json(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
@@ -121,66 +135,10 @@ pub fn blend(data: &[u8]) {
 /// tolerance by its own measurement, and what it writes reads back and
 /// builds.
 pub fn reduce(data: &[u8]) {
-    use tcb_core::skeleton::{Joint, Skeleton, Transform};
-    use tcb_fit::{Knots, Metric, ReduceOptions, Tangents};
     let mut u = Unstructured::new(data);
-    let Ok(mut doc) = arbitrary_doc(&mut u) else {
+    let Some((doc, clip, skeleton, options)) = reduce_input(&mut u) else {
         return;
     };
-    let skeleton = if bool::arbitrary(&mut u).unwrap_or(false) {
-        let mut joints = Vec::new();
-        for (i, track) in doc.tracks.iter_mut().enumerate() {
-            let channel = match track.kind {
-                TrackKind::Quat => "rotation",
-                TrackKind::Vec3 if i % 2 == 0 => "translation",
-                TrackKind::Vec3 => "scale",
-                _ => "weight",
-            };
-            track.name = format!("j{i}.{channel}");
-            let parent = match i {
-                0 => None,
-                _ => u.int_in_range(0..=i).ok().filter(|p| *p < i),
-            };
-            let [x, y, z, _] = value(&mut u).unwrap_or_default();
-            joints.push(Joint {
-                name: format!("j{i}"),
-                parent,
-                rest: Transform {
-                    translation: glam::Vec3::new(x, y, z),
-                    ..Transform::IDENTITY
-                },
-            });
-        }
-        Some(Skeleton::new(joints).unwrap())
-    } else {
-        None
-    };
-    let Ok(clip) = doc.build() else {
-        return;
-    };
-    let number = |u: &mut Unstructured| -> Option<f64> {
-        match u.int_in_range(0..=3u8).unwrap_or(0) {
-            0 => None,
-            1 => f64::arbitrary(u).ok(),
-            _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
-        }
-    };
-    let options = ReduceOptions::default()
-        .tolerance(number(&mut u))
-        .shell(number(&mut u))
-        .metric(
-            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
-                .unwrap_or(&None),
-        )
-        .rotation_tolerance(number(&mut u))
-        .knots(
-            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
-                .unwrap_or(&Knots::Track),
-        )
-        .tangents(
-            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
-                .unwrap_or(&Tangents::Best),
-        );
     let input = tcb_fit::reduce::Input {
         doc: &doc,
         clip: &clip,
@@ -198,6 +156,75 @@ pub fn reduce(data: &[u8]) {
         let back = ClipDoc::parse(&r.doc.to_json()).expect("the reduced clip reads back");
         back.build().expect("the reduced clip builds");
     }
+}
+
+/// `tcb reduce`'s input, as the `reduce` and `reduce_readback` targets
+/// draw it: a structured clip (built), sometimes a skeleton whose joints
+/// its tracks animate, and arbitrary options.
+pub(crate) type ReduceInput = (
+    ClipDoc,
+    tcb_core::Clip,
+    Option<tcb_core::skeleton::Skeleton>,
+    tcb_fit::ReduceOptions,
+);
+
+pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
+    use tcb_core::skeleton::{Joint, Skeleton, Transform};
+    use tcb_fit::{Knots, Metric, ReduceOptions, Tangents};
+    let mut doc = arbitrary_doc(u).ok()?;
+    let skeleton = if bool::arbitrary(u).unwrap_or(false) {
+        let mut joints = Vec::new();
+        for (i, track) in doc.tracks.iter_mut().enumerate() {
+            let channel = match track.kind {
+                TrackKind::Quat => "rotation",
+                TrackKind::Vec3 if i % 2 == 0 => "translation",
+                TrackKind::Vec3 => "scale",
+                _ => "weight",
+            };
+            track.name = format!("j{i}.{channel}");
+            let parent = match i {
+                0 => None,
+                _ => u.int_in_range(0..=i).ok().filter(|p| *p < i),
+            };
+            let [x, y, z, _] = value(u).unwrap_or_default();
+            joints.push(Joint {
+                name: format!("j{i}"),
+                parent,
+                rest: Transform {
+                    translation: glam::Vec3::new(x, y, z),
+                    ..Transform::IDENTITY
+                },
+            });
+        }
+        Some(Skeleton::new(joints).unwrap())
+    } else {
+        None
+    };
+    let clip = doc.build().ok()?;
+    let number = |u: &mut Unstructured| -> Option<f64> {
+        match u.int_in_range(0..=3u8).unwrap_or(0) {
+            0 => None,
+            1 => f64::arbitrary(u).ok(),
+            _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
+        }
+    };
+    let options = ReduceOptions::default()
+        .tolerance(number(u))
+        .shell(number(u))
+        .metric(
+            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
+                .unwrap_or(&None),
+        )
+        .rotation_tolerance(number(u))
+        .knots(
+            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
+                .unwrap_or(&Knots::Track),
+        )
+        .tangents(
+            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
+                .unwrap_or(&Tangents::Best),
+        );
+    Some((doc, clip, skeleton, options))
 }
 
 /// `.tcbc` bytes, then (past the length their header gives) bytes that

@@ -62,3 +62,28 @@ fn tcbc_corpus() {
 fn pack_corpus() {
     replay("pack", bodies::pack);
 }
+
+#[test]
+fn quantize_corpus() {
+    replay("quantize", bodies::quantize);
+}
+
+#[test]
+fn playback_corpus() {
+    replay("playback", bodies::playback);
+}
+
+#[test]
+fn roundtrip_corpus() {
+    replay("roundtrip", bodies::roundtrip);
+}
+
+#[test]
+fn export_corpus() {
+    replay("export", bodies::export);
+}
+
+#[test]
+fn reduce_readback_corpus() {
+    replay("reduce_readback", bodies::reduce_readback);
+}

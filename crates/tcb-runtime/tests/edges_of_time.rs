@@ -198,6 +198,22 @@ fn an_infinite_tangent_just_before_the_last_key() {
     ));
     assert_eq!(Clip::compile(&grouped).loose_track_count(), 0);
     bad.extend(mismatches(&grouped, &around(&[1.421875])));
+    // The same ten times over: one group of the kernels instead of loose
+    // lanes (both gave NaN there).
+    let varied = |i: usize| {
+        format!(
+            r#"{{"name": "t{i}", "kind": "scalar", "times": [-5.5, -4.4609375, -3.734375, -2.3515625, 1.421875],
+           "values": [1, 2, 3, 4, {i}], "ends": "copy", "match_speed": true, "continuity_fade": false,
+           "tcb": [1.5909326897655337e80, 1.19, 0.03], "pre": "linear", "post": "constant"}}"#
+        )
+    };
+    let ten: Vec<String> = (0..10).map(varied).collect();
+    let group = clip(&format!(
+        r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
+        ten.join(", ")
+    ));
+    assert_eq!(Clip::compile(&group).group_count(), 1);
+    bad.extend(mismatches(&group, &around(&[1.421875])));
     assert_none(&bad);
 }
 
