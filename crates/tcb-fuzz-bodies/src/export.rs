@@ -17,7 +17,7 @@ use tcb_io::gltf_export::{Container, ExportOptions, export as export_gltf};
 /// each two of them and a few edge times.
 pub fn export(data: &[u8]) {
     let mut u = Unstructured::new(data);
-    let Ok(mut doc) = crate::arbitrary_doc(&mut u) else {
+    let Ok(mut doc) = crate::inputs::arbitrary_doc(&mut u) else {
         return;
     };
     let mut weights = 0;

@@ -12,14 +12,13 @@
 use arbitrary::{Arbitrary, Unstructured};
 use std::sync::Arc;
 use tcb_core::params::Tcb;
-use tcb_core::{
-    Ends, Extrapolation, Hemisphere, Interp, RotationMode, TangentRule, TrackData, TrackKind,
-};
-use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
+use tcb_core::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, TrackData, TrackKind};
+use tcb_io::{ClipDoc, SettingsDoc, TrackDoc};
 use tcb_runtime::{BlendMask, Instance, PackSource, Packed, Playback};
 
 mod edges;
 mod export;
+mod inputs;
 mod playback;
 mod quantize;
 mod reduce_readback;
@@ -27,6 +26,8 @@ mod roundtrip;
 
 pub use edges::{edge_time, edge_times, f32_ulps, ulps};
 pub use export::export;
+use inputs::*;
+pub use inputs::{arbitrary_doc, arbitrary_time};
 pub use playback::{clip_time, playback};
 pub use quantize::quantize;
 pub use reduce_readback::reduce_readback;
@@ -156,75 +157,6 @@ pub fn reduce(data: &[u8]) {
         let back = ClipDoc::parse(&r.doc.to_json()).expect("the reduced clip reads back");
         back.build().expect("the reduced clip builds");
     }
-}
-
-/// `tcb reduce`'s input, as the `reduce` and `reduce_readback` targets
-/// draw it: a structured clip (built), sometimes a skeleton whose joints
-/// its tracks animate, and arbitrary options.
-pub(crate) type ReduceInput = (
-    ClipDoc,
-    tcb_core::Clip,
-    Option<tcb_core::skeleton::Skeleton>,
-    tcb_fit::ReduceOptions,
-);
-
-pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
-    use tcb_core::skeleton::{Joint, Skeleton, Transform};
-    use tcb_fit::{Knots, Metric, ReduceOptions, Tangents};
-    let mut doc = arbitrary_doc(u).ok()?;
-    let skeleton = if bool::arbitrary(u).unwrap_or(false) {
-        let mut joints = Vec::new();
-        for (i, track) in doc.tracks.iter_mut().enumerate() {
-            let channel = match track.kind {
-                TrackKind::Quat => "rotation",
-                TrackKind::Vec3 if i % 2 == 0 => "translation",
-                TrackKind::Vec3 => "scale",
-                _ => "weight",
-            };
-            track.name = format!("j{i}.{channel}");
-            let parent = match i {
-                0 => None,
-                _ => u.int_in_range(0..=i).ok().filter(|p| *p < i),
-            };
-            let [x, y, z, _] = value(u).unwrap_or_default();
-            joints.push(Joint {
-                name: format!("j{i}"),
-                parent,
-                rest: Transform {
-                    translation: glam::Vec3::new(x, y, z),
-                    ..Transform::IDENTITY
-                },
-            });
-        }
-        Some(Skeleton::new(joints).unwrap())
-    } else {
-        None
-    };
-    let clip = doc.build().ok()?;
-    let number = |u: &mut Unstructured| -> Option<f64> {
-        match u.int_in_range(0..=3u8).unwrap_or(0) {
-            0 => None,
-            1 => f64::arbitrary(u).ok(),
-            _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
-        }
-    };
-    let options = ReduceOptions::default()
-        .tolerance(number(u))
-        .shell(number(u))
-        .metric(
-            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
-                .unwrap_or(&None),
-        )
-        .rotation_tolerance(number(u))
-        .knots(
-            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
-                .unwrap_or(&Knots::Track),
-        )
-        .tangents(
-            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
-                .unwrap_or(&Tangents::Best),
-        );
-    Some((doc, clip, skeleton, options))
 }
 
 /// `.tcbc` bytes, then (past the length their header gives) bytes that
@@ -411,161 +343,6 @@ fn check(clip: &tcb_core::Clip, times: &[f64], options: &tcb_runtime::CompileOpt
             }
         }
     }
-}
-
-/// Equal as numbers (the equivalence tests' `==`: -0 equals 0), NaN
-/// equal to any NaN.
-fn same(a: &[f32], b: &[f32]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
-}
-
-/// Up to sign, within 1e-6 (relative above 1).
-fn assert_rotation(got: &[f32], want: &[f32], name: &str, t: f64) {
-    if want.iter().any(|x| !x.is_finite()) {
-        return;
-    }
-    let close = |sign: f32| {
-        got.iter()
-            .zip(want)
-            .all(|(g, w)| (g * sign - w).abs() <= 1e-6 * w.abs().max(1.0))
-    };
-    assert!(
-        close(1.0) || close(-1.0),
-        "{name} at {t}: runtime {got:?}, reference {want:?}"
-    );
-}
-
-/// Mostly nice numbers (where the interesting paths are), sometimes any f32.
-fn arbitrary_f32(u: &mut Unstructured) -> arbitrary::Result<f32> {
-    Ok(match u.int_in_range(0..=7u8)? {
-        0 => f32::arbitrary(u)?,
-        _ => f32::from(i16::arbitrary(u)?) / 4096.0,
-    })
-}
-
-/// Mostly times around the keys, sometimes anything (NaN and infinities included).
-pub fn arbitrary_time(u: &mut Unstructured) -> arbitrary::Result<f64> {
-    if u.is_empty() {
-        return Err(arbitrary::Error::NotEnoughData);
-    }
-    Ok(match u.int_in_range(0..=7u8)? {
-        0 => f64::arbitrary(u)?,
-        1 => *u.choose(&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 0.0, -0.0])?,
-        _ => f64::from(i16::arbitrary(u)?) / 1024.0,
-    })
-}
-
-fn some<'a, T>(
-    u: &mut Unstructured<'a>,
-    f: impl FnOnce(&mut Unstructured<'a>) -> arbitrary::Result<T>,
-) -> arbitrary::Result<Option<T>> {
-    Ok(if bool::arbitrary(u)? {
-        Some(f(u)?)
-    } else {
-        None
-    })
-}
-
-fn tcb3(u: &mut Unstructured) -> arbitrary::Result<[f64; 3]> {
-    let mut x = || -> arbitrary::Result<f64> {
-        Ok(match u.int_in_range(0..=7u8)? {
-            0 => f64::arbitrary(u)?,
-            _ => f64::from(i8::arbitrary(u)?) / 100.0,
-        })
-    };
-    Ok([x()?, x()?, x()?])
-}
-
-// `bool::arbitrary` itself is not general enough over the lifetimes `some` asks for.
-#[allow(clippy::redundant_closure)]
-fn settings(u: &mut Unstructured) -> arbitrary::Result<SettingsDoc> {
-    Ok(SettingsDoc {
-        tangent_rule: some(u, |u| u.choose(TangentRule::ALL).copied())?,
-        ends: some(u, |u| u.choose(Ends::ALL).copied())?,
-        match_speed: some(u, |u| bool::arbitrary(u))?,
-        continuity_fade: some(u, |u| bool::arbitrary(u))?,
-        tcb: some(u, tcb3)?,
-        pre: some(u, |u| u.choose(Extrapolation::ALL).copied())?,
-        post: some(u, |u| u.choose(Extrapolation::ALL).copied())?,
-        rotation: some(u, |u| u.choose(RotationMode::ALL).copied())?,
-        hemisphere: some(u, |u| u.choose(Hemisphere::ALL).copied())?,
-    })
-}
-
-fn value(u: &mut Unstructured) -> arbitrary::Result<[f32; 4]> {
-    Ok([
-        arbitrary_f32(u)?,
-        arbitrary_f32(u)?,
-        arbitrary_f32(u)?,
-        arbitrary_f32(u)?,
-    ])
-}
-
-/// A clip document of 1 to 6 tracks of 1 to 9 keys; `build` refuses what is invalid.
-pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
-    let kinds = [
-        TrackKind::Scalar,
-        TrackKind::Vec2,
-        TrackKind::Vec3,
-        TrackKind::Vec4,
-        TrackKind::Quat,
-    ];
-    let defaults = settings(u)?;
-    let mut tracks = Vec::new();
-    for i in 0..u.int_in_range(1..=6u8)? {
-        let kind = *u.choose(&kinds)?;
-        let n = u.int_in_range(1..=9usize)?;
-        let mut t = f64::from(i8::arbitrary(u)?) / 8.0;
-        let mut times = Vec::with_capacity(n);
-        for _ in 0..n {
-            times.push(t);
-            t += match u.int_in_range(0..=15u8)? {
-                0 => f64::arbitrary(u)?,
-                1 => 1e-9,
-                _ => f64::from(u8::arbitrary(u)?) / 64.0 + 1.0 / 128.0,
-            };
-        }
-        let values = (0..n)
-            .map(|_| value(u))
-            .collect::<arbitrary::Result<Vec<_>>>()?;
-        let keys = if bool::arbitrary(u)? {
-            (0..n)
-                .map(|_| {
-                    Ok(KeyDoc {
-                        tcb: some(u, tcb3)?,
-                        ease: some(u, |u| {
-                            Ok([
-                                f64::from(u8::arbitrary(u)?) / 128.0,
-                                f64::from(u8::arbitrary(u)?) / 128.0,
-                            ])
-                        })?,
-                        interp: some(u, |u| u.choose(Interp::ALL).copied())?,
-                        tangent_in: some(u, value)?,
-                        tangent_out: some(u, value)?,
-                    })
-                })
-                .collect::<arbitrary::Result<Vec<_>>>()?
-        } else {
-            Vec::new()
-        };
-        tracks.push(TrackDoc {
-            name: format!("t{i}"),
-            kind,
-            times,
-            values,
-            keys,
-            settings: settings(u)?,
-        });
-    }
-    Ok(ClipDoc {
-        name: "fuzz".into(),
-        defaults,
-        tracks,
-        skeleton: None,
-    })
 }
 
 /// `.tcbc` bytes with the magic, version, length and checksum of a good

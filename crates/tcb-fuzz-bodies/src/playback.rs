@@ -3,7 +3,7 @@
 //! the scalar reference at the same clip time.
 
 use crate::edges::edge_times;
-use crate::{assert_rotation, same};
+use crate::inputs::{assert_rotation, same};
 use arbitrary::{Arbitrary, Unstructured};
 use std::sync::Arc;
 use tcb_core::{TrackData, TrackKind};
@@ -59,7 +59,7 @@ pub fn clip_time(mode: Playback, speed: f64, time: f64, range: Option<(f64, f64)
 /// keys.
 pub fn playback(data: &[u8]) {
     let mut u = Unstructured::new(data);
-    let Ok(doc) = crate::arbitrary_doc(&mut u) else {
+    let Ok(doc) = crate::inputs::arbitrary_doc(&mut u) else {
         return;
     };
     let Ok(clip) = doc.build() else {
@@ -102,7 +102,7 @@ pub fn playback(data: &[u8]) {
         return;
     }
     let rigged = u.ratio(1, 3u8).unwrap_or(false);
-    let rest = crate::value(&mut u).unwrap_or([0.5; 4]);
+    let rest = crate::inputs::value(&mut u).unwrap_or([0.5; 4]);
     // Edge times in clip time, then divided by the speed: instance times.
     let keys: Vec<f64> = clip.key_times().into_iter().take(200).collect();
     let mut times = edge_times(&mut u, &keys, 48);

@@ -2,7 +2,7 @@
 //! [`CompileOptions::quantize`] against the same clip in f32.
 
 use crate::edges::edge_times;
-use crate::same;
+use crate::inputs::same;
 use arbitrary::Unstructured;
 use std::sync::Arc;
 use tcb_core::TrackData;
@@ -17,7 +17,7 @@ use tcb_runtime::{CompileOptions, Instance};
 /// quantized forward playback equals a seek bit for bit.
 pub fn quantize(data: &[u8]) {
     let mut u = Unstructured::new(data);
-    let Ok(doc) = crate::arbitrary_doc(&mut u) else {
+    let Ok(doc) = crate::inputs::arbitrary_doc(&mut u) else {
         return;
     };
     let Ok(clip) = doc.build() else {

@@ -16,7 +16,7 @@ use tcb_io::ClipDoc;
 /// points) at the check times, measured afresh against the input.
 pub fn reduce_readback(data: &[u8]) {
     let mut u = Unstructured::new(data);
-    let Some((doc, clip, skeleton, options)) = crate::reduce_input(&mut u) else {
+    let Some((doc, clip, skeleton, options)) = crate::inputs::reduce_input(&mut u) else {
         return;
     };
     let input = tcb_fit::reduce::Input {

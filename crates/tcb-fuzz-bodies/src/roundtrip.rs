@@ -29,7 +29,7 @@ pub fn roundtrip(data: &[u8]) {
         doc
     } else {
         let mut u = Unstructured::new(rest);
-        let Ok(mut doc) = crate::arbitrary_doc(&mut u) else {
+        let Ok(mut doc) = crate::inputs::arbitrary_doc(&mut u) else {
             return;
         };
         for t in &mut doc.tracks {
