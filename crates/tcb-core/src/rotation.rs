@@ -184,52 +184,10 @@ impl RotationTrack {
         normalize: bool,
     ) -> Result<Self, TrackError> {
         check_keys(&times, values.len(), &keys, settings.ends, Quat::is_finite)?;
-        for (side, mode) in [("pre", settings.pre), ("post", settings.post)] {
-            if matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat) {
-                return Err(TrackError::ExtrapolationOnRotation { side, mode });
-            }
-        }
-        let squad_mode = settings.rotation == RotationMode::Squad;
-        if squad_mode && settings.ends == Ends::Natural {
-            return Err(TrackError::NaturalOnSquad);
-        }
-        if squad_mode
-            && let Some(key) = keys
-                .iter()
-                .position(|k| k.tangent_in.is_some() || k.tangent_out.is_some())
-        {
-            return Err(TrackError::TangentOnSquad { key });
-        }
+        check_rotation_settings(&keys, settings)?;
         let n = times.len();
         let mut keys = keys_or_default(keys, n);
-        let mut qs: Vec<DQuat> = Vec::with_capacity(n);
-        for (key, q) in values.iter().enumerate() {
-            let v = DVec4::new(q.x.into(), q.y.into(), q.z.into(), q.w.into());
-            if !v.is_finite() {
-                return Err(TrackError::NonFiniteValue { key, what: "value" });
-            }
-            let len = v.length();
-            if len == 0.0 || !len.is_finite() {
-                return Err(TrackError::ZeroQuaternion { key });
-            }
-            let mut v = if normalize {
-                DVec4::from_array(crate::quat::unit_key(v.to_array()))
-            } else {
-                v
-            };
-            if settings.hemisphere == Hemisphere::Nearest
-                && let Some(prev) = qs.last()
-                && DVec4::from(*prev).dot(v) < 0.0
-            {
-                // The key's explicit tangents describe the curve through the
-                // value as given: they flip with it.
-                v = -v;
-                let k = &mut keys[key];
-                k.tangent_in = k.tangent_in.map(|t| -t);
-                k.tangent_out = k.tangent_out.map(|t| -t);
-            }
-            qs.push(DQuat::from_vec4(v));
-        }
+        let qs = unit_keys(&values, &mut keys, settings.hemisphere, normalize)?;
         if settings.ends == Ends::Cyclic {
             let (a, b) = (DVec4::from(qs[0]), DVec4::from(qs[n - 1]));
             if (a - b).length().min((a + b).length()) > 1e-6 {
@@ -240,33 +198,10 @@ impl RotationTrack {
         let eases: Vec<SegmentEase> = segment_eases(&keys).collect();
         let interps: Vec<Interp> = keys.iter().map(|k| k.interp).collect();
 
-        let shape = if squad_mode {
+        let shape = if settings.rotation == RotationMode::Squad {
             Shape::Squad(squad_segments(&times, &qs, &keys, &eases, settings))
         } else {
-            let as_vec4 = |q: Quat| Vec4::new(q.x, q.y, q.z, q.w);
-            let vkeys = keys
-                .iter()
-                .map(|k| KeyParams {
-                    tcb: k.tcb,
-                    ease: k.ease,
-                    interp: k.interp,
-                    tangent_in: k.tangent_in.map(as_vec4),
-                    tangent_out: k.tangent_out.map(as_vec4),
-                })
-                .collect();
-            let vs = values.iter().map(|&q| as_vec4(q)).collect();
-            let wrap_sign = if settings.ends == Ends::Cyclic && qs[0].dot(qs[n - 1]) < 0.0 {
-                -1.0
-            } else {
-                1.0
-            };
-            Shape::Hermite(Track::new_wrapped(
-                times.clone(),
-                vs,
-                vkeys,
-                settings,
-                wrap_sign,
-            )?)
+            Shape::Hermite(hermite_shape(&times, &qs, &values, &keys, settings)?)
         };
         Ok(RotationTrack {
             times,
@@ -465,6 +400,100 @@ fn squad_segments(
             }
         })
         .collect()
+}
+
+/// The settings a rotation track cannot have: `linear` or `offset-repeat`
+/// extrapolation, and under `squad` natural ends or explicit tangents.
+fn check_rotation_settings(
+    keys: &[KeyParams<Quat>],
+    settings: &TrackSettings,
+) -> Result<(), TrackError> {
+    for (side, mode) in [("pre", settings.pre), ("post", settings.post)] {
+        if matches!(mode, Extrapolation::Linear | Extrapolation::OffsetRepeat) {
+            return Err(TrackError::ExtrapolationOnRotation { side, mode });
+        }
+    }
+    let squad_mode = settings.rotation == RotationMode::Squad;
+    if squad_mode && settings.ends == Ends::Natural {
+        return Err(TrackError::NaturalOnSquad);
+    }
+    if squad_mode
+        && let Some(key) = keys
+            .iter()
+            .position(|k| k.tangent_in.is_some() || k.tangent_out.is_some())
+    {
+        return Err(TrackError::TangentOnSquad { key });
+    }
+    Ok(())
+}
+
+/// The keys in f64, checked (finite, not zero), made unit where
+/// `normalize`, and under `nearest` each flipped into the hemisphere of
+/// the one before (with its explicit tangents, which describe the curve
+/// through the value as given).
+fn unit_keys(
+    values: &[Quat],
+    keys: &mut [KeyParams<Quat>],
+    hemisphere: Hemisphere,
+    normalize: bool,
+) -> Result<Vec<DQuat>, TrackError> {
+    let mut qs: Vec<DQuat> = Vec::with_capacity(values.len());
+    for (key, q) in values.iter().enumerate() {
+        let v = DVec4::new(q.x.into(), q.y.into(), q.z.into(), q.w.into());
+        if !v.is_finite() {
+            return Err(TrackError::NonFiniteValue { key, what: "value" });
+        }
+        let len = v.length();
+        if len == 0.0 || !len.is_finite() {
+            return Err(TrackError::ZeroQuaternion { key });
+        }
+        let mut v = if normalize {
+            DVec4::from_array(crate::quat::unit_key(v.to_array()))
+        } else {
+            v
+        };
+        if hemisphere == Hemisphere::Nearest
+            && let Some(prev) = qs.last()
+            && DVec4::from(*prev).dot(v) < 0.0
+        {
+            v = -v;
+            let k = &mut keys[key];
+            k.tangent_in = k.tangent_in.map(|t| -t);
+            k.tangent_out = k.tangent_out.map(|t| -t);
+        }
+        qs.push(DQuat::from_vec4(v));
+    }
+    Ok(qs)
+}
+
+/// A `hermite` rotation's curve: its components as a vec4 track, wrapped
+/// with the sign that joins a cyclic track's ends.
+fn hermite_shape(
+    times: &[f64],
+    qs: &[DQuat],
+    values: &[Quat],
+    keys: &[KeyParams<Quat>],
+    settings: &TrackSettings,
+) -> Result<Track<Vec4>, TrackError> {
+    let n = times.len();
+    let as_vec4 = |q: Quat| Vec4::new(q.x, q.y, q.z, q.w);
+    let vkeys = keys
+        .iter()
+        .map(|k| KeyParams {
+            tcb: k.tcb,
+            ease: k.ease,
+            interp: k.interp,
+            tangent_in: k.tangent_in.map(as_vec4),
+            tangent_out: k.tangent_out.map(as_vec4),
+        })
+        .collect();
+    let vs = values.iter().map(|&q| as_vec4(q)).collect();
+    let wrap_sign = if settings.ends == Ends::Cyclic && qs[0].dot(qs[n - 1]) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    Track::new_wrapped(times.to_vec(), vs, vkeys, settings, wrap_sign)
 }
 
 #[cfg(test)]
