@@ -68,6 +68,24 @@ fn plays_its_reference(source: &PackSource, block: usize) {
         .map(|f| t0 + f as f64 / 60.0)
         .take_while(|t| *t <= t1)
         .collect();
+    // Backward at 60 fps, forward at 240 fps (several frames a key) and at
+    // 24 fps (several keys a frame, crossing segments), in short runs.
+    let span = (t1 - t0).min(3.0);
+    times.extend(
+        (0..)
+            .map(|f| t1 - f as f64 / 60.0)
+            .take_while(|t| *t >= t1 - span),
+    );
+    times.extend(
+        (0..)
+            .map(|f| t0 + f as f64 / 240.0)
+            .take_while(|t| *t <= t0 + span),
+    );
+    times.extend(
+        (0..)
+            .map(|f| t0 + 0.7 + f as f64 / 24.0)
+            .take_while(|t| *t <= t1),
+    );
     let mut x = 12345u64;
     for _ in 0..500 {
         x = x
