@@ -96,7 +96,7 @@ pub(crate) fn plots(
             let group = Group {
                 name,
                 tracks,
-                svg: r.svg,
+                svg: without_repeated_points(&r.svg),
                 from,
                 to,
             };
@@ -111,9 +111,46 @@ pub(crate) fn plots(
     Ok((out, notes))
 }
 
+/// `svg` with each polyline's runs of one point written once: the same
+/// picture. Curves are sampled at every key and drawn on whole pixels, so
+/// a capture's curves repeat most points (half the bytes of its plots).
+/// Text cannot hold the attribute: plotters writes its quotes `&quot;`.
+fn without_repeated_points(svg: &str) -> String {
+    const POINTS: &str = " points=\"";
+    let mut out = String::with_capacity(svg.len());
+    let mut rest = svg;
+    while let Some(at) = rest.find(POINTS) {
+        let (before, after) = rest.split_at(at + POINTS.len());
+        out.push_str(before);
+        let end = after.find('"').unwrap_or(after.len());
+        let mut last = None;
+        for (i, p) in after[..end].split_ascii_whitespace().enumerate() {
+            if last != Some(p) {
+                if i > 0 {
+                    out.push(' ');
+                }
+                out.push_str(p);
+            }
+            last = Some(p);
+        }
+        rest = &after[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn repeated_points_go_and_the_rest_stays() {
+        let svg = r#"<svg><polyline stroke="black" points="1,2 1,2 1,2 3,4 1,2 1,2 "/><text x="1">a points=&quot;x x&quot;</text><polyline points="5,5"/></svg>"#;
+        assert_eq!(
+            without_repeated_points(svg),
+            r#"<svg><polyline stroke="black" points="1,2 3,4 1,2"/><text x="1">a points=&quot;x x&quot;</text><polyline points="5,5"/></svg>"#
+        );
+    }
 
     #[test]
     fn tracks_group_by_joint_or_by_prefix() {
