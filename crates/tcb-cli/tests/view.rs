@@ -162,6 +162,7 @@ struct Point {
 struct Pixels {
     pixels: u64,
     cx: Option<f64>,
+    min_x: Option<f64>,
     max_y: Option<f64>,
 }
 
@@ -371,5 +372,35 @@ fn view_shows_a_clip_without_skeleton_as_its_curves_alone() {
         "screenshots: {}, {}",
         r.shots[0].png.display(),
         r.page_shot.display()
+    );
+}
+
+#[test]
+fn view_shows_a_leaf_joints_rotation_as_its_tip() {
+    // simple_skin.gltf rotates node2, a joint with no child: no joint moves.
+    let Some(r) = check_in_browser("skin", &file("data/simple_skin.gltf"), &["0", "2"]) else {
+        return;
+    };
+    assert!(
+        r.requests.is_empty() && r.errors.is_empty(),
+        "{:?} {:?}",
+        r.requests,
+        r.errors
+    );
+    assert_eq!(r.joints, ["node0", "node1", "node2"]);
+    // The root has no track: the first group's curves show.
+    assert_eq!(r.shots[0].state.plot.as_deref(), Some("node2"));
+    let (a, b) = (&r.shots[0], &r.shots[1]);
+    for j in &r.joints {
+        assert_eq!(a.positions[j], b.positions[j], "{j}");
+    }
+    let (fa, fb) = (a.figure.as_ref().unwrap(), b.figure.as_ref().unwrap());
+    eprintln!(
+        "the tip's pixels: left edge {:?} at 0 s, {:?} at 2 s",
+        fa.min_x, fb.min_x
+    );
+    assert!(
+        fa.min_x.unwrap() - fb.min_x.unwrap() > 10.0,
+        "{fa:?} {fb:?}"
     );
 }

@@ -7,7 +7,9 @@
 //!           + three.min.js   three.js (MIT, its licence at the top), bundled by
 //!                            tools/view/bundle.mjs and committed: no node to build
 //!           + JSON           frame times, model-space joint positions per frame
-//!                            (SkeletonBinding), one `tcb plot` SVG per joint
+//!                            (SkeletonBinding; and the rotations of animated leaf
+//!                            joints, which no position shows), one `tcb plot` SVG
+//!                            per joint
 //!           + page.js        draws the positions, interpolating linearly between frames
 //! ```
 //!

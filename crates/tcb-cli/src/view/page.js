@@ -2,7 +2,8 @@
 // with the runtime (the JSON in #tcb-data) on a ground grid, with three.js
 // (the global THREE), and shows the picked joint's curves: the SVG that
 // `tcb plot` draws. It computes no animation: at a frame's time a joint is
-// where the runtime put it; between frames it is interpolated linearly.
+// where the runtime put it (and a leaf joint's tip turned as the runtime
+// turned it); between frames it is interpolated linearly.
 // window.tcbView lets a test read what the page shows.
 (function () {
   "use strict";
@@ -166,6 +167,26 @@
       return m;
     });
 
+    // A leaf joint's rotation moves no joint: it gets a tip along its +Y
+    // (glTF's bone axis), about half as long as its bone.
+    const tipRotations = Float32Array.from(figure.tip_rotations);
+    const cone = new THREE.CylinderGeometry(0, 0.03 * height, 1, 12);
+    cone.translate(0, 0.5, 0);
+    const tips = figure.tips.map((j) => {
+      const p = figure.parents[j];
+      let length = 0;
+      if (p !== null) {
+        const d = [0, 1, 2].map((k) => positions[3 * j + k] - positions[3 * p + k]);
+        length = 0.6 * Math.hypot(...d);
+      }
+      const m = new THREE.Mesh(cone, boneMaterial);
+      m.scale.set(1, length > 1e-6 * height ? length : 0.12 * height, 1);
+      m.userData.joint = j;
+      m.castShadow = true;
+      body.add(m);
+      return m;
+    });
+
     // The camera: from the side of the root's travel (so that moving
     // forward shows as moving across), a little above, taking in the whole
     // motion.
@@ -236,6 +257,20 @@
         bone.quaternion.setFromUnitVectors(axis, b.sub(a).divideScalar(length));
         bone.scale.set(1, length, 1);
       }
+      const k = tips.length;
+      for (let i = 0; i < k; i++) {
+        const o = 4 * (f * k + i);
+        let q = tipRotations.subarray(o, o + 4);
+        if (w > 0) {
+          // nlerp on the nearer hemisphere.
+          const n = tipRotations.subarray(o + 4 * k, o + 8 * k);
+          const s = q[0] * n[0] + q[1] * n[1] + q[2] * n[2] + q[3] * n[3] < 0 ? -1 : 1;
+          q = q.map((c, at) => c + w * (s * n[at] - c));
+        }
+        const tip = tips[i];
+        tip.quaternion.set(q[0], q[1], q[2], q[3]).normalize();
+        tip.position.copy(spheres[figure.tips[i]].position);
+      }
       if ($("follow").checked) {
         const r = spheres[rootJoint].getWorldPosition(new THREE.Vector3());
         if (followFrom) {
@@ -265,7 +300,7 @@
       const r = canvas.getBoundingClientRect();
       const ndc = new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, 1 - ((e.clientY - r.top) / r.height) * 2);
       raycaster.setFromCamera(ndc, camera);
-      const hit = raycaster.intersectObjects([...spheres, ...bones.filter(Boolean)], false)[0];
+      const hit = raycaster.intersectObjects([...spheres, ...bones.filter(Boolean), ...tips], false)[0];
       if (hit) choose(figure.names[hit.object.userData.joint]);
     });
     controls.addEventListener("change", () => requestDraw());
@@ -428,9 +463,11 @@
   }
 
   // ---- start
+  // The root's curves first, or the first group's where no track animates the root.
+  const rootName = figure ? figure.names[Math.max(0, figure.parents.indexOf(null))] : null;
   const first =
     data.joint ??
-    (figure ? figure.names[Math.max(0, figure.parents.indexOf(null))] : data.groups.length ? data.groups[0].name : null);
+    (data.groups.some((g) => g.name === rootName) ? rootName : data.groups.length ? data.groups[0].name : rootName);
   if (first !== null) choose(first);
   draw();
 

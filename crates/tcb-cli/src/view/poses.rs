@@ -95,6 +95,13 @@ pub(crate) struct Figure {
     pub up: usize,
     /// Model-space positions: frame after frame, joint after joint, x y z.
     pub positions: Vec<f32>,
+    /// The joints with a rotation track and no child, whose rotation their
+    /// position cannot show: the page draws them a tip along their +Y
+    /// (glTF's bone axis).
+    pub tips: Vec<usize>,
+    /// The tips' model-space rotations: frame after frame, tip after tip,
+    /// x y z w.
+    pub tip_rotations: Vec<f32>,
 }
 
 /// Each joint's model-space position at each of `times`: `clip` compiled,
@@ -113,13 +120,33 @@ pub(crate) fn figure(clip: &Clip, skeleton: &Skeleton, times: &[f64]) -> Result<
     let mut instance = tcb_runtime::Instance::new(runtime);
     let mut local = vec![tcb_core::skeleton::Transform::IDENTITY; joints];
     let mut model = vec![glam::Affine3A::IDENTITY; joints];
+    let rotated = |name: &str| {
+        let track = format!("{name}.rotation");
+        clip.tracks()
+            .iter()
+            .any(|t| t.name == track && t.data.kind() == tcb_core::TrackKind::Quat)
+    };
+    let tips: Vec<usize> = skeleton
+        .joints()
+        .iter()
+        .enumerate()
+        .filter(|(i, j)| {
+            !skeleton.joints().iter().any(|c| c.parent == Some(*i)) && rotated(&j.name)
+        })
+        .map(|(i, _)| i)
+        .collect();
     let mut positions = Vec::with_capacity(count as usize * 3);
+    let mut tip_rotations = Vec::with_capacity(times.len() * tips.len() * 4);
     for &t in times {
         binding
             .model_transforms(instance.sample(t), &mut local, &mut model)
             .map_err(|e| e.to_string())?;
         for m in &model {
             positions.extend_from_slice(&m.translation.to_array());
+        }
+        for &j in &tips {
+            let (_, rotation, _) = model[j].to_scale_rotation_translation();
+            tip_rotations.extend_from_slice(&rotation.to_array());
         }
     }
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
@@ -140,6 +167,8 @@ pub(crate) fn figure(clip: &Clip, skeleton: &Skeleton, times: &[f64]) -> Result<
         parents: skeleton.joints().iter().map(|j| j.parent).collect(),
         up,
         positions,
+        tips,
+        tip_rotations,
     })
 }
 
