@@ -13,6 +13,7 @@
 // - playback: Play pressed at 2x for about 0.6 s, then Pause;
 // - picking: a click on a joint in the 3D view, and a choice in the
 //   "curves of" list, and what the page showed for each;
+// - orbit: where the root is drawn before and after a drag across the view;
 // - every request the page made that was not for itself or a blob (a
 //   self-contained page makes none), and every console error.
 //
@@ -139,6 +140,18 @@ try {
     await drawn();
     report.pick.clicked = name;
     report.pick.afterClick = await page.evaluate(() => window.tcbView.state());
+  }
+  // Orbit: a drag across the view turns the camera about its target.
+  if (info.hasSkeleton) {
+    const box = await page.locator("#view").boundingBox();
+    const before = await page.evaluate(() => window.tcbView.project(window.tcbView.root));
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.down();
+    await page.mouse.move(box.x + box.width / 2 - 200, box.y + box.height / 2, { steps: 10 });
+    await page.mouse.up();
+    await drawn();
+    const after = await page.evaluate(() => window.tcbView.project(window.tcbView.root));
+    report.orbit = { before, after };
   }
   const last = info.groups[info.groups.length - 1];
   await page.selectOption("#joint", { label: last });

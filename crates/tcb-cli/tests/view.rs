@@ -128,7 +128,15 @@ struct Report {
     shots: Vec<Shot>,
     playback: Playback,
     pick: Pick,
+    orbit: Option<Orbit>,
     page_shot: PathBuf,
+}
+
+/// Where the root was drawn before and after a drag across the view.
+#[derive(Deserialize)]
+struct Orbit {
+    before: Point,
+    after: Point,
 }
 
 #[derive(Deserialize)]
@@ -145,6 +153,7 @@ struct Shot {
 struct State {
     time: f64,
     playing: bool,
+    speed: f64,
     picked: Option<String>,
     plot: Option<String>,
     cursor: Option<f64>,
@@ -323,7 +332,11 @@ fn view_plays_the_cmu_jump_in_chromium_where_the_runtime_puts_it() {
     // Playback, and picking a joint by a click and from the list.
     let p = &r.playback;
     assert!(p.playing.playing && !p.paused.playing && p.button == "Play");
-    assert!(p.playing.time != p.before);
+    assert!(p.playing.time != p.before && p.playing.speed == 2.0);
+    let o = r.orbit.as_ref().unwrap();
+    let turned = (o.after.x - o.before.x).hypot(o.after.y - o.before.y);
+    eprintln!("a drag of 200 px moved the drawn root {turned:.1} px");
+    assert!(turned > 20.0, "{turned}");
     let clicked = r.pick.clicked.as_deref().unwrap();
     let after = r.pick.after_click.as_ref().unwrap();
     assert_eq!(after.picked.as_deref(), Some(clicked));
