@@ -52,6 +52,28 @@ fn view_writes_one_self_contained_page() {
     );
     assert!(dir.join("bounce.html").is_file());
 
+    // A packed clip keeps no skeleton: its curves alone.
+    let packed = dir.join("cmu.tcbc");
+    let short = short_cmu(120);
+    let o = tcb(&[
+        "compress",
+        short.to_str().unwrap(),
+        "-o",
+        packed.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb(&[
+        "view",
+        packed.to_str().unwrap(),
+        "-o",
+        dir.join("packed.html").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stderr_has(
+        &o,
+        "no skeleton (the curves alone), 120 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
+    );
+
     // glTF: a skin's joints.
     let o = tcb(&[
         "view",
