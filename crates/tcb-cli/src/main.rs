@@ -669,14 +669,16 @@ fn with_progress<T>(template: &str, work: impl FnOnce(&(dyn Fn(usize, usize) + S
 }
 
 /// Any clip file as a source clip and its skeleton: a `.tcbc` as its
-/// reference (the dequantized keys; the file keeps no skeleton), the rest
+/// reference (the dequantized keys) and the skeleton it keeps, the rest
 /// through `tcb_io` (warnings printed).
 fn load_any(
     path: &std::path::Path,
     options: &tcb_io::ImportOptions,
 ) -> Result<(tcb_core::Clip, Option<tcb_core::skeleton::Skeleton>), BoxError> {
     if extension(path) == "tcbc" {
-        return Ok((load_tcbc(path)?.0, None));
+        let (clip, runtime) = load_tcbc(path)?;
+        let skeleton = runtime.packed().and_then(|p| p.skeleton.clone());
+        return Ok((clip, skeleton));
     }
     let loaded = tcb_io::load_with(path, options)?;
     warn(&loaded.warnings);
@@ -928,6 +930,10 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
             &packed.note
         }
     )?;
+    match &packed.skeleton {
+        Some(s) => writeln!(out, "skeleton: {} joints", s.joints().len())?,
+        None => writeln!(out, "skeleton: none")?,
+    }
     write_packed_tracks(&mut out, head)?;
     writeln!(
         out,
