@@ -1228,10 +1228,20 @@ fn view_page(args: &ViewArgs) -> Result<(), BoxError> {
     }
     output_folder_exists(&output)?;
     let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
-    let (clip, skeleton) = load_any(&args.clip, &options)?;
+    // A packed clip plays its own stream, as `sample` plays it.
+    let (clip, skeleton, runtime) = if extension(&args.clip) == "tcbc" {
+        let (clip, runtime) = load_tcbc(&args.clip)?;
+        let skeleton = runtime.packed().and_then(|p| p.skeleton.clone());
+        (clip, skeleton, runtime)
+    } else {
+        let (clip, skeleton) = load_any(&args.clip, &options)?;
+        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile(&clip));
+        (clip, skeleton, runtime)
+    };
     let page = view::page(
         &clip,
         skeleton.as_ref(),
+        runtime,
         &view::Options {
             title: file,
             fps: args.fps,

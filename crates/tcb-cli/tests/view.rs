@@ -52,7 +52,7 @@ fn view_writes_one_self_contained_page() {
     );
     assert!(dir.join("bounce.html").is_file());
 
-    // A packed clip keeps no skeleton: its curves alone.
+    // A packed clip keeps its input's skeleton and plays its own stream.
     let packed = dir.join("cmu.tcbc");
     let short = short_cmu(120);
     let o = tcb(&[
@@ -71,7 +71,7 @@ fn view_writes_one_self_contained_page() {
     assert!(o.status.success(), "{}", stderr(&o));
     stderr_has(
         &o,
-        "no skeleton (the curves alone), 120 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
+        "38 joints, 120 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
     );
 
     // glTF: a skin's joints.

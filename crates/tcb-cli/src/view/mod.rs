@@ -20,6 +20,7 @@ mod plots;
 mod poses;
 
 use serde::Serialize;
+use std::sync::Arc;
 use tcb_core::Clip;
 use tcb_core::skeleton::Skeleton;
 
@@ -62,10 +63,12 @@ struct Data<'a> {
     joint: Option<&'a str>,
 }
 
-/// The page of `clip` played on `skeleton` (none: its curves alone).
+/// The page of `clip` played by `runtime` (`clip` compiled, or the packed
+/// stream whose reference it is) on `skeleton` (none: its curves alone).
 pub(crate) fn page(
     clip: &Clip,
     skeleton: Option<&Skeleton>,
+    runtime: Arc<tcb_runtime::Clip>,
     options: &Options,
 ) -> Result<Page, Box<dyn std::error::Error>> {
     let frames = poses::frames(clip, options.fps)?;
@@ -75,7 +78,7 @@ pub(crate) fn page(
         None => None,
     };
     let figure = match skeleton {
-        Some(s) => Some(poses::figure(clip, s, &frames.times)?),
+        Some(s) => Some(poses::figure(clip, runtime, s, &frames.times)?),
         None => None,
     };
     let (groups, notes) = plots::plots(clip, groups, &options.title)?;
@@ -176,7 +179,8 @@ mod tests {
             fps: None,
             joint: None,
         };
-        let page = page(&clip, None, &options).unwrap();
+        let runtime = Arc::new(tcb_runtime::Clip::compile(&clip));
+        let page = page(&clip, None, runtime, &options).unwrap();
         // three.js's, the data's and the page script's.
         assert_eq!(page.html.matches("</script").count(), 3);
         assert!(page.html.contains("Permission is hereby granted"));

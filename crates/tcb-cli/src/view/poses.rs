@@ -104,9 +104,15 @@ pub(crate) struct Figure {
     pub tip_rotations: Vec<f32>,
 }
 
-/// Each joint's model-space position at each of `times`: `clip` compiled,
-/// sampled by an instance and bound to `skeleton` ([`tcb_runtime::SkeletonBinding`]).
-pub(crate) fn figure(clip: &Clip, skeleton: &Skeleton, times: &[f64]) -> Result<Figure, String> {
+/// Each joint's model-space position at each of `times`: `runtime` (`clip`
+/// compiled, or the packed stream whose reference it is) sampled by an
+/// instance and bound to `skeleton` ([`tcb_runtime::SkeletonBinding`]).
+pub(crate) fn figure(
+    clip: &Clip,
+    runtime: Arc<tcb_runtime::Clip>,
+    skeleton: &Skeleton,
+    times: &[f64],
+) -> Result<Figure, String> {
     let joints = skeleton.joints().len();
     let count = times.len() as u64 * joints as u64;
     if count > MAX_POSITIONS {
@@ -115,7 +121,6 @@ pub(crate) fn figure(clip: &Clip, skeleton: &Skeleton, times: &[f64]) -> Result<
             times.len()
         ));
     }
-    let runtime = Arc::new(tcb_runtime::Clip::compile(clip));
     let binding = tcb_runtime::SkeletonBinding::new(skeleton.clone(), &runtime);
     let mut instance = tcb_runtime::Instance::new(runtime);
     let mut local = vec![tcb_core::skeleton::Transform::IDENTITY; joints];
