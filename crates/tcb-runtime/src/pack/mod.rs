@@ -713,6 +713,10 @@ pub struct Packed {
     /// What made it (`tcb compress`'s options and measured error), for
     /// `tcb info`: free text, kept in the file.
     pub note: String,
+    /// The skeleton the clip animates, if it has one (`tcb compress` keeps
+    /// the input's): kept in the file, so that a `.tcbc` plays on its
+    /// figure alone.
+    pub skeleton: Option<tcb_core::skeleton::Skeleton>,
 }
 
 /// Per key of a block, the integer a lane codes: the block's first value,
@@ -842,6 +846,7 @@ impl Packed {
             stream,
             stream_len,
             note: String::new(),
+            skeleton: None,
         })
     }
 
@@ -1073,8 +1078,9 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+/// The format version this build writes (it reads version 1 too: no
+/// skeleton).
+pub const VERSION: u32 = 2;
 
 mod file;
 pub(crate) mod store;
