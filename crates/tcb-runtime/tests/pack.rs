@@ -126,11 +126,12 @@ fn file_round_trip() {
     );
 }
 
-/// The skeleton a file keeps reads back; a version 1 file (no skeleton
-/// section) still reads; a skeleton whose joint names a later parent, or
-/// whose rest is not finite, is refused in one line.
+/// The skeleton a file keeps reads back; a file of an older version
+/// (1: no skeleton section; 2: zigzag residuals) or a newer one is refused
+/// in one line that says so; a skeleton whose joint names a later parent,
+/// or whose rest is not finite, is refused in one line.
 #[test]
-fn skeleton_round_trip_and_version_1() {
+fn skeleton_round_trip_and_other_versions() {
     let bvh = include_str!("../../../data/cmu-01_01.bvh");
     let skeleton = tcb_io::bvh::Bvh::parse(bvh).unwrap().skeleton().clone();
     let (_, source) = cmu();
@@ -146,7 +147,6 @@ fn skeleton_round_trip_and_version_1() {
         Some(skeleton.joints().len())
     );
 
-    // Version 1: the same body without the skeleton section.
     let reseal = |mut b: Vec<u8>| {
         let len = b.len() as u64;
         b[12..20].copy_from_slice(&len.to_le_bytes());
@@ -155,12 +155,18 @@ fn skeleton_round_trip_and_version_1() {
         b
     };
     packed.skeleton = None;
-    let mut v1 = packed.to_bytes();
-    assert_eq!(v1[v1.len() - 4..], [0, 0, 0, 0]); // no joints
-    v1.truncate(v1.len() - 4);
-    v1[8..12].copy_from_slice(&1u32.to_le_bytes());
-    let v1 = reseal(v1);
-    assert_eq!(Packed::from_bytes(&v1).unwrap(), packed);
+    for (version, says) in [(1u32, "older"), (2, "older"), (4, "newer")] {
+        let mut b = packed.to_bytes();
+        b[8..12].copy_from_slice(&version.to_le_bytes());
+        let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
+        assert!(
+            msg.starts_with(&format!(
+                ".tcbc version {version}; this build reads version 3"
+            )) && msg.contains(says)
+                && !msg.contains('\n'),
+            "{msg}"
+        );
+    }
 
     // The first joint's parent set to itself, then its rest's x to NaN.
     let first = bytes.len() - skeleton_bytes(&skeleton);

@@ -71,8 +71,9 @@ impl<'a> Reader<'a> {
     }
 
     /// The lane count (which must be the `stored` components of the
-    /// tracks) and per lane the widths of block start values and deltas.
-    fn block_widths(&mut self, stored: usize) -> Result<(Vec<u8>, Vec<u8>), PackError> {
+    /// tracks) and per lane the widths of block start values and deltas
+    /// and its base width.
+    fn block_widths(&mut self, stored: usize) -> Result<[Vec<u8>; 3], PackError> {
         let lanes = self.u32("the lane count")? as usize;
         if lanes != stored {
             return err(format!(
@@ -81,10 +82,12 @@ impl<'a> Reader<'a> {
         }
         let abs_bits = self.take(lanes, "the block widths")?.to_vec();
         let delta_bits = self.take(lanes, "the block widths")?.to_vec();
-        if let Some(b) = abs_bits.iter().chain(&delta_bits).find(|b| **b > 31) {
+        let base_width = self.take(lanes, "the base widths")?.to_vec();
+        let all = abs_bits.iter().chain(&delta_bits).chain(&base_width);
+        if let Some(b) = all.into_iter().find(|b| **b > 31) {
             return err(format!("a block width of {b} bits (at most 31)"));
         }
-        Ok((abs_bits, delta_bits))
+        Ok([abs_bits, delta_bits, base_width])
     }
 
     /// The segment table and the stream of `keys` keys of `lanes` lanes:
@@ -116,7 +119,7 @@ impl<'a> Reader<'a> {
         Ok((seg_at, stream, len))
     }
 
-    /// The skeleton section (version 2): a joint count (0: none), then per
+    /// The skeleton section (since version 2): a joint count (0: none), then per
     /// joint its name, parent (`u32::MAX`: a root; else an earlier joint),
     /// which of its rest rotation and scale follow (bit 0, bit 1; else
     /// identity and one), and its rest translation, rotation and scale
@@ -291,6 +294,7 @@ impl Packed {
         w.len(self.abs_bits.len());
         w.0.extend_from_slice(&self.abs_bits);
         w.0.extend_from_slice(&self.delta_bits);
+        w.0.extend_from_slice(&self.base_width);
         w.len(self.seg_at.len());
         for s in &self.seg_at {
             w.u32(*s);
@@ -339,7 +343,7 @@ impl Packed {
     /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
     /// decoding every key takes a few).
     pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
-        let (version, body) = checked_body(bytes)?;
+        let body = checked_body(bytes)?;
         let mut r = Reader { bytes: body, at: 0 };
         let name = r.str("the clip's name")?;
         let note = r.str("the note")?;
@@ -363,9 +367,9 @@ impl Packed {
             ));
         }
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
-        let (abs_bits, delta_bits) = r.block_widths(stored)?;
+        let [abs_bits, delta_bits, base_width] = r.block_widths(stored)?;
         let (seg_at, stream, len) = r.stream(keys, stored)?;
-        let skeleton = if version >= 2 { r.skeleton()? } else { None };
+        let skeleton = r.skeleton()?;
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
         }
@@ -380,6 +384,7 @@ impl Packed {
             },
             abs_bits,
             delta_bits,
+            base_width,
             seg_at,
             stream,
             stream_len: len,
@@ -392,16 +397,21 @@ impl Packed {
     }
 }
 
-/// The version and the body of `.tcbc` bytes after their header, once the
+/// The body of `.tcbc` bytes after their header, once the
 /// magic number, version, length and checksum hold.
-fn checked_body(bytes: &[u8]) -> Result<(u32, &[u8]), PackError> {
+fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
     if bytes.len() < HEADER || bytes[..8] != MAGIC {
         return err("not a .tcbc file (no TCBC magic number)");
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if !(1..=VERSION).contains(&version) {
+    if version != VERSION {
+        let why = if version < VERSION {
+            "written by an older tcb, whose residuals this build does not decode: compress the source again"
+        } else {
+            "written by a newer tcb"
+        };
         return err(format!(
-            ".tcbc version {version}; this build reads versions 1 to {VERSION}"
+            ".tcbc version {version}; this build reads version {VERSION} ({why})"
         ));
     }
     let total = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
@@ -416,5 +426,5 @@ fn checked_body(bytes: &[u8]) -> Result<(u32, &[u8]), PackError> {
     if crc32fast::hash(body) != crc {
         return err("checksum mismatch: the file is corrupted");
     }
-    Ok((version, body))
+    Ok(body)
 }

@@ -13,8 +13,8 @@
 //! block of 64 keys:   x_b (absolute), x_{b+1} - x_b (delta), then per key
 //!                     r_k = x_k - (2 x_{k-1} - x_{k-2})          (2nd-order prediction)
 //! segment of 16 keys: per component a header (the prediction order, 1 or 2,
-//!                     and a width), then each component's residuals of the
-//!                     segment in its width (zigzag)
+//!                     and a width w), then each component's residuals of the
+//!                     segment as r_k + 2^(w-1) in w bits
 //! ```
 //!
 //! so playback decodes one key per key it crosses (shifts and adds), and a
@@ -586,6 +586,20 @@ fn key_params<V: Copy>(tcb: Tcb, n: usize) -> Vec<KeyParams<V>> {
     vec![key; n]
 }
 
+/// A residual `r` of width `w` is stored as `r + bias(w)`, in
+/// `0 .. 2^w` (the range of a zigzag code of `w` bits): the decoder
+/// subtracts it 8 lanes at a time, where undoing a zigzag code takes four
+/// operations. 0 for width 0 (nothing stored).
+#[inline(always)]
+pub(crate) fn bias(w: u32) -> i32 {
+    if w == 0 { 0 } else { 1i32.wrapping_shl(w - 1) }
+}
+
+/// The low `w` bits.
+fn mask(w: u32) -> u32 {
+    ((1u64 << w) - 1) as u32
+}
+
 /// Bits a zigzag-coded value takes.
 fn bits_of(z: u32) -> u32 {
     32 - z.leading_zeros()
@@ -705,6 +719,8 @@ pub struct Packed {
     /// Per lane: bits of the zigzag absolute value and delta at block starts.
     pub(crate) abs_bits: Vec<u8>,
     pub(crate) delta_bits: Vec<u8>,
+    /// Per lane: the width its header codes against at a block's start.
+    pub(crate) base_width: Vec<u8>,
     /// Per segment its first bit, then the stream's length in bits.
     pub(crate) seg_at: Vec<u32>,
     /// The bits as words, then two words of zeros; its length in bytes.
@@ -733,18 +749,47 @@ fn code(x: &[i32], k: usize, order: u32, block: usize) -> i32 {
     }
 }
 
+/// Per lane, the width that makes the headers of the blocks' first
+/// segments (`chosen` per segment, `every` segments a block) shortest.
+fn base_widths(chosen: &[Vec<(u32, u32)>], every: usize, lanes: usize) -> Vec<u8> {
+    (0..lanes)
+        .map(|l| {
+            let cost = |b: u32| -> usize {
+                chosen
+                    .iter()
+                    .step_by(every)
+                    .map(|c| width_code_bits(c[l].1, b))
+                    .sum()
+            };
+            (0..1u32 << WIDTH_BITS)
+                .min_by_key(|&b| cost(b))
+                .unwrap_or(0) as u8
+        })
+        .collect()
+}
+
+/// Bits of [`put_header`]'s width code for `width` after `before`.
+fn width_code_bits(width: u32, before: u32) -> usize {
+    match width.abs_diff(before) {
+        0 => 1,
+        1 => 3,
+        _ => 2 + WIDTH_BITS as usize,
+    }
+}
+
 /// A segment's header entry for one lane: the prediction order (1 bit:
 /// 0 for 2, 1 for 1), then its residual width, coded against the lane's
-/// width in the segment before (not across blocks, where a seek starts):
-/// `0` the same, `10s` one more (`s` = 0) or one less, `11wwwww` any.
-fn put_header(w: &mut BitWriter, order: u32, width: u32, before: Option<u32>) {
+/// width in the segment before, or at a block's start (where a seek
+/// starts) against the lane's base width: `0` the same, `10s` one more
+/// (`s` = 0) or one less, `11wwwww` any.
+fn put_header(w: &mut BitWriter, order: u32, width: u32, before: u32) {
     w.put(2 - order, 1);
-    match before {
-        Some(b) if b == width => w.put(0, 1),
-        Some(b) if b + 1 == width || width + 1 == b => {
+    match width.abs_diff(before) {
+        0 => w.put(0, 1),
+        1 => {
             w.put(1, 1);
             w.put(0, 1);
-            w.put(u32::from(width < b), 1);
+            w.put(u32::from(width < before), 1);
         }
         _ => {
             w.put(1, 1);
@@ -789,6 +834,11 @@ impl Packed {
         let n = source.keys;
         let lanes: Vec<&Vec<i32>> = source.tracks.iter().flat_map(|t| t.values.iter()).collect();
         let (abs_bits, delta_bits) = block_start_widths(&lanes, n, block);
+        let chosen: Vec<Vec<(u32, u32)>> = (0..n)
+            .step_by(SEGMENT_KEYS)
+            .map(|s| segment_orders(&lanes, s..(s + SEGMENT_KEYS).min(n), block))
+            .collect();
+        let base_width = base_widths(&chosen, block / SEGMENT_KEYS, lanes.len());
         let mut w = BitWriter {
             bytes: Vec::new(),
             bits: 0,
@@ -798,14 +848,17 @@ impl Packed {
         let bit_offset = |bits: usize| {
             u32::try_from(bits).map_err(|_| PackError("the packed stream exceeds 2^32 bits".into()))
         };
-        for s in (0..n).step_by(SEGMENT_KEYS) {
+        for (s, chosen) in (0..n).step_by(SEGMENT_KEYS).zip(&chosen) {
             seg_at.push(bit_offset(w.bits)?);
-            let chosen = segment_orders(&lanes, s..(s + SEGMENT_KEYS).min(n), block);
             for (l, &(order, wd)) in chosen.iter().enumerate() {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
                 }
-                let before = (s % block != 0).then(|| widths[l]);
+                let before = if s % block == 0 {
+                    base_width[l].into()
+                } else {
+                    widths[l]
+                };
                 put_header(&mut w, order, wd, before);
                 widths[l] = wd;
             }
@@ -824,9 +877,10 @@ impl Packed {
             }
             // Lane by lane: a lane's residuals of the segment are contiguous.
             let end = (s + SEGMENT_KEYS).min(n);
-            for (x, &(order, wd)) in lanes.iter().zip(&chosen) {
+            for (x, &(order, wd)) in lanes.iter().zip(chosen) {
                 for k in (s..end).filter(|k| k % block >= 2) {
-                    w.put(zigzag(code(x, k, order, block)), wd);
+                    let stored = code(x, k, order, block).wrapping_add(bias(wd)) as u32;
+                    w.put(stored & mask(wd), wd);
                 }
             }
         }
@@ -842,6 +896,7 @@ impl Packed {
             block,
             abs_bits,
             delta_bits,
+            base_width,
             seg_at,
             stream,
             stream_len,
@@ -948,8 +1003,8 @@ impl Packed {
     }
 
     /// Segment `j`'s headers from bit `pos`: each lane's prediction order
-    /// and width (coded against the segment before, except at a block's
-    /// start), checked.
+    /// and width (coded against the segment before, or at a block's start
+    /// against the lane's base width), checked.
     fn segment_headers(
         &self,
         j: usize,
@@ -959,15 +1014,16 @@ impl Packed {
     ) -> Result<(), PackError> {
         let bits = self.stream_len * 8;
         let block_start = (j * SEGMENT_KEYS).is_multiple_of(self.block);
-        for (wd, order) in widths.iter_mut().zip(orders.iter_mut()) {
+        let lanes = widths
+            .iter_mut()
+            .zip(orders.iter_mut())
+            .zip(&self.base_width);
+        for ((wd, order), base) in lanes {
             if *pos > bits {
                 return ends_early();
             }
-            let before = if block_start { 0 } else { *wd };
+            let before = if block_start { u32::from(*base) } else { *wd };
             let (o, w, used) = read_header(&self.stream, *pos, before);
-            if block_start && used != 3 + WIDTH_BITS as usize {
-                return err(format!("segment {j} starts a block with a relative width"));
-            }
             if w >= 1 << WIDTH_BITS {
                 return err(format!("segment {j}: a width out of range"));
             }
@@ -1041,7 +1097,7 @@ impl Packed {
         }
         for (l, xl) in x.iter_mut().enumerate() {
             for k in keys.clone().filter(|k| k % self.block >= 2) {
-                let r = unzigzag(take(widths[l])?);
+                let r = (take(widths[l])? as i32).wrapping_sub(bias(widths[l]));
                 let i = k - first_key;
                 let trend = if orders[l] == 2 {
                     xl[i - 1].wrapping_sub(xl[i - 2])
@@ -1067,7 +1123,7 @@ impl Packed {
 
     /// Bytes of the encoded stream and its tables (what a runtime keeps).
     pub fn stream_bytes(&self) -> usize {
-        8 * self.stream.len() + 4 * self.seg_at.len() + self.abs_bits.len() + self.delta_bits.len()
+        8 * self.stream.len() + 4 * self.seg_at.len() + 3 * self.abs_bits.len()
     }
 
     /// Bits of the residuals, widths and block starts.
@@ -1078,9 +1134,10 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes (it reads version 1 too: no
-/// skeleton).
-pub const VERSION: u32 = 2;
+/// The format version this build writes and reads (version 3: residuals
+/// stored offset by half their range; 1 and 2 stored them zigzag-coded and
+/// are refused with a one-line error).
+pub const VERSION: u32 = 3;
 
 mod file;
 pub(crate) mod store;

@@ -153,6 +153,9 @@ pub(crate) struct PackCache {
     /// Per plane: all ones in lanes whose residuals in the segment `cur`
     /// have a width above 0 (stored and not on the prediction).
     live: Vec<i32x8>,
+    /// Per plane: what the residuals of the segment `cur` are stored above
+    /// their value (`super::bias` of their width).
+    bias: Vec<i32x8>,
     /// Integers of one key in the group's planes (scratch; zero where no
     /// lane is stored).
     flat: Vec<i32x8>,
@@ -178,6 +181,7 @@ impl PackedKeys {
             widths: vec![0; self.lane_slot.len()],
             trend: vec![i32x8::ZERO; np],
             live: vec![i32x8::ZERO; np],
+            bias: vec![i32x8::ZERO; np],
             flat: vec![i32x8::ZERO; np],
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
@@ -237,12 +241,20 @@ impl PackCache {
         let mut pos = g.packed.seg_at[j] as usize;
         let trend: &mut [i32] = bytemuck::cast_slice_mut(&mut self.trend);
         let live: &mut [i32] = bytemuck::cast_slice_mut(&mut self.live);
+        let bias: &mut [i32] = bytemuck::cast_slice_mut(&mut self.bias);
+        if block {
+            // A block's first headers code against the lanes' base widths.
+            for (w, &base) in self.widths.iter_mut().zip(&g.packed.base_width) {
+                *w = base.into();
+            }
+        }
         for (w, &slot) in self.widths.iter_mut().zip(&g.lane_slot) {
-            let (order, width, used) = read_header(words, pos, if block { 0 } else { *w });
+            let (order, width, used) = read_header(words, pos, *w);
             pos += used;
             *w = width;
             trend[slot as usize] = if order == 2 { -1 } else { 0 };
             live[slot as usize] = if width > 0 { -1 } else { 0 };
+            bias[slot as usize] = super::bias(width);
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         let first = if block {
@@ -265,13 +277,12 @@ impl PackCache {
         for &p in &g.stored_planes {
             let p = p as usize;
             let (mut a, mut b) = (self.x0[p], self.x1[p]);
-            let (trend, live, step) = (self.trend[p], self.live[p], g.step[p]);
+            let (trend, live, bias) = (self.trend[p], self.live[p], self.bias[p]);
+            let step = g.step[p];
             for r in first..keys {
                 let at = (BEFORE + r) * np + p;
-                // Widths below 32: the shift's sign bit is 0.
                 let z: i32x8 = bytemuck::cast(self.rows[at]);
-                let z = z & live;
-                let x = b + ((b - a) & trend) + ((z >> 1) ^ (i32x8::ZERO - (z & 1)));
+                let x = b + ((b - a) & trend) + ((z & live) - bias);
                 (a, b) = (b, x);
                 self.rows[at] = super::dequantize_lanes(x, step);
             }
@@ -329,7 +340,8 @@ impl PackCache {
 }
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
-/// stream into `out[i * stride]`, still zigzag-coded.
+/// stream into `out[i * stride]`, as stored (`super::bias` above their
+/// value).
 type Unpack = fn(&[u64], usize, &mut [i32], usize);
 
 /// One function per width, each unrolled: a 64-bit window holds `64 / W`
