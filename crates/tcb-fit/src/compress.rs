@@ -232,7 +232,7 @@ fn search(
     // Per track a relative weight (rebalanced below) times kappa.
     let mut weight = vec![1.0f64; budget.unit.len()];
     let mut best: Option<(usize, Measured, Packed)> = None;
-    for round in 0..4 {
+    for round in 0..ROUNDS {
         // Every round bisects the whole range (later rounds, with weights
         // rebalanced, fewer times).
         let iterations = if round == 0 { 9 } else { 6 };
@@ -260,6 +260,12 @@ fn search(
     let (_, measured, packed) = best.expect("a round that holds, or an error above");
     Ok((measured, packed))
 }
+
+/// Rounds of bisecting kappa: on CMU 01_01 at ACL's target the file takes
+/// 186,948 bytes after 4 rounds (27 clips measured), 184,056 after 8 and
+/// 12; every 4th frame 61,569, 61,145 and 60,656 bytes; at the default
+/// tolerance 193,966 bytes each.
+const ROUNDS: usize = 12;
 
 /// Bisect kappa (log scale, `iterations` times) between one that holds
 /// (0.25 is taken to) and one that does not (64): the last kappa that
