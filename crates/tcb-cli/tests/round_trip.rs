@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{command, scratch, short_cmu, stderr};
+use common::{assert_success, scratch, short_cmu, tcb_to};
 use std::path::PathBuf;
 
 /// This binary's scratch folder.
@@ -62,13 +62,8 @@ fn a_reduced_clip_written_then_read_is_the_clip_verified() {
 
     // `tcb reduce` writes that same text.
     let out = dir().join("reduced-by-tcb.json");
-    let o = command()
-        .args(["reduce", input.to_str().unwrap(), "-o"])
-        .arg(&out)
-        .args(["--tolerance", "0.005"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("reduce", &input, &out, &["--tolerance", "0.005"]);
+    assert_success(&o);
     assert!(
         std::fs::read_to_string(&out).unwrap() == reduced.doc.to_json(),
         "tcb reduce wrote another clip than tcb_fit::reduce made"

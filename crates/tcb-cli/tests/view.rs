@@ -22,13 +22,8 @@ use std::sync::Arc;
 fn view_writes_one_self_contained_page() {
     let dir = scratch("view-page");
     let out = dir.join("cmu.html");
-    let o = tcb(&[
-        "view",
-        &file("data/cmu-01_01.bvh"),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("view", file("data/cmu-01_01.bvh"), &out, &[]);
+    assert_success(&o);
     stderr_has(
         &o,
         "38 joints, 2752 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
@@ -45,7 +40,7 @@ fn view_writes_one_self_contained_page() {
         .args(["view", &file("examples/clips/bounce.json")])
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     stderr_has(
         &o,
         "no skeleton (the curves alone), 121 frames at 60 fps (the default: keys not evenly spaced), 3 tracks in 1 plots",
@@ -55,33 +50,23 @@ fn view_writes_one_self_contained_page() {
     // A packed clip keeps its input's skeleton and plays its own stream.
     let packed = dir.join("cmu.tcbc");
     let short = short_cmu(120);
-    let o = tcb(&[
-        "compress",
-        short.to_str().unwrap(),
-        "-o",
-        packed.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = tcb(&[
-        "view",
-        packed.to_str().unwrap(),
-        "-o",
-        dir.join("packed.html").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("compress", &short, &packed, &[]);
+    assert_success(&o);
+    let o = tcb_to("view", &packed, dir.join("packed.html"), &[]);
+    assert_success(&o);
     stderr_has(
         &o,
         "38 joints, 120 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
     );
 
     // glTF: a skin's joints.
-    let o = tcb(&[
+    let o = tcb_to(
         "view",
-        &file("data/simple_skin.gltf"),
-        "-o",
-        dir.join("skin.html").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        file("data/simple_skin.gltf"),
+        dir.join("skin.html"),
+        &[],
+    );
+    assert_success(&o);
     stderr_has(&o, "joints");
 }
 
@@ -258,8 +243,8 @@ fn check_in_browser(name: &str, clip: &str, times: &[&str]) -> Option<Report> {
         return None;
     }
     let page = scratch("view-browser").join(format!("{name}.html"));
-    let o = tcb(&["view", clip, "-o", page.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("view", clip, &page, &[]);
+    assert_success(&o);
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("view-shots")
         .join(name);
