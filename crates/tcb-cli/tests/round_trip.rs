@@ -7,33 +7,11 @@ mod common;
 
 use common::{assert_success, scratch, short_cmu, tcb_to};
 use std::path::PathBuf;
+use tcb_test_support::debug_difference;
 
 /// This binary's scratch folder.
 fn dir() -> PathBuf {
     scratch("round-trip-test")
-}
-
-/// Equal `Debug` text is equal bits: every float is printed in its
-/// shortest round-trip form (`-0` and `0` differ). The first difference,
-/// or `None`.
-fn difference(read: &tcb_io::ClipDoc, written: &tcb_io::ClipDoc) -> Option<String> {
-    let (a, b) = (format!("{read:?}"), format!("{written:?}"));
-    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
-    let at = a
-        .iter()
-        .zip(&b)
-        .position(|(x, y)| x != y)
-        .or_else(|| (a.len() != b.len()).then(|| a.len().min(b.len())))?;
-    let around = |s: &[char]| -> String {
-        s[at.saturating_sub(80)..(at + 40).min(s.len())]
-            .iter()
-            .collect()
-    };
-    Some(format!(
-        "read back:\n  ...{}...\nwritten:\n  ...{}...",
-        around(&a),
-        around(&b)
-    ))
 }
 
 #[test]
@@ -56,7 +34,7 @@ fn a_reduced_clip_written_then_read_is_the_clip_verified() {
     let path = dir().join("reduced.json");
     tcb_io::write_clip_doc(&reduced.doc, &path).unwrap();
     let read = tcb_io::read_clip_doc(&path).unwrap();
-    if let Some(d) = difference(&read, &reduced.doc) {
+    if let Some(d) = debug_difference(&read, &reduced.doc) {
         panic!("{d}");
     }
 
