@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{file, scratch, stderr, stderr_has, stdout, tcb};
+use common::{assert_success, file, scratch, stderr, stderr_has, stdout, tcb, tcb_to};
 use std::path::PathBuf;
 
 /// The bundled example clips' folder.
@@ -35,7 +35,7 @@ fn clip_with(defaults: &str, track: &str) -> String {
 #[test]
 fn header_and_columns_follow_the_contract() {
     let o = tcb(&["sample", &example("bounce.json"), "--at", "0,0.25,1.5"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let out = stdout(&o);
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(
@@ -128,7 +128,7 @@ fn negative_huge_and_non_finite_times_work_as_written() {
         "--at",
         "-2.5,0,1e6,nan,inf,-inf,1e300",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     assert_eq!(stdout(&o).lines().count(), 8);
     // spin repeats with period 2: 1e6 is a whole number of periods.
     let rows: Vec<String> = stdout(&o).lines().map(str::to_owned).collect();
@@ -185,7 +185,7 @@ fn sampled_squad_velocities_are_the_references() {
             args.push("--scalar");
         }
         let o = tcb(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
+        assert_success(&o);
         stdout(&o)
     };
     let (a, b) = (run(false), run(true));
@@ -500,7 +500,7 @@ fn tcb_beyond_one_is_allowed() {
     );
     let path = temp_clip("beyond.json", &text);
     let o = tcb(&["sample", path.to_str().unwrap(), "--at", "0.5,1.5"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
 }
 
 /// A file of the repository's `data/`, as an argument.
@@ -512,22 +512,12 @@ fn data(name: &str) -> String {
 fn import_and_export_round_trip_through_the_command() {
     let dir = scratch("cli-test");
     let clip = dir.join("skin.json");
-    let o = tcb(&[
-        "import",
-        &data("simple_skin.gltf"),
-        "-o",
-        clip.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("import", data("simple_skin.gltf"), &clip, &[]);
+    assert_success(&o);
     stderr_has(&o, "1 tracks, 12 keys");
     let glb = dir.join("skin.glb");
-    let o = tcb(&[
-        "export",
-        clip.to_str().unwrap(),
-        "-o",
-        glb.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("export", &clip, &glb, &[]);
+    assert_success(&o);
     // LINEAR slerp goes back as LINEAR, exactly.
     stderr_has(&o, "1 exact, 0 resampled");
     let a = tcb(&["sample", clip.to_str().unwrap(), "--fps", "7"]);
@@ -548,7 +538,7 @@ fn import_and_export_errors_write_nothing() {
         "cut.bvh",
         "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 Xrotation Yrotation Zrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n1 2 3\n4 5\n",
     );
-    let o = tcb(&["import", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let o = tcb_to("import", &bad, &out, &[]);
     assert!(!o.status.success());
     assert!(
         stderr(&o).ends_with(
@@ -558,40 +548,26 @@ fn import_and_export_errors_write_nothing() {
         stderr(&o)
     );
     assert!(!out.exists());
-    let o = tcb(&[
+    let o = tcb_to(
         "import",
-        &data("simple_skin.gltf"),
-        "-o",
-        out.to_str().unwrap(),
-        "--rotation",
-        "hermite",
-    ]);
+        data("simple_skin.gltf"),
+        &out,
+        &["--rotation", "hermite"],
+    );
     stderr_has(&o, "--rotation is for BVH files");
-    let o = tcb(&[
+    let o = tcb_to(
         "import",
-        &data("simple_skin.gltf"),
-        "-o",
-        out.to_str().unwrap(),
-        "--animation",
-        "walk",
-    ]);
+        data("simple_skin.gltf"),
+        &out,
+        &["--animation", "walk"],
+    );
     stderr_has(&o, "no animation 'walk' (the file has: 0)");
     assert!(!out.exists());
     let glb = dir.join("never.glb");
-    let o = tcb(&[
-        "export",
-        &example("bounce.json"),
-        "-o",
-        glb.to_str().unwrap(),
-    ]);
+    let o = tcb_to("export", example("bounce.json"), &glb, &[]);
     stderr_has(&o, "track 'ball.position' (vec3) has no glTF target");
     assert!(!glb.exists());
-    let o = tcb(&[
-        "export",
-        &example("bounce.json"),
-        "-o",
-        dir.join("x.fbx").to_str().unwrap(),
-    ]);
+    let o = tcb_to("export", example("bounce.json"), dir.join("x.fbx"), &[]);
     stderr_has(&o, "must end in .glb or .gltf");
 }
 
@@ -600,26 +576,22 @@ fn export_renames_tracks_and_prints_one_summary_line() {
     let dir = scratch("cli-test");
     let glb = dir.join("bounce-renamed.glb");
     // Refused without renames, with the way out in the message.
-    let o = tcb(&[
-        "export",
-        &example("bounce.json"),
-        "-o",
-        glb.to_str().unwrap(),
-    ]);
+    let o = tcb_to("export", example("bounce.json"), &glb, &[]);
     assert!(!o.status.success());
     stderr_has(&o, "--rename 'ball.position=ball.translation'");
     assert!(!glb.exists());
-    let o = tcb(&[
+    let o = tcb_to(
         "export",
-        &example("bounce.json"),
-        "-o",
-        glb.to_str().unwrap(),
-        "--rename",
-        "ball.position=ball.translation",
-        "--rename",
-        "ball.squash=ball.weights.0",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        example("bounce.json"),
+        &glb,
+        &[
+            "--rename",
+            "ball.position=ball.translation",
+            "--rename",
+            "ball.squash=ball.weights.0",
+        ],
+    );
+    assert_success(&o);
     let err = stderr(&o);
     let wrote: Vec<&str> = err.lines().filter(|l| l.contains("wrote")).collect();
     assert_eq!(wrote.len(), 1, "{err}");
@@ -630,7 +602,7 @@ fn export_renames_tracks_and_prints_one_summary_line() {
     assert!(!err.contains("tcb: resampled"), "{err}");
     // The morph weight comes back under its new name.
     let o = tcb(&["sample", glb.to_str().unwrap(), "--at", "0.5"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     assert!(
         stdout(&o).starts_with("time,ball.translation.x"),
         "{}",
@@ -638,14 +610,12 @@ fn export_renames_tracks_and_prints_one_summary_line() {
     );
     assert!(stdout(&o).contains("ball.weights.0"), "{}", stdout(&o));
     for bad in ["nope=x", "ball.position", "=x"] {
-        let o = tcb(&[
+        let o = tcb_to(
             "export",
-            &example("bounce.json"),
-            "-o",
-            dir.join("never2.glb").to_str().unwrap(),
-            "--rename",
-            bad,
-        ]);
+            example("bounce.json"),
+            dir.join("never2.glb"),
+            &["--rename", bad],
+        );
         assert!(!o.status.success(), "{bad}");
         assert!(stderr(&o).contains("--rename"), "{bad}: {}", stderr(&o));
     }
@@ -667,10 +637,8 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
     for input in &inputs {
         for extra in [&[][..], &["--velocity"], &["--speed"]] {
             let _ = std::fs::remove_file(&out);
-            let mut args = vec!["plot", input.as_str(), "-o", out.to_str().unwrap()];
-            args.extend_from_slice(extra);
             // Any clip, any kind of track: each kind gets a panel.
-            let o = tcb(&args);
+            let o = tcb_to("plot", input, &out, extra);
             assert!(o.status.success(), "{input} {extra:?}: {}", stderr(&o));
             let svg = std::fs::read_to_string(&out).unwrap();
             assert!(
@@ -679,26 +647,20 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
             );
         }
     }
-    let o = tcb(&[
+    let o = tcb_to(
         "plot",
-        &example("careen.json"),
-        "-o",
-        out.to_str().unwrap(),
-        "--path",
-        "--inbetweens",
-        "4",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = tcb(&[
+        example("careen.json"),
+        &out,
+        &["--path", "--inbetweens", "4"],
+    );
+    assert_success(&o);
+    let o = tcb_to(
         "plot",
-        &example("spin.json"),
-        "-o",
-        out.to_str().unwrap(),
-        "--track",
-        "top.squad",
-        "--components",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        example("spin.json"),
+        &out,
+        &["--track", "top.squad", "--components"],
+    );
+    assert_success(&o);
     let never = dir.join("never.svg");
     for (args, message) in [
         (
@@ -718,22 +680,14 @@ fn plot_draws_every_bundled_file_and_refuses_bad_arguments() {
             "--components x,q: two different components",
         ),
     ] {
-        let bounce = example("bounce.json");
-        let mut all = vec!["plot", bounce.as_str(), "-o", never.to_str().unwrap()];
-        all.extend(args.iter().copied());
-        let o = tcb(&all);
+        let o = tcb_to("plot", example("bounce.json"), &never, &args);
         assert!(!o.status.success(), "{args:?}");
         let err = stderr(&o);
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
         assert!(err.contains(message), "{args:?}: {err}");
         assert!(!never.exists());
     }
-    let o = tcb(&[
-        "plot",
-        &example("bounce.json"),
-        "-o",
-        dir.join("x.png").to_str().unwrap(),
-    ]);
+    let o = tcb_to("plot", example("bounce.json"), dir.join("x.png"), &[]);
     stderr_has(&o, "the output must end in .svg");
 }
 
@@ -743,9 +697,7 @@ fn plot_draws_a_panel_per_kind_and_skips_what_path_cannot_draw_in_one_line() {
     let out = dir.join("bounce.svg");
     let plot = |input: &str, extra: &[&str]| {
         let _ = std::fs::remove_file(&out);
-        let mut args = vec!["plot", input, "-o", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        let o = tcb(&args);
+        let o = tcb_to("plot", input, &out, extra);
         assert!(o.status.success(), "{input} {extra:?}: {}", stderr(&o));
         (std::fs::read_to_string(&out).unwrap(), stderr(&o))
     };
@@ -805,12 +757,7 @@ fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
     let file = asset.join("up.gltf");
     std::fs::write(&file, gltf).unwrap();
     let out = dir.join("up.json");
-    let o = tcb(&[
-        "import",
-        file.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = tcb_to("import", &file, &out, &[]);
     assert!(!o.status.success());
     assert!(
         stderr(&o).contains("buffer 0 ('../data.bin'): is outside the glTF file's folder (allow it with --allow-outside-paths"),
@@ -818,14 +765,8 @@ fn a_buffer_outside_the_assets_folder_needs_allow_outside_paths() {
         stderr(&o)
     );
     assert!(!out.exists());
-    let o = tcb(&[
-        "import",
-        file.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--allow-outside-paths",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("import", &file, &out, &["--allow-outside-paths"]);
+    assert_success(&o);
     assert!(out.exists());
 }
 

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{scratch, stderr, stdout, tcb};
+use common::{assert_success, scratch, stderr, stdout, tcb, tcb_to};
 use std::path::PathBuf;
 
 /// This binary's scratch folder.
@@ -44,12 +44,7 @@ fn times_gltf_cannot_hold_are_one_line_and_write_nothing() {
     ] {
         let clip = clip_at(name, times);
         let out = dir().join(format!("{name}.glb"));
-        let o = tcb(&[
-            "export",
-            clip.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        let o = tcb_to("export", &clip, &out, &[]);
         assert!(!o.status.success(), "{name}");
         let err = stderr(&o);
         assert_eq!(err.lines().count(), 1, "{err}");
@@ -63,7 +58,7 @@ fn times_gltf_cannot_hold_are_one_line_and_write_nothing() {
 /// `tcb sample --scalar FILE --at TIMES`, as rows of numbers.
 fn sample(file: &str, at: &str) -> Vec<Vec<f64>> {
     let o = tcb(&["sample", "--scalar", file, "--at", at]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     stdout(&o)
         .lines()
         .skip(1)
@@ -78,13 +73,8 @@ fn keys_moved_by_f32_times_are_reported_and_read_back_within_it() {
         "1e6, 1000000.1, 1000000.2, 1000000.3, 1000000.4",
     );
     let glb = dir().join("million.glb");
-    let o = tcb(&[
-        "export",
-        clip.to_str().unwrap(),
-        "-o",
-        glb.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("export", &clip, &glb, &[]);
+    assert_success(&o);
     let err = stderr(&o);
     let wrote = err.lines().find(|l| l.contains("wrote")).expect(&err);
     assert!(wrote.contains("1 tracks, 0 exact"), "{err}");
@@ -99,13 +89,8 @@ fn keys_moved_by_f32_times_are_reported_and_read_back_within_it() {
     );
 
     let back = dir().join("million-back.json");
-    let o = tcb(&[
-        "import",
-        glb.to_str().unwrap(),
-        "-o",
-        back.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("import", &glb, &back, &[]);
+    assert_success(&o);
     // The keys, where f32 stores them, and between.
     let at: Vec<String> = (0..=64)
         .map(|i| format!("{:?}", 1e6 + 0.4 * f64::from(i) / 64.0))

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{command, root, stderr};
+use common::{assert_success, command, root};
 use std::path::{Path, PathBuf};
 
 const TOL: f64 = 1e-5;
@@ -49,7 +49,7 @@ fn sample(clip: &str, times: &[f64], scalar: bool) -> (Vec<String>, Vec<Vec<f64>
         cmd.arg("--scalar");
     }
     let out = cmd.output().unwrap();
-    assert!(out.status.success(), "{}", stderr(&out));
+    assert_success(&out);
     parse_csv(&common::stdout(&out))
 }
 

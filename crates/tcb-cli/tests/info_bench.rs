@@ -2,12 +2,12 @@
 
 mod common;
 
-use common::{file, stderr, stdout, tcb};
+use common::{assert_success, file, stderr, stdout, tcb};
 
 #[test]
 fn info_names_tracks_grids_and_bytes() {
     let o = tcb(&["info", &file("examples/clips/bounce.json")]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let out = stdout(&o);
     assert!(
         out.contains("3 tracks, 8 channels, 10 keys, 0 to 2 s"),
@@ -29,7 +29,7 @@ fn info_names_tracks_grids_and_bytes() {
     assert!(out.contains("bytes: "));
     // A BVH file, imported on the fly, with its skeleton.
     let o = tcb(&["info", &file("data/cmu-01_01.bvh"), "--rotation", "hermite"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let out = stdout(&o);
     assert!(
         out.contains("32 tracks") && out.contains("skeleton: 38 joints"),
@@ -51,7 +51,7 @@ fn info_names_tracks_grids_and_bytes() {
         "hermite",
         "--quantize",
     ]);
-    assert!(q.status.success(), "{}", stderr(&q));
+    assert_success(&q);
     let qout = stdout(&q);
     assert_eq!(
         qout.matches("quantization error at most").count(),
@@ -85,7 +85,7 @@ fn bench_reports_ns_per_joint_bytes_and_flags() {
         "2",
         "--quantize",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let out = stdout(&o);
     for want in [
         "build:",
@@ -139,7 +139,7 @@ fn info_says_which_tracks_quantizing_keeps_in_f32() {
     )
     .unwrap();
     let o = tcb(&["info", path.to_str().unwrap(), "--quantize"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let out = stdout(&o);
     assert_eq!(out.matches("kept in f32").count(), 1, "{out}");
     assert_eq!(

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{file, scratch, short_cmu, stderr, stderr_has, stdout, tcb};
+use common::{assert_success, file, scratch, short_cmu, stderr, stderr_has, stdout, tcb, tcb_to};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -14,15 +14,8 @@ fn dir() -> PathBuf {
 
 /// `tcb reduce INPUT -o OUT [EXTRA...]`, which must succeed.
 fn reduce_ok(input: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "reduce",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend(extra);
-    let o = tcb(&args);
-    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    let o = tcb_to("reduce", input, out, extra);
+    assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
     o
 }
 
@@ -73,18 +66,8 @@ fn reduces_a_bvh_within_the_shell_tolerance_and_the_result_plays_and_exports() {
     stderr_has(&o, "tcb: a quick timing (300 ms, one run");
     stderr_has(&o, "ns per joint per frame");
     stderr_has(&o, "tcb: estimated runtime cost: input ");
-    for args in [
-        vec!["sample", out.to_str().unwrap(), "--at", "0.5,1"],
-        vec![
-            "export",
-            out.to_str().unwrap(),
-            "-o",
-            dir().join("short.glb").to_str().unwrap(),
-        ],
-    ] {
-        let o = tcb(&args);
-        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-    }
+    assert_success(&tcb(&["sample", out.to_str().unwrap(), "--at", "0.5,1"]));
+    assert_success(&tcb_to("export", &out, dir().join("short.glb"), &[]));
 }
 
 /// At the default tolerance the jittery capture keeps most keys. Fitted
@@ -131,7 +114,7 @@ fn sample_with(clip: &Path, times: &[f64], extra: &[&str]) -> Vec<Vec<f64>> {
     let mut args = vec!["sample", clip.to_str().unwrap(), "--at", &at];
     args.extend(extra);
     let o = tcb(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     stdout(&o)
         .lines()
         .skip(1)
@@ -247,22 +230,15 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
         (vec![&bvh, "--knots", "bone"], "unknown knot sharing 'bone'"),
     ];
     for (args, message) in cases {
-        let mut all = vec!["reduce", args[0], "-o", out.to_str().unwrap()];
-        all.extend(&args[1..]);
-        let o = tcb(&all);
-        assert!(!o.status.success(), "{all:?}");
-        assert!(stderr(&o).contains(message), "{all:?}: {}", stderr(&o));
-        assert!(o.stdout.is_empty(), "{all:?}");
-        assert!(!out.exists(), "{all:?} wrote {}", out.display());
+        let o = tcb_to("reduce", args[0], &out, &args[1..]);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+        assert!(o.stdout.is_empty(), "{args:?}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
     }
-    let o = tcb(&[
-        "reduce",
-        &bounce,
-        "-o",
-        dir().join("x.csv").to_str().unwrap(),
-    ]);
+    let o = tcb_to("reduce", &bounce, dir().join("x.csv"), &[]);
     stderr_has(&o, "the output must end in .json");
-    let o = tcb(&["reduce", &bounce, "-o", "/nonexistent-tcb-dir/x.json"]);
+    let o = tcb_to("reduce", &bounce, "/nonexistent-tcb-dir/x.json", &[]);
     stderr_has(&o, "/nonexistent-tcb-dir: no such directory");
 }
 
@@ -270,13 +246,8 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
 fn an_imported_clip_keeps_its_skeleton_and_reduces_by_shell() {
     let bvh = short_cmu(120);
     let json = dir().join("short-import.json");
-    let o = tcb(&[
-        "import",
-        bvh.to_str().unwrap(),
-        "-o",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("import", &bvh, &json, &[]);
+    assert_success(&o);
     let from_bvh = tcb_io::load(&bvh).unwrap().skeleton.unwrap();
     let from_json = tcb_io::load(&json).unwrap().skeleton.unwrap();
     assert_eq!(from_json, from_bvh);
@@ -331,15 +302,8 @@ fn a_constant_track_becomes_two_keys_even_beside_a_kept_grid() {
 fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
     let input = short_cmu(240);
     let out = dir().join("short.tcbc");
-    let o = tcb(&[
-        "compress",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--tolerance",
-        "0.002",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("compress", &input, &out, &["--tolerance", "0.002"]);
+    assert_success(&o);
     let stdout = stdout(&o);
     let line = stdout.lines().last().unwrap();
     let rest = line
@@ -364,14 +328,14 @@ fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
         }
     }
     let o = tcb(&["info", out.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     let info = common::stdout(&o);
     assert!(
         info.contains("bits per value") && info.contains("made by: tcb compress"),
         "{info}"
     );
     let o = tcb(&["bench", out.to_str().unwrap(), "--rounds", "1"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
 }
 
 /// Bad requests and files: one line on stderr, exit 1, nothing written.
@@ -413,15 +377,8 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
     }
     // A damaged .tcbc: one line, from sample and info alike.
     let good = dir().join("good.tcbc");
-    let o = tcb(&[
-        "compress",
-        input,
-        "-o",
-        good.to_str().unwrap(),
-        "--tolerance",
-        "0.01",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("compress", input, &good, &["--tolerance", "0.01"]);
+    assert_success(&o);
     let mut bytes = std::fs::read(&good).unwrap();
     let n = bytes.len();
     bytes[n / 2] ^= 1;

@@ -5,35 +5,13 @@
 
 mod common;
 
-use common::{command, scratch, short_cmu, stderr};
+use common::{assert_success, scratch, short_cmu, tcb_to};
 use std::path::PathBuf;
+use tcb_test_support::debug_difference;
 
 /// This binary's scratch folder.
 fn dir() -> PathBuf {
     scratch("round-trip-test")
-}
-
-/// Equal `Debug` text is equal bits: every float is printed in its
-/// shortest round-trip form (`-0` and `0` differ). The first difference,
-/// or `None`.
-fn difference(read: &tcb_io::ClipDoc, written: &tcb_io::ClipDoc) -> Option<String> {
-    let (a, b) = (format!("{read:?}"), format!("{written:?}"));
-    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
-    let at = a
-        .iter()
-        .zip(&b)
-        .position(|(x, y)| x != y)
-        .or_else(|| (a.len() != b.len()).then(|| a.len().min(b.len())))?;
-    let around = |s: &[char]| -> String {
-        s[at.saturating_sub(80)..(at + 40).min(s.len())]
-            .iter()
-            .collect()
-    };
-    Some(format!(
-        "read back:\n  ...{}...\nwritten:\n  ...{}...",
-        around(&a),
-        around(&b)
-    ))
 }
 
 #[test]
@@ -56,19 +34,14 @@ fn a_reduced_clip_written_then_read_is_the_clip_verified() {
     let path = dir().join("reduced.json");
     tcb_io::write_clip_doc(&reduced.doc, &path).unwrap();
     let read = tcb_io::read_clip_doc(&path).unwrap();
-    if let Some(d) = difference(&read, &reduced.doc) {
+    if let Some(d) = debug_difference(&read, &reduced.doc) {
         panic!("{d}");
     }
 
     // `tcb reduce` writes that same text.
     let out = dir().join("reduced-by-tcb.json");
-    let o = command()
-        .args(["reduce", input.to_str().unwrap(), "-o"])
-        .arg(&out)
-        .args(["--tolerance", "0.005"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("reduce", &input, &out, &["--tolerance", "0.005"]);
+    assert_success(&o);
     assert!(
         std::fs::read_to_string(&out).unwrap() == reduced.doc.to_json(),
         "tcb reduce wrote another clip than tcb_fit::reduce made"

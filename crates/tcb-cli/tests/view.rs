@@ -22,13 +22,8 @@ use std::sync::Arc;
 fn view_writes_one_self_contained_page() {
     let dir = scratch("view-page");
     let out = dir.join("cmu.html");
-    let o = tcb(&[
-        "view",
-        &file("data/cmu-01_01.bvh"),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("view", file("data/cmu-01_01.bvh"), &out, &[]);
+    assert_success(&o);
     stderr_has(
         &o,
         "38 joints, 2752 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
@@ -45,7 +40,7 @@ fn view_writes_one_self_contained_page() {
         .args(["view", &file("examples/clips/bounce.json")])
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert_success(&o);
     stderr_has(
         &o,
         "no skeleton (the curves alone), 121 frames at 60 fps (the default: keys not evenly spaced), 3 tracks in 1 plots",
@@ -55,33 +50,23 @@ fn view_writes_one_self_contained_page() {
     // A packed clip keeps its input's skeleton and plays its own stream.
     let packed = dir.join("cmu.tcbc");
     let short = short_cmu(120);
-    let o = tcb(&[
-        "compress",
-        short.to_str().unwrap(),
-        "-o",
-        packed.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = tcb(&[
-        "view",
-        packed.to_str().unwrap(),
-        "-o",
-        dir.join("packed.html").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("compress", &short, &packed, &[]);
+    assert_success(&o);
+    let o = tcb_to("view", &packed, dir.join("packed.html"), &[]);
+    assert_success(&o);
     stderr_has(
         &o,
         "38 joints, 120 frames at 120.0005 fps (the clip's key times), 32 tracks in 31 plots",
     );
 
     // glTF: a skin's joints.
-    let o = tcb(&[
+    let o = tcb_to(
         "view",
-        &file("data/simple_skin.gltf"),
-        "-o",
-        dir.join("skin.html").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        file("data/simple_skin.gltf"),
+        dir.join("skin.html"),
+        &[],
+    );
+    assert_success(&o);
     stderr_has(&o, "joints");
 }
 
@@ -258,8 +243,8 @@ fn check_in_browser(name: &str, clip: &str, times: &[&str]) -> Option<Report> {
         return None;
     }
     let page = scratch("view-browser").join(format!("{name}.html"));
-    let o = tcb(&["view", clip, "-o", page.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let o = tcb_to("view", clip, &page, &[]);
+    assert_success(&o);
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("view-shots")
         .join(name);
@@ -285,9 +270,24 @@ fn view_plays_the_cmu_jump_in_chromium_where_the_runtime_puts_it() {
     assert!(r.has_skeleton && r.stage_visible);
     assert_eq!(r.joints.len(), 38);
     assert_eq!(r.groups.len(), 31);
+    joints_are_drawn_where_the_binding_puts_them(&r, "data/cmu-01_01.bvh");
+    the_figure_follows_the_root_through_the_jump(&r);
+    playback_orbit_and_picking_respond(&r);
+    eprintln!(
+        "screenshots: {} and {}",
+        r.shots
+            .iter()
+            .map(|s| s.png.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        r.page_shot.display()
+    );
+}
 
-    // Joint positions as drawn against SkeletonBinding's at the same time.
-    let loaded = tcb_io::load(file("data/cmu-01_01.bvh")).unwrap();
+/// Each shot's joint positions, as drawn, against `SkeletonBinding`'s at
+/// the same time for the clip `clip` (under the repository).
+fn joints_are_drawn_where_the_binding_puts_them(r: &Report, clip: &str) {
+    let loaded = tcb_io::load(file(clip)).unwrap();
     let clip = Arc::new(tcb_runtime::Clip::compile(&loaded.clip));
     let binding = tcb_runtime::SkeletonBinding::new(loaded.skeleton.unwrap(), &clip);
     let mut instance = tcb_runtime::Instance::new(clip);
@@ -315,10 +315,12 @@ fn view_plays_the_cmu_jump_in_chromium_where_the_runtime_puts_it() {
     }
     eprintln!("largest difference of a drawn joint from SkeletonBinding: {worst:e}");
     assert!(worst <= 1e-5, "{worst:e}");
+}
 
-    // The screenshots: the figure (its orange bones) is where the root is
-    // drawn, and moves as the root does. Hips go forward along +z from 1 s
-    // to 3 s, up in the jump at 2 s.
+/// The screenshots at 1, 2 and 3 s of the CMU jump: the figure (its orange
+/// bones) is where the root is drawn, and moves as the root does. Hips go
+/// forward along +z from 1 s to 3 s, up in the jump at 2 s.
+fn the_figure_follows_the_root_through_the_jump(r: &Report) {
     let hips = |s: &Shot| s.positions["Hips"];
     let [a, mid, b] = [&r.shots[0], &r.shots[1], &r.shots[2]];
     assert!(hips(b)[2] - hips(a)[2] > 10.0 && hips(mid)[1] - hips(a)[1] > 3.0);
@@ -350,8 +352,11 @@ fn view_plays_the_cmu_jump_in_chromium_where_the_runtime_puts_it() {
     assert!(moved * expected > 0.0 && (moved - expected).abs() < 0.25 * expected.abs() + 10.0);
     // In the air at 2 s: the feet above where they stand at 1 s and 3 s.
     assert!(fm.max_y.unwrap() + 10.0 < fa.max_y.unwrap().min(fb.max_y.unwrap()));
+}
 
-    // Playback, and picking a joint by a click and from the list.
+/// Playback at the speed chosen, a drag that orbits the camera, and
+/// picking a joint by a click and from the list.
+fn playback_orbit_and_picking_respond(r: &Report) {
     let p = &r.playback;
     assert!(p.playing.playing && !p.paused.playing && p.button == "Play");
     assert!(p.playing.time != p.before && p.playing.speed == 2.0);
@@ -367,15 +372,6 @@ fn view_plays_the_cmu_jump_in_chromium_where_the_runtime_puts_it() {
     assert_eq!(c.state.plot.as_deref(), Some(r.pick.chosen.as_str()));
     assert_eq!(c.img[0], 900);
     assert!(c.state.cursor.is_some());
-    eprintln!(
-        "screenshots: {} and {}",
-        r.shots
-            .iter()
-            .map(|s| s.png.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        r.page_shot.display()
-    );
 }
 
 #[test]

@@ -8,6 +8,7 @@ use tcb_core::{
     Ends, Extrapolation, KeyParams, RotationMode, RotationTrack, TangentRule, Tcb, Track,
     TrackSettings, Vector,
 };
+use tcb_test_support::proptest_config;
 
 const RULES: [TangentRule; 4] = [
     TangentRule::Uniform,
@@ -59,28 +60,8 @@ fn quat_close(a: Quat, b: Quat, tol: f32) -> bool {
     (a - b).length().min((a + b).length()) <= tol
 }
 
-/// Cases and seed: deterministic by default so that CI cannot flake;
-/// `PROPTEST_CASES` and `PROPTEST_RNG_SEED` override them for deeper runs.
-fn config(cases: u32) -> ProptestConfig {
-    let env = ProptestConfig::default();
-    let set = |name: &str| std::env::var_os(name).is_some();
-    ProptestConfig {
-        cases: if set("PROPTEST_CASES") {
-            env.cases
-        } else {
-            cases
-        },
-        rng_seed: if set("PROPTEST_RNG_SEED") {
-            env.rng_seed
-        } else {
-            proptest::test_runner::RngSeed::Fixed(0x7cb_1984)
-        },
-        ..env
-    }
-}
-
 proptest! {
-    #![proptest_config(config(200))]
+    #![proptest_config(proptest_config(200))]
 
     /// Keys clustered over 15 orders of magnitude, spans that overflow
     /// f64 when subtracted: the seek's guess (evenly spaced keys) lands
@@ -293,7 +274,7 @@ fn quats(n: usize) -> impl Strategy<Value = Vec<Quat>> {
 }
 
 proptest! {
-    #![proptest_config(config(100))]
+    #![proptest_config(proptest_config(100))]
 
     #[test]
     fn rotations_are_unit_and_pass_through_keys(

@@ -11,33 +11,13 @@ use proptest::prelude::*;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 use tcb_core::{Ends, Extrapolation, Hemisphere, Interp, RotationMode, TangentRule, TrackKind};
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
-
-/// Where two documents' `Debug` texts first differ (`None`: same bits).
-fn difference(read: &ClipDoc, written: &ClipDoc) -> Option<String> {
-    let (a, b) = (format!("{read:?}"), format!("{written:?}"));
-    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
-    let at = a
-        .iter()
-        .zip(&b)
-        .position(|(x, y)| x != y)
-        .or_else(|| (a.len() != b.len()).then(|| a.len().min(b.len())))?;
-    let around = |s: &[char]| -> String {
-        s[at.saturating_sub(80)..(at + 40).min(s.len())]
-            .iter()
-            .collect()
-    };
-    Some(format!(
-        "read back:\n  ...{}...\nwritten:\n  ...{}...",
-        around(&a),
-        around(&b)
-    ))
-}
+use tcb_test_support::debug_difference;
 
 /// `doc` written, then read: the same bits, in memory and through a file.
 fn assert_reads_back(doc: &ClipDoc) {
     let json = doc.to_json();
     let again = ClipDoc::parse(&json).unwrap_or_else(|e| panic!("{e}"));
-    if let Some(d) = difference(&again, doc) {
+    if let Some(d) = debug_difference(&again, doc) {
         panic!("{d}");
     }
     let dir = std::env::temp_dir().join(format!("tcb-io-round-trip-{}", std::process::id()));
@@ -45,7 +25,7 @@ fn assert_reads_back(doc: &ClipDoc) {
     let path = dir.join(format!("{}.json", doc.name));
     tcb_io::write_clip_doc(doc, &path).unwrap();
     let read = tcb_io::read_clip_doc(&path).unwrap();
-    if let Some(d) = difference(&read, doc) {
+    if let Some(d) = debug_difference(&read, doc) {
         panic!("through {}: {d}", path.display());
     }
 }
@@ -309,7 +289,7 @@ proptest! {
     fn every_written_clip_reads_back_bit_for_bit(doc in clip()) {
         let json = doc.to_json();
         let again = ClipDoc::parse(&json).map_err(|e| TestCaseError::fail(format!("{e}\n{json}")))?;
-        if let Some(d) = difference(&again, &doc) {
+        if let Some(d) = debug_difference(&again, &doc) {
             return Err(TestCaseError::fail(d));
         }
     }

@@ -17,6 +17,31 @@ pub fn tcb(args: &[&str]) -> Output {
     command().args(args).output().expect("run tcb")
 }
 
+/// `tcb SUBCOMMAND INPUT -o OUT EXTRA...`, run to the end: the shape of
+/// `import`, `export`, `reduce`, `compress`, `plot` and `view`.
+pub fn tcb_to(
+    subcommand: &str,
+    input: impl AsRef<Path>,
+    out: impl AsRef<Path>,
+    extra: &[&str],
+) -> Output {
+    command()
+        .arg(subcommand)
+        .arg(input.as_ref())
+        .arg("-o")
+        .arg(out.as_ref())
+        .args(extra)
+        .output()
+        .expect("run tcb")
+}
+
+/// Asserts that the run succeeded (showing what it wrote to stderr if
+/// not).
+#[track_caller]
+pub fn assert_success(o: &Output) {
+    assert!(o.status.success(), "{}", stderr(o));
+}
+
 /// What the run wrote to stdout (`tcb` writes UTF-8).
 pub fn stdout(o: &Output) -> String {
     String::from_utf8(o.stdout.clone()).expect("stdout is UTF-8")
