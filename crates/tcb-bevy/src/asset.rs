@@ -54,6 +54,11 @@ impl TcbClip {
 /// Loads [`TcbClip`]s from `.json` (tcb clip JSON), `.bvh`, `.gltf`, `.glb`
 /// and `.tcbc` files. A `.gltf`'s buffers must be embedded (`data:` URIs);
 /// a `.glb` holds its own.
+///
+/// bevy's own glTF loader (and any other `.json` loader) registers the
+/// same extensions: load typed, `asset_server.load::<TcbClip>(path)`, and
+/// bevy picks this loader; an untyped or labeled load (`walk.glb#Scene0`)
+/// picks the loader registered last.
 #[derive(Default, TypePath)]
 pub struct TcbClipLoader;
 

@@ -166,7 +166,8 @@ impl TcbPlayer {
         self.bound.as_ref().map(|b| b.current.time)
     }
 
-    /// Jump to `time` in the clip playing.
+    /// Jump to `time` in the clip playing (no effect before the player is
+    /// bound, or for a time that is not finite).
     pub fn seek(&mut self, time: f64) {
         if let Some(b) = &mut self.bound
             && time.is_finite()
