@@ -47,7 +47,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     tcb_io::write_clip_doc(&doc, &out)?;
     let clip = tcb_io::load(&out)?.clip;
-    println!("wrote {}; sampled back:", out.display());
+    println!(
+        "wrote {}; sampled back (positions in the clip's units, velocities in units per second):",
+        out.display()
+    );
     let mut row = [0.0f32; 3];
     let mut vel = [0.0f32; 3];
     for i in 0..=8 {

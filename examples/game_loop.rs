@@ -84,10 +84,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let per_frame = spent.as_secs_f64() / frames.max(1) as f64;
     println!(
-        "{frames} frames of {} characters ({joints} joints each): {:.2} us per frame, {:.1} ns per joint (two clips sampled, blended, composed); highest head {head_height:.2}",
+        "{frames} frames of {} characters ({joints} joints each): {:.2} us of wall clock per frame \
+         for all of them, {:.1} ns per joint (each joint: two clips sampled, blended and composed \
+         into model space); a 60 fps frame has 16,667 us",
         characters.len(),
         per_frame * 1e6,
         per_frame * 1e9 / (characters.len() * joints) as f64
+    );
+    println!(
+        "highest head: {head_height:.2} BVH units above the origin (this capture's units: \
+         about 1/18 of the figure's height)"
     );
     Ok(())
 }

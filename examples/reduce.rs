@@ -18,6 +18,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let reduced = tcb_fit::reduce(input, &Default::default(), &|_, _| {})?;
     println!("{}", reduced.summary_line());
+    let s = &reduced.settings;
+    println!(
+        "max error: the farthest a point at a joint or {:.3} units from it (the shell, about 3 cm \
+         on a 1.7 m figure {:.1} units tall) moved, in the BVH's units, over every frame and 3 \
+         inbetweens; allowed: {:.3e} units (about 0.1 mm); time in seconds",
+        s.shell, s.height, s.tolerance
+    );
     println!(
         "compiled runtime clip: {} -> {} bytes ({:.2}x smaller), keys {} -> {}",
         reduced.before.bytes,

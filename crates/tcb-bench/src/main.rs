@@ -303,7 +303,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     let mut rows: Vec<_> = all.iter().map(|s| report::measure(s, &timing)).collect();
     report::relate(&mut rows);
     let here = report::Fingerprint::here();
-    print_report(args, &rows, &here, &timing);
+    print_report(args, &rows, &here, &timing, load);
     let doc = report::to_json(&rows, &here, &timing);
     let text = serde_json::to_string_pretty(&doc)? + "\n";
     for path in args.json.iter().chain(&save) {
@@ -434,18 +434,21 @@ fn only_names(args: &Args) -> Result<Option<Vec<&str>>, Box<dyn std::error::Erro
     Ok(names)
 }
 
-/// The report on stdout: the table, the README's goals met or not, and a
-/// word after `--quick`.
+/// The report on stdout: the table, the README's goals met or not (after
+/// what their figures depend on, with the load the run started under),
+/// and a word after `--quick`.
 fn print_report(
     args: &Args,
     rows: &[report::Row],
     here: &report::Fingerprint,
     timing: &report::Timing,
+    load: Option<f64>,
 ) {
     print!("{}", report::table(rows, here, timing));
     let goals = report::goals(rows);
     if !goals.is_empty() {
         println!("\ngoals (the README's \"Goals\"):");
+        println!("{}", goals_note(load, here.cores));
         for (line, met) in goals {
             println!("  {} {line}", if met { "met    " } else { "not yet" });
         }
@@ -455,4 +458,23 @@ fn print_report(
             "\nThis was --quick; run without it for the full report (11 rounds of 20 ms, every frame)."
         );
     }
+}
+
+/// What the goals' figures depend on, said before them: the ns-per-joint
+/// goals are absolute, so a slower CPU or a busy machine misses them; the
+/// others are bytes or ratios timed in the same rounds; crowd's needs
+/// idle cores. `load` is the one-minute load average when the run started.
+fn goals_note(load: Option<f64>, cores: usize) -> String {
+    let load = match load {
+        Some(l) if l > 0.5 * cores as f64 => {
+            format!("load average {l:.2} on {cores} cores at the start: busy, so these read slow")
+        }
+        Some(l) => format!("load average {l:.2} on {cores} cores at the start"),
+        None => "load average unknown".to_string(),
+    };
+    format!(
+        "  the ns-per-joint goals are absolute: they hold or not with the CPU, the build and\n  \
+         what else runs; the rest are bytes, which no machine changes, or ratios timed in the\n  \
+         same rounds (crowd's needs idle cores).\n  This run: {load}."
+    )
 }

@@ -8,6 +8,7 @@
 //! tcb import FILE.gltf|FILE.glb -o CLIP.json [--animation NAME_OR_INDEX]
 //! tcb info CLIP
 //! tcb bench CLIP [--fps 60] [--instances N] [--threads N]
+//! tcb view CLIP [-o PAGE.html] [--fps N] [--joint NAME]
 //! ```
 //!
 //! `sample` also reads BVH and glTF files directly (imported on the fly).
@@ -16,6 +17,8 @@
 //! status and nothing on stdout.
 
 #![forbid(unsafe_code)]
+
+mod view;
 
 use clap::{Args, Parser, Subcommand};
 use std::io::{self, Write};
@@ -76,6 +79,34 @@ enum Command {
     Plot(PlotArgs),
     /// Write the figures of docs/figures/ (the paper's, redrawn) to a directory.
     Figures(FiguresArgs),
+    /// Write one self-contained HTML page that plays the clip on its
+    /// skeleton (three.js inside), with each joint's curves.
+    View(ViewArgs),
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    /// The clip: clip JSON, BVH, glTF, GLB or a packed .tcbc (a clip with
+    /// no skeleton shows its curves alone).
+    clip: PathBuf,
+    /// The page to write (default: the clip's file name with .html, in the
+    /// current directory).
+    #[arg(short, long, value_name = "OUT.html")]
+    output: Option<PathBuf>,
+    /// Poses per second the page holds (default: the clip's key times when
+    /// they are evenly spaced, as in motion capture; else 60).
+    #[arg(long, value_name = "FPS", allow_hyphen_values = true)]
+    fps: Option<f64>,
+    /// The joint, or group of tracks (`ball` for `ball.position`), whose
+    /// curves show first (default: the root joint, or the first group).
+    #[arg(long, value_name = "NAME")]
+    joint: Option<String>,
+    /// BVH: rotation mode of its rotation tracks, as `tcb import`.
+    #[arg(long, value_name = "squad|hermite")]
+    rotation: Option<tcb_core::RotationMode>,
+    /// glTF: the animation, by name or index (default: the first).
+    #[arg(long, value_name = "NAME_OR_INDEX")]
+    animation: Option<String>,
 }
 
 #[derive(Args)]
@@ -339,6 +370,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench(&args),
         Command::Plot(args) => plot(&args),
         Command::Figures(args) => figures(&args),
+        Command::View(args) => view_page(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -637,14 +669,16 @@ fn with_progress<T>(template: &str, work: impl FnOnce(&(dyn Fn(usize, usize) + S
 }
 
 /// Any clip file as a source clip and its skeleton: a `.tcbc` as its
-/// reference (the dequantized keys; the file keeps no skeleton), the rest
+/// reference (the dequantized keys) and the skeleton it keeps, the rest
 /// through `tcb_io` (warnings printed).
 fn load_any(
     path: &std::path::Path,
     options: &tcb_io::ImportOptions,
 ) -> Result<(tcb_core::Clip, Option<tcb_core::skeleton::Skeleton>), BoxError> {
     if extension(path) == "tcbc" {
-        return Ok((load_tcbc(path)?.0, None));
+        let (clip, runtime) = load_tcbc(path)?;
+        let skeleton = runtime.packed().and_then(|p| p.skeleton.clone());
+        return Ok((clip, skeleton));
     }
     let loaded = tcb_io::load_with(path, options)?;
     warn(&loaded.warnings);
@@ -896,6 +930,10 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
             &packed.note
         }
     )?;
+    match &packed.skeleton {
+        Some(s) => writeln!(out, "skeleton: {} joints", s.joints().len())?,
+        None => writeln!(out, "skeleton: none")?,
+    }
     write_packed_tracks(&mut out, head)?;
     writeln!(
         out,
@@ -1173,6 +1211,53 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
     }
     tcb_io::write_atomically(&args.output, drawn.svg.as_bytes())?;
     eprintln!("tcb: wrote {}", args.output.display());
+    Ok(())
+}
+
+fn view_page(args: &ViewArgs) -> Result<(), BoxError> {
+    let file = args.clip.file_name().map_or_else(
+        || args.clip.display().to_string(),
+        |f| f.to_string_lossy().into_owned(),
+    );
+    let output = match &args.output {
+        Some(o) => o.clone(),
+        None => PathBuf::from(&file).with_extension("html"),
+    };
+    if extension(&output) != "html" {
+        return Err(format!("{}: the output must end in .html", output.display()).into());
+    }
+    output_folder_exists(&output)?;
+    let options = import_options(&args.clip, args.rotation, args.animation.as_ref())?;
+    // A packed clip plays its own stream, as `sample` plays it.
+    let (clip, skeleton, runtime) = if extension(&args.clip) == "tcbc" {
+        let (clip, runtime) = load_tcbc(&args.clip)?;
+        let skeleton = runtime.packed().and_then(|p| p.skeleton.clone());
+        (clip, skeleton, runtime)
+    } else {
+        let (clip, skeleton) = load_any(&args.clip, &options)?;
+        let runtime = std::sync::Arc::new(tcb_runtime::Clip::compile(&clip));
+        (clip, skeleton, runtime)
+    };
+    let page = view::page(
+        &clip,
+        skeleton.as_ref(),
+        runtime,
+        &view::Options {
+            title: file,
+            fps: args.fps,
+            joint: args.joint.clone(),
+        },
+    )?;
+    for note in &page.notes {
+        eprintln!("tcb: {note}");
+    }
+    tcb_io::write_atomically(&output, page.html.as_bytes())?;
+    eprintln!(
+        "tcb: wrote {} ({}): {}",
+        output.display(),
+        mb(page.html.len()),
+        page.summary
+    );
     Ok(())
 }
 

@@ -229,8 +229,9 @@ extern "C" {
  * Load a clip file and compile it: by extension, a clip (`.json`), BVH
  * (`.bvh`) or glTF (`.gltf`, `.glb`; the first animation) file, imported
  * as `tcb import` does, or a packed `.tcbc` file (played from its packed
- * stream; it carries no skeleton). BVH and glTF files, and clip files with
- * a `skeleton`, give the clip a skeleton (`tcb_clip_has_skeleton`).
+ * stream). BVH and glTF files, clip files with a `skeleton` and `.tcbc`
+ * files written from those give the clip a skeleton
+ * (`tcb_clip_has_skeleton`).
  *
  * `path` is a NUL-terminated UTF-8 path; `flags` is 0 or an OR of
  * `TCB_LOAD_*`. On success `*out` is a new clip, to be freed with

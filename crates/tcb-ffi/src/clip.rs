@@ -49,9 +49,10 @@ fn compile_options(flags: u32) -> Result<CompileOptions> {
 fn packed(bytes: &[u8], origin: &str) -> Result<TcbClip> {
     let clip = Clip::from_bytes(bytes)
         .map_err(|e| Failure::new(TcbStatus::InvalidData, format!("{origin}: {e}")))?;
+    let skeleton = clip.packed().and_then(|p| p.skeleton.clone());
     Ok(TcbClip {
         clip: Arc::new(clip),
-        skeleton: None,
+        skeleton,
     })
 }
 
@@ -138,8 +139,9 @@ fn load_memory(bytes: &[u8], format: &str, flags: u32) -> Result<TcbClip> {
 /// Load a clip file and compile it: by extension, a clip (`.json`), BVH
 /// (`.bvh`) or glTF (`.gltf`, `.glb`; the first animation) file, imported
 /// as `tcb import` does, or a packed `.tcbc` file (played from its packed
-/// stream; it carries no skeleton). BVH and glTF files, and clip files with
-/// a `skeleton`, give the clip a skeleton (`tcb_clip_has_skeleton`).
+/// stream). BVH and glTF files, clip files with a `skeleton` and `.tcbc`
+/// files written from those give the clip a skeleton
+/// (`tcb_clip_has_skeleton`).
 ///
 /// `path` is a NUL-terminated UTF-8 path; `flags` is 0 or an OR of
 /// `TCB_LOAD_*`. On success `*out` is a new clip, to be freed with

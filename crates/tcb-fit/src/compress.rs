@@ -195,6 +195,7 @@ pub fn compress(
         measured.worst.at,
         measured.worst.time
     );
+    packed.skeleton = skeleton.cloned();
     let bytes = check_written(&packed)?;
     let values = packed.head().keys * packed.head().lanes();
     Ok(Compressed {

@@ -3,7 +3,22 @@
 //! The clip file (`tcb-clip/1` JSON, the project's `docs/clip-format.md`):
 //! parsing with errors that name the file, the track and the key, building
 //! validated [`tcb_core::Clip`]s, and writing clips without leaving
-//! half-written files.
+//! half-written files; BVH and glTF import, glTF export.
+//!
+//! Most programs start with [`load`]: a clip file, BVH or glTF by its
+//! extension, with its skeleton when the file has one.
+//!
+//! ```
+//! # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+//! # /*
+//! let path = "data/cmu-01_01.bvh"; // from the repository's root
+//! # */
+//! let loaded = tcb_io::load(path)?;
+//! println!("{} tracks, {} joints", loaded.clip.tracks().len(), loaded.skeleton.map_or(0, |s| s.joints().len()));
+//! # Ok::<(), tcb_io::Error>(())
+//! ```
+//!
+//! A clip from text, and the one-line errors of a bad one:
 //!
 //! ```
 //! let text = r#"{

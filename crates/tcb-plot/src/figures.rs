@@ -42,7 +42,8 @@ fn path(title: &str) -> Plot {
     }
 }
 
-/// Every figure, in the order the README shows them.
+/// Every figure, in the order docs/guide.md shows them, then the
+/// README's (a test names the first one's clip).
 pub fn figures() -> Vec<Figure> {
     vec![
         Figure {
@@ -110,6 +111,18 @@ pub fn figures() -> Vec<Figure> {
                 from: Some(0.0),
                 to: Some(2.0),
                 ..titled("Squad against hermite on the same rotation keys")
+            },
+        },
+        Figure {
+            name: "parameters.svg",
+            clip: "examples/clips/parameters.json",
+            plot: Plot {
+                inbetweens: Some(0),
+                from: Some(0.0),
+                to: Some(4.0),
+                ..titled(
+                    "The same five keys: tension, continuity and bias (Kochanek & Bartels 1984)",
+                )
             },
         },
     ]

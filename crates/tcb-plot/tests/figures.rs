@@ -7,7 +7,7 @@ use std::path::Path;
 fn figures_regenerate_byte_for_byte() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let figures = tcb_plot::figures();
-    assert_eq!(figures.len(), 9);
+    assert_eq!(figures.len(), 10);
     for f in &figures {
         let svg = f.render(&root).unwrap();
         let committed = std::fs::read_to_string(root.join("docs/figures").join(f.name))

@@ -68,6 +68,24 @@ fn plays_its_reference(source: &PackSource, block: usize) {
         .map(|f| t0 + f as f64 / 60.0)
         .take_while(|t| *t <= t1)
         .collect();
+    // Backward at 60 fps, forward at 240 fps (several frames a key) and at
+    // 24 fps (several keys a frame, crossing segments), in short runs.
+    let span = (t1 - t0).min(3.0);
+    times.extend(
+        (0..)
+            .map(|f| t1 - f as f64 / 60.0)
+            .take_while(|t| *t >= t1 - span),
+    );
+    times.extend(
+        (0..)
+            .map(|f| t0 + f as f64 / 240.0)
+            .take_while(|t| *t <= t0 + span),
+    );
+    times.extend(
+        (0..)
+            .map(|f| t0 + 0.7 + f as f64 / 24.0)
+            .take_while(|t| *t <= t1),
+    );
     let mut x = 12345u64;
     for _ in 0..500 {
         x = x
@@ -106,6 +124,66 @@ fn file_round_trip() {
             .to_bytes()
             .is_none()
     );
+}
+
+/// The skeleton a file keeps reads back; a version 1 file (no skeleton
+/// section) still reads; a skeleton whose joint names a later parent, or
+/// whose rest is not finite, is refused in one line.
+#[test]
+fn skeleton_round_trip_and_version_1() {
+    let bvh = include_str!("../../../data/cmu-01_01.bvh");
+    let skeleton = tcb_io::bvh::Bvh::parse(bvh).unwrap().skeleton().clone();
+    let (_, source) = cmu();
+    let mut packed = Packed::encode(&source).unwrap();
+    packed.skeleton = Some(skeleton.clone());
+    let bytes = packed.to_bytes();
+    let back = Packed::from_bytes(&bytes).unwrap();
+    assert_eq!(back.skeleton.as_ref(), Some(&skeleton));
+    let clip = Clip::from_bytes(&bytes).unwrap();
+    let kept = clip.packed().and_then(|p| p.skeleton.as_ref());
+    assert_eq!(
+        kept.map(|s| s.joints().len()),
+        Some(skeleton.joints().len())
+    );
+
+    // Version 1: the same body without the skeleton section.
+    let reseal = |mut b: Vec<u8>| {
+        let len = b.len() as u64;
+        b[12..20].copy_from_slice(&len.to_le_bytes());
+        let crc = crc32fast::hash(&b[24..]);
+        b[20..24].copy_from_slice(&crc.to_le_bytes());
+        b
+    };
+    packed.skeleton = None;
+    let mut v1 = packed.to_bytes();
+    assert_eq!(v1[v1.len() - 4..], [0, 0, 0, 0]); // no joints
+    v1.truncate(v1.len() - 4);
+    v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let v1 = reseal(v1);
+    assert_eq!(Packed::from_bytes(&v1).unwrap(), packed);
+
+    // The first joint's parent set to itself, then its rest's x to NaN.
+    let first = bytes.len() - skeleton_bytes(&skeleton);
+    let name = skeleton.joints()[0].name.len();
+    let mut b = bytes.clone();
+    b[first + 4 + name..first + 8 + name].copy_from_slice(&0u32.to_le_bytes());
+    let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
+    assert!(
+        msg.starts_with("skeleton: ") && !msg.contains('\n'),
+        "{msg}"
+    );
+    let mut b = bytes.clone();
+    b[first + 9 + name..first + 13 + name].copy_from_slice(&f32::NAN.to_le_bytes());
+    let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
+    assert!(msg.contains("not finite"), "{msg}");
+}
+
+/// Bytes of a skeleton section's joints (after its count).
+fn skeleton_bytes(s: &tcb_core::skeleton::Skeleton) -> usize {
+    s.joints()
+        .iter()
+        .map(|j| 4 + j.name.len() + 4 + 1 + 12)
+        .sum()
 }
 
 #[test]

@@ -207,8 +207,11 @@ pub fn map_lanes<L: Lane>(
     let len = tn - t0;
     let rel = time - t0;
     let m = (rel / len).floor();
-    // Rounding can push r a hair outside [0, L].
-    let r = (rel - m * len).clamp_to(zero, len);
+    // Rounding can push r a hair outside [0, L]; near the ends of f64,
+    // `time - t0` overflows to an infinity and r is NaN: such a time (its
+    // place in the cycle lost to rounding anyway) wraps to the first key.
+    let r = rel - m * len;
+    let r = L::select(r.eq(r), r.clamp_to(zero, len), zero);
     let odd = (m - (m * L::of(0.5)).floor() * two).eq(one);
     let back = out & mode.oscillate & odd;
     let wraps = out & (mode.repeat | mode.oscillate | mode.offset_repeat);
@@ -238,6 +241,18 @@ mod tests {
             time,
             direction,
             cycles,
+        }
+    }
+
+    /// Near -f64::MAX, `time - t0` overflows (issue 29): the wrapping
+    /// modes land on the first key, not on a NaN time.
+    #[test]
+    fn a_finite_time_whose_offset_overflows_wraps_to_the_first_key() {
+        for mode in [E::Repeat, E::Oscillate, E::OffsetRepeat] {
+            match map_time(-f64::MAX, 1e300, 3e300, mode, mode) {
+                Mapped::Inside { time, .. } => assert_eq!(time, 1e300, "{mode:?}"),
+                m => panic!("{mode:?}: {m:?}"),
+            }
         }
     }
 

@@ -36,7 +36,7 @@ int main(int argc, char **argv) {
     CHECK(tcb_clip_load_file(path, 0, &clip));
     double start = 0.0, end = 0.0;
     CHECK(tcb_clip_time_range(clip, &start, &end));
-    printf("tcb %s: %s, %zu tracks, %zu floats a row, keys %.4f..%.4f s\n",
+    printf("tcb %s: %s, %zu tracks, %zu floats a row, keys from %.4f to %.4f s\n",
            tcb_version(), path, tcb_clip_track_count(clip),
            tcb_clip_channel_count(clip), start, end);
 
@@ -62,14 +62,15 @@ int main(int argc, char **argv) {
     size_t hand = 0;
     CHECK(tcb_skeleton_find_joint(skel, "LeftHand", &hand));
     const float *m = matrices + hand * TCB_MATRIX_FLOATS;
-    printf("LeftHand model position at %.2f s: %.4f %.4f %.4f (of %zu joints)\n", t, m[12],
-           m[13], m[14], joints);
+    printf("LeftHand model-space position at %.2f s, in the file's units: %.4f %.4f %.4f"
+           " (of %zu joints)\n",
+           t, m[12], m[13], m[14], joints);
     /* Or each joint's local translation, rotation, scale (10 floats a joint). */
     float *locals = malloc(joints * TCB_TRANSFORM_FLOATS * sizeof *locals);
     if (!locals) return 1;
     CHECK(tcb_skeleton_local_transforms(skel, inst, locals, joints * TCB_TRANSFORM_FLOATS));
-    printf("Hips local rotation: %.4f %.4f %.4f %.4f\n", locals[3], locals[4], locals[5],
-           locals[6]);
+    printf("Hips local rotation (quaternion x y z w): %.4f %.4f %.4f %.4f\n", locals[3],
+           locals[4], locals[5], locals[6]);
     free(locals);
 
     /* Cross-fade two instances through a rig into a pose of the rig. */
@@ -94,7 +95,8 @@ int main(int argc, char **argv) {
         CHECK(tcb_skeleton_model_matrices_pose(rig_skel, mixed, matrices,
                                                joints * TCB_MATRIX_FLOATS));
     }
-    printf("LeftHand after the cross-fade: %.4f %.4f %.4f\n", m[12], m[13], m[14]);
+    printf("LeftHand after the cross-fade, in the file's units: %.4f %.4f %.4f\n", m[12], m[13],
+           m[14]);
 
     /* Errors: a status and a message, never a crash. */
     TcbClip *missing = NULL;

@@ -83,7 +83,8 @@ int main(int argc, char **argv) {
         size_t head = 0;
         tcb::check(tcb_skeleton_find_joint(skeleton.get(), "Head", &head), "find joint");
         const float *m = &matrices[head * TCB_MATRIX_FLOATS];
-        std::printf("Head model position at %.2f s: %.4f %.4f %.4f\n", t, m[12], m[13], m[14]);
+        std::printf("Head model-space position at %.2f s, in the file's units: %.4f %.4f %.4f\n", t,
+                    m[12], m[13], m[14]);
 
         // An error is an exception here, with the library's message.
         try {

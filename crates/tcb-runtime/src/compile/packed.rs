@@ -223,8 +223,12 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
             table.extend_from_slice(section);
         }
     }
+    let mut stored_planes: Vec<u32> = lane_slot.iter().map(|at| at / 8).collect();
+    stored_planes.sort_unstable();
+    stored_planes.dedup();
     PackedKeys {
         packed: packed.clone(),
+        stored_planes,
         keys: n,
         planes: np,
         lane_slot,

@@ -11,9 +11,10 @@
 use super::{
     MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, VERSION, check_block, err,
 };
-use tcb_core::TrackKind;
-use tcb_core::TrackSettings;
+use glam::{Quat, Vec3};
 use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
+use tcb_core::skeleton::{Joint, Skeleton, Transform};
+use tcb_core::{TrackKind, TrackSettings};
 
 const HEADER: usize = 24;
 const KINDS: [TrackKind; 5] = [
@@ -113,6 +114,54 @@ impl<'a> Reader<'a> {
             ));
         }
         Ok((seg_at, stream, len))
+    }
+
+    /// The skeleton section (version 2): a joint count (0: none), then per
+    /// joint its name, parent (`u32::MAX`: a root; else an earlier joint),
+    /// which of its rest rotation and scale follow (bit 0, bit 1; else
+    /// identity and one), and its rest translation, rotation and scale
+    /// (finite `f32`s).
+    fn skeleton(&mut self) -> Result<Option<Skeleton>, PackError> {
+        let count = self.u32("the joint count")? as usize;
+        // A joint takes at least 21 bytes: refuse counts the file cannot hold.
+        if count > (self.bytes.len() - self.at) / 21 {
+            return err(format!(
+                "{count} joints claimed with {} bytes left",
+                self.bytes.len() - self.at
+            ));
+        }
+        let mut skeleton = Skeleton::default();
+        for i in 0..count {
+            let name = self.str(&format!("joint {i}'s name"))?;
+            let what = format!("joint {name}'s rest transform");
+            let parent = match self.u32(&format!("joint {name}'s parent"))? {
+                u32::MAX => None,
+                p => Some(p as usize),
+            };
+            let flags = self.u8(&what)?;
+            if flags > 3 {
+                return err(format!("joint {name}: rest flags {flags} (at most 3)"));
+            }
+            let mut v = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+            let given = [true; 3].into_iter().chain([flags & 1 == 1; 4]);
+            for (x, given) in v.iter_mut().zip(given.chain([flags & 2 == 2; 3])) {
+                if given {
+                    *x = self.f32(&what)?;
+                }
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                return err(format!("joint {name}: a rest transform that is not finite"));
+            }
+            let rest = Transform {
+                translation: Vec3::from_slice(&v[0..3]),
+                rotation: Quat::from_slice(&v[3..7]),
+                scale: Vec3::from_slice(&v[7..10]),
+            };
+            skeleton
+                .push(Joint { name, parent, rest })
+                .map_err(|e| PackError(format!("skeleton: {e}")))?;
+        }
+        Ok((count > 0).then_some(skeleton))
     }
 
     /// Track `i`'s head: name, kind, settings, tension, continuity, bias,
@@ -249,6 +298,22 @@ impl Packed {
         let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
         w.len(self.stream_len);
         w.0.extend_from_slice(&bytes[..self.stream_len]);
+        let joints = self.skeleton.as_ref().map_or(&[][..], Skeleton::joints);
+        w.len(joints.len());
+        for j in joints {
+            w.str(&j.name);
+            w.u32(j.parent.map_or(u32::MAX, |p| p as u32));
+            let r = &j.rest;
+            let (turned, scaled) = (r.rotation != Quat::IDENTITY, r.scale != Vec3::ONE);
+            w.u8(u8::from(turned) | u8::from(scaled) << 1);
+            let rotation = r.rotation.to_array();
+            let scale = r.scale.to_array();
+            let floats = r.translation.to_array().into_iter();
+            let floats = floats.chain(rotation.into_iter().filter(|_| turned));
+            for v in floats.chain(scale.into_iter().filter(|_| scaled)) {
+                w.f32(v);
+            }
+        }
         let total = w.0.len() as u64;
         let crc = crc32fast::hash(&w.0[HEADER..]);
         let head = &mut w.0[..HEADER];
@@ -274,7 +339,7 @@ impl Packed {
     /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
     /// decoding every key takes a few).
     pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
-        let body = checked_body(bytes)?;
+        let (version, body) = checked_body(bytes)?;
         let mut r = Reader { bytes: body, at: 0 };
         let name = r.str("the clip's name")?;
         let note = r.str("the note")?;
@@ -300,6 +365,7 @@ impl Packed {
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
         let (abs_bits, delta_bits) = r.block_widths(stored)?;
         let (seg_at, stream, len) = r.stream(keys, stored)?;
+        let skeleton = if version >= 2 { r.skeleton()? } else { None };
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
         }
@@ -318,6 +384,7 @@ impl Packed {
             stream,
             stream_len: len,
             note,
+            skeleton,
         };
         packed.head.validate_head()?;
         packed.check_structure()?;
@@ -325,16 +392,16 @@ impl Packed {
     }
 }
 
-/// The body of `.tcbc` bytes after their header, once the magic number,
-/// version, length and checksum hold.
-fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
+/// The version and the body of `.tcbc` bytes after their header, once the
+/// magic number, version, length and checksum hold.
+fn checked_body(bytes: &[u8]) -> Result<(u32, &[u8]), PackError> {
     if bytes.len() < HEADER || bytes[..8] != MAGIC {
         return err("not a .tcbc file (no TCBC magic number)");
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != VERSION {
+    if !(1..=VERSION).contains(&version) {
         return err(format!(
-            ".tcbc version {version}; this build reads version {VERSION}"
+            ".tcbc version {version}; this build reads versions 1 to {VERSION}"
         ));
     }
     let total = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
@@ -349,5 +416,5 @@ fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
     if crc32fast::hash(body) != crc {
         return err("checksum mismatch: the file is corrupted");
     }
-    Ok(body)
+    Ok((version, body))
 }

@@ -675,17 +675,22 @@ pub(crate) fn window(words: &[u64], pos: usize) -> u64 {
     (pair[0] >> o) | ((pair[1] << 1) << (63 - o))
 }
 
-/// Bytes (little-endian, padded with zeros) as words, plus two words of
-/// padding.
+/// Words of zeros after a stream's: the runtime's decoder reads 16 values
+/// of up to 31 bits from any bit of the stream (`store::unpack16`), in
+/// 64-bit windows of two words.
+pub(crate) const STREAM_PAD: usize = 10;
+
+/// Bytes (little-endian, padded with zeros) as words, plus
+/// [`STREAM_PAD`] words of padding.
 pub(crate) fn to_words(bytes: &[u8]) -> Vec<u64> {
     // Sized once: the stream is the largest thing a loader allocates.
-    let mut words = Vec::with_capacity(bytes.len().div_ceil(8) + 2);
+    let mut words = Vec::with_capacity(bytes.len().div_ceil(8) + STREAM_PAD);
     words.extend(bytes.chunks(8).map(|c| {
         let mut b = [0u8; 8];
         b[..c.len()].copy_from_slice(c);
         u64::from_le_bytes(b)
     }));
-    words.extend([0, 0]);
+    words.extend([0; STREAM_PAD]);
     words
 }
 
@@ -708,6 +713,10 @@ pub struct Packed {
     /// What made it (`tcb compress`'s options and measured error), for
     /// `tcb info`: free text, kept in the file.
     pub note: String,
+    /// The skeleton the clip animates, if it has one (`tcb compress` keeps
+    /// the input's): kept in the file, so that a `.tcbc` plays on its
+    /// figure alone.
+    pub skeleton: Option<tcb_core::skeleton::Skeleton>,
 }
 
 /// Per key of a block, the integer a lane codes: the block's first value,
@@ -837,6 +846,7 @@ impl Packed {
             stream,
             stream_len,
             note: String::new(),
+            skeleton: None,
         })
     }
 
@@ -1068,8 +1078,9 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+/// The format version this build writes (it reads version 1 too: no
+/// skeleton).
+pub const VERSION: u32 = 2;
 
 mod file;
 pub(crate) mod store;

@@ -1,10 +1,17 @@
 //! A group's controls from a [`Packed`] stream: keys decoded as playback
 //! reaches them, tangents derived from their neighbours.
 //!
-//! An instance keeps the last four decoded keys (`P`, in the group's planes)
-//! and the predictor's state; a segment from key `a` to `a + 1` needs keys
-//! `a - 1 ..= a + 2`, so forward playback decodes one key per key it
-//! crosses. Interior tangents are the tangent rule on the two chords,
+//! An instance keeps the decoded keys (`P`, in the group's planes) of one
+//! 16-key segment and the three keys before it, and the predictor's state;
+//! a segment from key `a` to `a + 1` needs keys `a - 1 ..= a + 2`. Playback
+//! decodes a segment when it first needs one of its keys, in three passes
+//! that each run without a branch on the data: every lane's residuals
+//! unpacked by a function for its width (16 values, a mask and a shift
+//! each), then per plane of 8 lanes the prediction and dequantization, key
+//! by key, with the predictor in registers, then the rebuilt `w`s. Forward
+//! playback decodes each key once; playing backwards re-decodes from the
+//! block's start only when it leaves a segment. Interior tangents are the
+//! tangent rule on the two chords,
 //!
 //! ```text
 //! TO_a = (P_a - P_{a-1}) out_a + (P_{a+1} - P_a) out_b       TI_b likewise with in_a, in_b
@@ -17,7 +24,7 @@
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
 
-use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag, window};
+use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag};
 use crate::segment::Segment;
 use std::sync::Arc;
 use wide::{f32x8, i32x8};
@@ -40,6 +47,8 @@ pub(crate) struct PackedKeys {
     pub step: Vec<f32x8>,
     /// Per plane: `in_a, in_b, out_a, out_b` of each lane.
     pub weights: Vec<[f32x8; 4]>,
+    /// The planes with a stored lane (the decoder predicts only these).
+    pub stored_planes: Vec<u32>,
     /// The first rotation plane; rotation blocks of 4 planes follow.
     pub rot_from: usize,
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
@@ -64,26 +73,6 @@ impl PackedKeys {
             + 4 * self.lane_slot.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
             + 8 * self.rebuild.len()
-    }
-
-    /// A cache for [`segment`](Self::segment), per instance.
-    pub fn cache(&self) -> PackCache {
-        let lanes = self.lane_slot.len();
-        PackCache {
-            seg: usize::MAX,
-            next: 0,
-            first: 0,
-            reads: vec![LaneRead::default(); lanes],
-            res: vec![i32x8::ZERO; SEGMENT_KEYS * self.planes],
-            trend: vec![i32x8::ZERO; self.planes],
-            abs: vec![0; lanes],
-            delta: vec![0; lanes],
-            flat: vec![i32x8::ZERO; self.planes],
-            x0: vec![i32x8::ZERO; self.planes],
-            x1: vec![i32x8::ZERO; self.planes],
-            p: vec![f32x8::ZERO; 4 * self.planes],
-            m: vec![f32x8::ZERO; 2 * self.planes],
-        }
     }
 
     /// The controls of the segment from key `a` to key `b`: a real segment
@@ -120,240 +109,264 @@ impl PackedKeys {
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
     fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
         let (np, n) = (self.planes, self.keys);
-        let ring = |k: usize| (k & 3) * np;
-        let (m0, m1) = c.m.split_at_mut(np);
-        let p = &c.p;
+        let mut m = std::mem::take(&mut c.m);
+        let (m0, m1) = m.split_at_mut(np);
         if a > 0 {
-            let (x, y, z) = (ring(a - 1), ring(a), ring(b));
-            let rows = p[x..x + np].iter().zip(&p[y..y + np]).zip(&p[z..z + np]);
+            let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
+            let rows = x.iter().zip(y).zip(z);
             for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
                 *m = (*y - *x) * w[2] + (*z - *y) * w[3];
             }
         }
         if b < n - 1 {
-            let (x, y, z) = (ring(a), ring(b), ring(b + 1));
-            let rows = p[x..x + np].iter().zip(&p[y..y + np]).zip(&p[z..z + np]);
+            let (x, y, z) = (c.ring(a, np), c.ring(b, np), c.ring(b + 1, np));
+            let rows = x.iter().zip(y).zip(z);
             for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
                 *m = (*y - *x) * w[0] + (*z - *y) * w[1];
             }
         }
+        c.m = m;
     }
 }
 
-/// Where one stream lane's residual is in a key's row of the current
-/// segment, and its width.
-#[derive(Clone, Copy, Debug, Default)]
-struct LaneRead {
-    slot: u32,
-    width: u32,
-}
+/// Rows of the decoded keys' window: the three keys before the current
+/// segment, its 16 keys, and 2 spare rows (a segment's residuals are
+/// unpacked 16 at a time, from row 2 at a block's start).
+const BEFORE: usize = 3;
+const ROWS: usize = BEFORE + SEGMENT_KEYS + 2;
 
 /// One instance's decoding state for a [`PackedKeys`] group.
 #[derive(Clone, Debug)]
 pub(crate) struct PackCache {
+    /// The segment whose keys `rows` holds (`usize::MAX`: none).
+    cur: usize,
+    /// The first key whose row is valid (the three before `cur`'s first
+    /// key, or, after a seek, the first key decoded).
+    valid: usize,
     /// The first key of the segment whose tangents `m` holds.
     seg: usize,
-    /// The next key to decode, and the first decoded since the last seek.
-    next: usize,
-    first: usize,
-    /// Per stream lane: its plane slot and this segment's width.
-    reads: Vec<LaneRead>,
-    /// This segment's residuals, zigzag-coded: per key of the segment, per
-    /// plane (a key's row is contiguous, in the group's planes).
-    res: Vec<i32x8>,
+    /// Per stream lane: its width in the segment `cur`.
+    widths: Vec<u32>,
     /// Per plane: all ones in lanes predicted by the line through their
     /// last two values (order 2), zeros in lanes predicted by the last.
     trend: Vec<i32x8>,
-    /// Per stream lane: this block's start and delta.
-    abs: Vec<i32>,
-    delta: Vec<i32>,
-    /// Integers of one key in the group's planes (scratch).
+    /// Per plane: all ones in lanes whose residuals in the segment `cur`
+    /// have a width above 0 (stored and not on the prediction).
+    live: Vec<i32x8>,
+    /// Integers of one key in the group's planes (scratch; zero where no
+    /// lane is stored).
     flat: Vec<i32x8>,
     /// The predictor: the last two keys' integers, per plane.
     x0: Vec<i32x8>,
     x1: Vec<i32x8>,
-    /// The last four decoded keys (key k in slot k & 3), `planes` each.
-    p: Vec<f32x8>,
+    /// Keys `16 cur - 3 ..` in `ROWS` rows of `planes` vectors (see
+    /// [`ROWS`]); while a segment is decoded, a row holds its residuals
+    /// (as `i32`) until the prediction replaces them with the key.
+    rows: Vec<f32x8>,
     /// `TO_a` then `TI_b` of the segment `seg`.
     m: Vec<f32x8>,
 }
 
+impl PackedKeys {
+    /// A cache for [`segment`](Self::segment), per instance.
+    pub fn cache(&self) -> PackCache {
+        let np = self.planes;
+        PackCache {
+            cur: usize::MAX,
+            valid: 0,
+            seg: usize::MAX,
+            widths: vec![0; self.lane_slot.len()],
+            trend: vec![i32x8::ZERO; np],
+            live: vec![i32x8::ZERO; np],
+            flat: vec![i32x8::ZERO; np],
+            x0: vec![i32x8::ZERO; np],
+            x1: vec![i32x8::ZERO; np],
+            rows: vec![f32x8::ZERO; ROWS * np],
+            m: vec![f32x8::ZERO; 2 * np],
+        }
+    }
+}
+
 impl PackCache {
+    /// Key `k`'s row (decoded: `valid <= k` and in or before `cur`).
     #[inline(always)]
     fn ring(&self, k: usize, np: usize) -> &[f32x8] {
-        let at = (k & 3) * np;
-        &self.p[at..at + np]
+        let at = (k + BEFORE - SEGMENT_KEYS * self.cur) * np;
+        &self.rows[at..at + np]
     }
 
-    /// Decode until keys `lo ..= hi` (at most 4) are in the ring: forward
-    /// from the last key decoded, or from the start of `lo`'s block.
+    /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
+    /// `lo`'s at most) have rows: on from the segment decoded last, or
+    /// from the start of `lo`'s block.
     fn ensure(&mut self, g: &PackedKeys, lo: usize, hi: usize) {
-        let start = lo - lo % g.packed.block;
-        let ok = if lo >= self.next {
-            self.next >= start
+        let to = hi / SEGMENT_KEYS;
+        if self.cur == to && lo >= self.valid {
+            return;
+        }
+        // A block's first segment needs nothing before it.
+        let restart = (lo - lo % g.packed.block) / SEGMENT_KEYS;
+        let from = if self.cur < to && self.cur + 1 >= restart {
+            self.cur + 1
         } else {
-            lo >= self.first.max(self.next.saturating_sub(4))
+            restart
         };
-        if !ok {
-            self.next = start;
-            self.first = start;
+        for j in from..=to {
+            self.decode_segment(g, j);
         }
-        while self.next <= hi {
-            self.decode_next(g);
-        }
+        debug_assert!(lo >= self.valid && self.cur == to);
     }
 
-    /// Decode key `next` into the ring.
-    fn decode_next(&mut self, g: &PackedKeys) {
-        let (k, np) = (self.next, g.planes);
-        let in_block = k % g.packed.block;
-        if k.is_multiple_of(SEGMENT_KEYS) {
-            self.enter_segment(g, k, in_block == 0);
-        }
-        let ring = (k & 3) * np;
-        let out = &mut self.p[ring..ring + np];
-        let (x0, x1) = (&mut self.x0[..np], &mut self.x1[..np]);
-        let step = &g.step[..np];
-        if in_block < 2 {
-            // The block's start values, then its deltas.
-            let from = if in_block == 0 {
-                &self.abs
-            } else {
-                &self.delta
-            };
-            scatter(&g.lane_slot, from, bytemuck::cast_slice_mut(&mut self.flat));
-            let start = i32x8::splat(-i32::from(in_block == 0));
-            for p in 0..np {
-                let x = (x1[p] & !start) + self.flat[p];
-                x0[p] = x1[p];
-                x1[p] = x;
-                out[p] = super::dequantize_lanes(x, step[p]);
-            }
+    /// Decode segment `j` into the rows (after segment `j - 1`, or at a
+    /// block's start): its headers, a block's start values and deltas,
+    /// every lane's residuals, then per plane the prediction and
+    /// dequantization, key by key, and the rebuilt `w`s.
+    fn decode_segment(&mut self, g: &PackedKeys, j: usize) {
+        let (np, n, s) = (g.planes, g.keys, j * SEGMENT_KEYS);
+        let block = s.is_multiple_of(g.packed.block);
+        debug_assert!(block || self.cur.wrapping_add(1) == j);
+        // The three keys before: the last rows of segment j - 1.
+        if self.cur.wrapping_add(1) == j {
+            self.rows
+                .copy_within(SEGMENT_KEYS * np..(SEGMENT_KEYS + BEFORE) * np, 0);
+            self.valid = self.valid.max(s.saturating_sub(BEFORE));
         } else {
-            // The key's row of residuals: the prediction (the last value,
-            // plus the last difference where the order is 2) plus the
-            // unzigzagged residual (widths below 32: the shift's sign bit
-            // is 0).
-            let row = &self.res[(k % SEGMENT_KEYS) * np..][..np];
-            let trend = &self.trend[..np];
-            for p in 0..np {
-                let (a, b, r) = (x0[p], x1[p], row[p]);
-                let x = b + ((b - a) & trend[p]) + ((r >> 1) ^ (i32x8::ZERO - (r & 1)));
-                x0[p] = b;
-                x1[p] = x;
-                out[p] = super::dequantize_lanes(x, step[p]);
-            }
+            self.valid = s;
         }
-        let rot = &mut out[g.rot_from..];
-        for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
-            let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
-            block[3] = (*mask & w) | (!*mask & block[3]);
-        }
-        self.next = k + 1;
-    }
-
-    /// At the first key of a segment: its headers (and, starting a block,
-    /// the block's start values and deltas) and every lane's residuals of
-    /// the segment, into `res` by key and plane lane; each lane's
-    /// prediction order.
-    fn enter_segment(&mut self, g: &PackedKeys, k: usize, block: bool) {
-        let s: &[u64] = &g.packed.stream;
-        let mut pos = g.packed.seg_at[k / SEGMENT_KEYS] as usize;
-        let flat: &mut [i32] = bytemuck::cast_slice_mut(&mut self.flat);
-        for (r, &slot) in self.reads.iter_mut().zip(&g.lane_slot) {
-            let before = if block { 0 } else { r.width };
-            let (order, w, used) = read_header(s, pos, before);
+        self.cur = j;
+        let words: &[u64] = &g.packed.stream;
+        let mut pos = g.packed.seg_at[j] as usize;
+        let trend: &mut [i32] = bytemuck::cast_slice_mut(&mut self.trend);
+        let live: &mut [i32] = bytemuck::cast_slice_mut(&mut self.live);
+        for (w, &slot) in self.widths.iter_mut().zip(&g.lane_slot) {
+            let (order, width, used) = read_header(words, pos, if block { 0 } else { *w });
             pos += used;
-            *r = LaneRead { slot, width: w };
-            flat[slot as usize] = if order == 2 { -1 } else { 0 };
+            *w = width;
+            trend[slot as usize] = if order == 2 { -1 } else { 0 };
+            live[slot as usize] = if width > 0 { -1 } else { 0 };
         }
-        self.trend.copy_from_slice(&self.flat);
-        if block {
-            for (x, &w) in self.abs.iter_mut().zip(&g.packed.abs_bits) {
-                *x = unzigzag(read_bits(s, pos, u32::from(w)));
-                pos += usize::from(w);
-            }
-            for (x, &w) in self.delta.iter_mut().zip(&g.packed.delta_bits) {
-                *x = unzigzag(read_bits(s, pos, u32::from(w)));
-                pos += usize::from(w);
-            }
-        }
-        // Rows: the segment's keys after the block's first two.
-        let end = (k + SEGMENT_KEYS).min(g.keys);
-        let first = if block { 2.min(end - k) } else { 0 };
-        read_segment(
-            s,
-            pos,
-            &self.reads,
-            first..end - k,
-            bytemuck::cast_slice_mut(&mut self.res),
-            8 * g.planes,
-        );
-    }
-}
-
-/// Each lane's residuals of one segment (contiguous, in the lane's width)
-/// from bit `pos` of `words` into `res`, still zigzag-coded, at
-/// `row * stride + slot` for the segment's `rows` (its keys after a
-/// block's first two): as many values from each 64-bit window as it holds.
-/// (A function of slices alone, out of line, so that its loop keeps its
-/// pointers in registers.)
-#[inline(never)]
-fn read_segment(
-    words: &[u64],
-    mut pos: usize,
-    reads: &[LaneRead],
-    rows: std::ops::Range<usize>,
-    res: &mut [i32],
-    stride: usize,
-) {
-    let count = rows.len();
-    if count == 0 {
-        return;
-    }
-    for r in reads {
-        let (w, slot) = (r.width as usize, r.slot as usize);
-        let first = rows.start * stride + slot;
-        // Every store below lands in `res` (checked once, not per value).
-        let Some(lane) = res.get_mut(first..=first + (count - 1) * stride) else {
-            continue;
+        let keys = (s + SEGMENT_KEYS).min(n) - s;
+        let first = if block {
+            self.block_start(g, &mut pos, keys)
+        } else {
+            0
         };
-        if w == 0 {
-            lane.iter_mut().step_by(stride).for_each(|x| *x = 0);
-            continue;
-        }
-        let (per, mask) = (PER_WINDOW[w] as usize, (1u64 << w) - 1);
-        let end = pos + count * w;
-        let (mut at, mut i) = (pos, 0);
-        while i < lane.len() {
-            let mut win = window(words, at);
-            let stop = (i + per * stride).min(lane.len());
-            while i < stop {
-                lane[i] = (win & mask) as i32;
-                win >>= w;
-                i += stride;
+        // Residuals: 16 of each lane of a width above 0 (those past the
+        // segment's keys land in spare rows, or in rows no key reads), into
+        // the rows as i32; `live` masks the rest.
+        let stride = 8 * np;
+        let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
+        let base = (BEFORE + first) * stride;
+        for (&w, &slot) in self.widths.iter().zip(&g.lane_slot) {
+            if w > 0 {
+                UNPACK[w as usize](words, pos, &mut rows[base + slot as usize..], stride);
+                pos += w as usize * (keys - first);
             }
-            at += per * w;
         }
-        pos = end;
+        for &p in &g.stored_planes {
+            let p = p as usize;
+            let (mut a, mut b) = (self.x0[p], self.x1[p]);
+            let (trend, live, step) = (self.trend[p], self.live[p], g.step[p]);
+            for r in first..keys {
+                let at = (BEFORE + r) * np + p;
+                // Widths below 32: the shift's sign bit is 0.
+                let z: i32x8 = bytemuck::cast(self.rows[at]);
+                let z = z & live;
+                let x = b + ((b - a) & trend) + ((z >> 1) ^ (i32x8::ZERO - (z & 1)));
+                (a, b) = (b, x);
+                self.rows[at] = super::dequantize_lanes(x, step);
+            }
+            (self.x0[p], self.x1[p]) = (a, b);
+        }
+        self.rebuild(g, first..keys);
+    }
+
+    /// A block's first two keys (its start values, then the deltas) into
+    /// rows `BEFORE` and `BEFORE + 1` and the predictor; returns the rows
+    /// written (2, or 1 for a last block of one key).
+    fn block_start(&mut self, g: &PackedKeys, pos: &mut usize, keys: usize) -> usize {
+        let np = g.planes;
+        let words: &[u64] = &g.packed.stream;
+        for (j, bits) in [&g.packed.abs_bits, &g.packed.delta_bits]
+            .into_iter()
+            .enumerate()
+        {
+            let flat: &mut [i32] = bytemuck::cast_slice_mut(&mut self.flat);
+            for (&w, &slot) in bits.iter().zip(&g.lane_slot) {
+                flat[slot as usize] = unzigzag(read_bits(words, *pos, u32::from(w)));
+                *pos += usize::from(w);
+            }
+            if j == keys {
+                break;
+            }
+            let row = &mut self.rows[(BEFORE + j) * np..][..np];
+            let state = self.x0.iter_mut().zip(&mut self.x1).zip(&self.flat);
+            for ((out, ((x0, x1), v)), step) in row.iter_mut().zip(state).zip(&g.step) {
+                // Key 0: the start value; key 1: key 0 plus the delta.
+                let x = if j == 0 { *v } else { *x1 + *v };
+                *x0 = if j == 0 { x } else { *x1 };
+                *x1 = x;
+                *out = super::dequantize_lanes(x, *step);
+            }
+        }
+        let first = 2.min(keys);
+        self.rebuild(g, 0..first);
+        first
+    }
+
+    /// Rebuild `w` of the rotations that store three components, in the
+    /// segment's rows `rows`.
+    fn rebuild(&mut self, g: &PackedKeys, rows: std::ops::Range<usize>) {
+        let np = g.planes;
+        for r in rows {
+            let row = &mut self.rows[(BEFORE + r) * np..][..np];
+            let rot = &mut row[g.rot_from..];
+            for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
+                let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
+                block[3] = (*mask & w) | (!*mask & block[3]);
+            }
+        }
     }
 }
 
-/// `64 / w`: the values of width `w` one 64-bit window holds.
-const PER_WINDOW: [u8; 33] = {
-    let mut t = [0u8; 33];
-    let mut w = 1;
-    while w <= 32 {
-        t[w] = (64 / w) as u8;
-        w += 1;
+/// Unpacks 16 values of one width (the index) from a bit position of a
+/// stream into `out[i * stride]`, still zigzag-coded.
+type Unpack = fn(&[u64], usize, &mut [i32], usize);
+
+/// One function per width, each unrolled: a 64-bit window holds `64 / W`
+/// values, taken with a mask and a shift.
+const UNPACK: [Unpack; 32] = {
+    macro_rules! widths {
+        ($($w:literal)*) => { [unpack_none as Unpack, $(unpack16::<$w> as Unpack),*] };
     }
-    t
+    widths!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
 };
 
-/// Stream lanes' integers into their plane lanes.
-#[inline(always)]
-fn scatter(slots: &[u32], x: &[i32], flat: &mut [i32]) {
-    for (&s, &v) in slots.iter().zip(x) {
-        flat[s as usize] = v;
+/// Width 0: nothing stored (the decoder masks such lanes' residuals).
+fn unpack_none(_: &[u64], _: usize, _: &mut [i32], _: usize) {}
+
+/// 16 values of `W` bits from bit `pos` of `words` into `out[i * stride]`.
+/// The stream ends with enough words of padding for 16 values from any
+/// bit of it ([`super::STREAM_PAD`]); a window past them (a stream not
+/// checked) writes nothing.
+fn unpack16<const W: usize>(words: &[u64], pos: usize, out: &mut [i32], stride: usize) {
+    let Some(out) = out.get_mut(..15 * stride + 1) else {
+        return;
+    };
+    let Some(src) = words.get(pos >> 6..(pos >> 6) + super::STREAM_PAD) else {
+        return;
+    };
+    let src: &[u64; super::STREAM_PAD] = src.try_into().expect("sliced to the length");
+    let (o, per, mask) = (pos & 63, 64 / W, (1u64 << W) - 1);
+    let mut i = 0;
+    while i < 16 {
+        let (at, sh) = ((o + i * W) >> 6, ((o + i * W) & 63) as u32);
+        let mut win = (src[at] >> sh) | ((src[at + 1] << 1) << (63 - sh));
+        let mut j = 0;
+        while j < per && i + j < 16 {
+            out[(i + j) * stride] = (win & mask) as i32;
+            win >>= W;
+            j += 1;
+        }
+        i += per;
     }
 }
