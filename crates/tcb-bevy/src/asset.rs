@@ -12,7 +12,7 @@ use tcb_io::{Format, ImportOptions};
 use tcb_runtime::Clip;
 
 /// A clip, compiled for playback, and the skeleton its file carried (BVH
-/// and glTF files carry one; a clip JSON may; a `.tcbc` does not).
+/// and glTF files carry one; a clip JSON or a `.tcbc` may).
 ///
 /// Load it with the [`AssetServer`](bevy_asset::AssetServer) once
 /// [`TcbPlugin`](crate::TcbPlugin) is added, and play it with a
@@ -116,7 +116,9 @@ impl AssetLoader for TcbClipLoader {
             .unwrap_or_default();
         if ext == "tcbc" {
             let clip = Clip::from_bytes(&bytes).map_err(|e| error(e.to_string()))?;
-            return Ok(TcbClip::new(Arc::new(clip), None));
+            // Format 2 keeps the skeleton `tcb compress` was given.
+            let skeleton = clip.packed().and_then(|p| p.skeleton.clone());
+            return Ok(TcbClip::new(Arc::new(clip), skeleton));
         }
         let format = Format::from_extension(&ext).ok_or_else(|| {
             error(format!(

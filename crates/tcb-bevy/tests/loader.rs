@@ -36,7 +36,10 @@ fn assets(test: &str) -> PathBuf {
         std::fs::write(dir.join(name), bytes).unwrap();
     }
     let steps = vec![1.0 / 4096.0; loaded.clip.tracks().len()];
-    let packed = Packed::encode(&PackSource::quantize(&loaded.clip, &steps).unwrap()).unwrap();
+    let mut packed = Packed::encode(&PackSource::quantize(&loaded.clip, &steps).unwrap()).unwrap();
+    // Without a skeleton, then with it, as `tcb compress` writes it.
+    std::fs::write(dir.join("bare.tcbc"), packed.to_bytes()).unwrap();
+    packed.skeleton = loaded.skeleton.clone();
     std::fs::write(dir.join("cmu.tcbc"), packed.to_bytes()).unwrap();
     std::fs::write(dir.join("broken.bvh"), "HIERARCHY\nROOT").unwrap();
     dir
@@ -66,21 +69,28 @@ fn every_format_loads_as_tcb_loads_it() {
             .collect();
         want.sort();
         assert_eq!(names, want, "{name}");
-        // A packed clip carries no skeleton; the others do.
-        assert_eq!(asset.skeleton().is_some(), name != "cmu.tcbc", "{name}");
+        // Every one carries a skeleton (glTF's joints in its node order);
+        // the .tcbc (format 2) the one it was written with.
+        assert!(asset.skeleton().is_some(), "{name}");
+        if name == "cmu.tcbc" {
+            assert_eq!(asset.skeleton(), reference.skeleton.as_ref());
+        }
     }
+    let bare = load(&mut app, "bare.tcbc").unwrap();
+    let clips = app.world().resource::<Assets<TcbClip>>();
+    assert!(clips.get(&bare).unwrap().skeleton().is_none());
     assert!(load(&mut app, "broken.bvh").is_none());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A `.tcbc` has no skeleton: it plays on joints spawned from the BVH's,
+/// A `.tcbc` without a skeleton plays on joints spawned from the BVH's,
 /// and the joints are where `SkeletonBinding` puts them on the packed clip.
 #[test]
 fn a_packed_clip_plays_on_joints_it_does_not_carry() {
     let dir = assets("packed");
     let mut app = app(&dir);
     let skeleton = tcb_io::load(dir.join("cmu.bvh")).unwrap().skeleton.unwrap();
-    let handle = load(&mut app, "cmu.tcbc").unwrap();
+    let handle = load(&mut app, "bare.tcbc").unwrap();
     let world = app.world_mut();
     let root = world
         .spawn((Transform::IDENTITY, TcbPlayer::new(handle)))
@@ -91,7 +101,8 @@ fn a_packed_clip_plays_on_joints_it_does_not_carry() {
         app.update();
     }
     let time = app.world().get::<TcbPlayer>(root).unwrap().time().unwrap();
-    let packed = Arc::new(Clip::from_bytes(&std::fs::read(dir.join("cmu.tcbc")).unwrap()).unwrap());
+    let packed =
+        Arc::new(Clip::from_bytes(&std::fs::read(dir.join("bare.tcbc")).unwrap()).unwrap());
     let binding = SkeletonBinding::new(skeleton, &packed);
     let mut instance = Instance::new(packed);
     instance.set_playback(Playback::Loop, 1.0).unwrap();
