@@ -12,8 +12,11 @@
 //! tcb-bevy's system.
 //!
 //! ```sh
-//! cargo bench -p tcb-bevy --bench player
+//! cd benches/bevy && cargo bench
 //! ```
+//!
+//! A crate outside the tcb workspace, so that the workspace's builds do
+//! not compile bevy's glTF import and animation.
 
 use bevy::MinimalPlugins;
 use bevy::app::{AnimationSystems, App, PostUpdate};
