@@ -1,5 +1,5 @@
-//! The README's bevy lines, compiled (tests/readme.rs checks that the
-//! README shows them as they are here). With `default-features = false`
+//! The bevy lines of tcb-bevy's README, compiled (tests/readme.rs checks
+//! that the README shows them as they are here). With `default-features = false`
 //! bevy's `DefaultPlugins` has no window: this builds but is not run.
 
 use bevy::prelude::*;
