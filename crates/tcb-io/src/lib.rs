@@ -52,7 +52,7 @@ pub use clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc,
 pub use error::{Error, ErrorKind, Location};
 pub use files::{DEFAULT_MAX_FILE_BYTES, ImportOptions, write_atomically};
 
-use files::{read_limited, read_text_limited};
+use files::read_limited;
 use std::path::Path;
 use tcb_core::skeleton::Skeleton;
 
@@ -103,39 +103,18 @@ pub fn load_with(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (doc, warnings) = match ext.as_str() {
-        "json" => (
-            clip::read_clip_doc_limited(path, options.max_file_bytes)?,
-            Vec::new(),
-        ),
-        "bvh" => {
-            let text = read_text_limited(path, options.max_file_bytes)?;
-            let bvh = bvh::Bvh::parse(&text).map_err(|e| e.in_file(path))?;
-            let doc = bvh
-                .to_clip_doc(&stem, options.rotation)
-                .map_err(|e| e.in_file(path))?;
-            (doc, bvh.warnings().to_vec())
-        }
-        "gltf" | "glb" => {
-            let bytes = read_limited(path, options.max_file_bytes)?;
-            let base = path.parent().unwrap_or(Path::new("."));
-            let g = gltf_import::import_with(&bytes, Some(base), &stem, options)
-                .map_err(|e| e.in_file(path))?;
-            (g.doc, g.warnings)
-        }
-        "" => {
-            return Err(Error::import(
-                "no file extension to tell its type (expected .json, .bvh, .gltf or .glb)",
-            )
-            .in_file(path));
-        }
-        _ => {
-            return Err(Error::import(format!(
-                "unknown file type '.{ext}' (expected .json, .bvh, .gltf or .glb)"
-            ))
-            .in_file(path));
-        }
+    let Some(format) = Format::from_extension(&ext) else {
+        let message = if ext.is_empty() {
+            "no file extension to tell its type (expected .json, .bvh, .gltf or .glb)".to_string()
+        } else {
+            format!("unknown file type '.{ext}' (expected .json, .bvh, .gltf or .glb)")
+        };
+        return Err(Error::import(message).in_file(path));
     };
+    let bytes = read_limited(path, options.max_file_bytes)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let (doc, warnings) =
+        read_doc(&bytes, format, Some(base), &stem, options).map_err(|e| e.in_file(path))?;
     let clip = doc.build().map_err(|e| e.in_file(path))?;
     // Warnings name the file, like errors.
     let warnings = warnings
@@ -147,5 +126,110 @@ pub fn load_with(path: impl AsRef<Path>, options: &ImportOptions) -> Result<Load
         doc,
         clip,
         warnings,
+    })
+}
+
+/// What a file holds, for [`load_bytes`] ([`load`] tells it by extension).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Format {
+    /// Clip JSON (`.json`, `docs/clip-format.md`).
+    Json,
+    /// BVH motion capture (`.bvh`).
+    Bvh,
+    /// glTF, as JSON (`.gltf`) or binary (`.glb`): the bytes tell which.
+    Gltf,
+}
+
+impl Format {
+    /// The format of a file extension (without the dot, any case): `json`,
+    /// `bvh`, `gltf` or `glb`; `None` for any other.
+    ///
+    /// ```
+    /// use tcb_io::Format;
+    /// assert_eq!(Format::from_extension("GLB"), Some(Format::Gltf));
+    /// assert_eq!(Format::from_extension("tcbc"), None); // tcb_runtime::Clip::from_bytes
+    /// ```
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        match ext.to_ascii_lowercase().as_str() {
+            "json" => Some(Format::Json),
+            "bvh" => Some(Format::Bvh),
+            "gltf" | "glb" => Some(Format::Gltf),
+            _ => None,
+        }
+    }
+}
+
+/// [`load_with`] from bytes in memory (an engine's asset reader, a
+/// network buffer): `format` says what they are, `name` names a BVH
+/// clip (and a glTF animation that has no name of its own; a clip JSON
+/// names itself). A glTF file's buffers must be in the bytes (`.glb`) or
+/// `data:` URIs: with no folder to resolve them in, external buffer files
+/// are an error. Bytes above `options.max_file_bytes` are refused. Errors
+/// and warnings name no file: add it with [`Error::in_file`].
+///
+/// ```
+/// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/cmu-01_01.bvh");
+/// # /*
+/// let path = "data/cmu-01_01.bvh"; // from the repository's root
+/// # */
+/// let bytes = std::fs::read(path).unwrap();
+/// let options = tcb_io::ImportOptions::default();
+/// let loaded = tcb_io::load_bytes(&bytes, tcb_io::Format::Bvh, "walk", &options)?;
+/// assert_eq!(loaded.doc.name, "walk");
+/// assert_eq!(loaded.skeleton.unwrap().joints().len(), 31 + 7);
+/// # Ok::<(), tcb_io::Error>(())
+/// ```
+pub fn load_bytes(
+    bytes: &[u8],
+    format: Format,
+    name: &str,
+    options: &ImportOptions,
+) -> Result<Loaded, Error> {
+    let (len, limit) = (bytes.len() as u64, options.max_file_bytes);
+    if len > limit {
+        return Err(Error::import(format!(
+            "{len} bytes; files above {limit} bytes are refused (ImportOptions::max_file_bytes)"
+        )));
+    }
+    let (doc, warnings) = read_doc(bytes, format, None, name, options)?;
+    let clip = doc.build()?;
+    Ok(Loaded {
+        skeleton: doc.skeleton.clone(),
+        doc,
+        clip,
+        warnings,
+    })
+}
+
+/// The document and warnings of `bytes` in `format`, errors naming no
+/// file; `base` resolves a glTF file's external buffers.
+fn read_doc(
+    bytes: &[u8],
+    format: Format,
+    base: Option<&Path>,
+    name: &str,
+    options: &ImportOptions,
+) -> Result<(ClipDoc, Vec<String>), Error> {
+    let text = || {
+        std::str::from_utf8(bytes).map_err(|_| Error {
+            location: Location::default(),
+            kind: ErrorKind::Io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                "stream did not contain valid UTF-8",
+            )),
+        })
+    };
+    Ok(match format {
+        Format::Json => (ClipDoc::parse(text()?)?, Vec::new()),
+        Format::Bvh => {
+            let bvh = bvh::Bvh::parse(text()?)?;
+            let doc = bvh.to_clip_doc(name, options.rotation)?;
+            (doc, bvh.warnings().to_vec())
+        }
+        Format::Gltf => {
+            let g = gltf_import::import_with(bytes, base, name, options)?;
+            (g.doc, g.warnings)
+        }
     })
 }
