@@ -147,15 +147,8 @@ pub(crate) struct PackCache {
     seg: usize,
     /// Per stream lane: its width in the segment `cur`.
     widths: Vec<u32>,
-    /// Per plane: all ones in lanes predicted by the line through their
-    /// last two values (order 2), zeros in lanes predicted by the last.
-    trend: Vec<i32x8>,
-    /// Per plane: all ones in lanes whose residuals in the segment `cur`
-    /// have a width above 0 (stored and not on the prediction).
-    live: Vec<i32x8>,
-    /// Per plane: what the residuals of the segment `cur` are stored above
-    /// their value (`super::bias` of their width).
-    bias: Vec<i32x8>,
+    /// Per plane, how its lanes code the segment `cur`.
+    coding: Vec<PlaneCoding>,
     /// Integers of one key in the group's planes (scratch; zero where no
     /// lane is stored).
     flat: Vec<i32x8>,
@@ -179,9 +172,7 @@ impl PackedKeys {
             valid: 0,
             seg: usize::MAX,
             widths: vec![0; self.lane_slot.len()],
-            trend: vec![i32x8::ZERO; np],
-            live: vec![i32x8::ZERO; np],
-            bias: vec![i32x8::ZERO; np],
+            coding: vec![PlaneCoding::default(); np],
             flat: vec![i32x8::ZERO; np],
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
@@ -239,9 +230,6 @@ impl PackCache {
         self.cur = j;
         let words: &[u64] = &g.packed.stream;
         let mut pos = g.packed.seg_at[j] as usize;
-        let trend: &mut [i32] = bytemuck::cast_slice_mut(&mut self.trend);
-        let live: &mut [i32] = bytemuck::cast_slice_mut(&mut self.live);
-        let bias: &mut [i32] = bytemuck::cast_slice_mut(&mut self.bias);
         if block {
             // A block's first headers code against the lanes' base widths.
             for (w, &base) in self.widths.iter_mut().zip(&g.packed.base_width) {
@@ -252,9 +240,12 @@ impl PackCache {
             let (order, width, used) = read_header(words, pos, *w);
             pos += used;
             *w = width;
-            trend[slot as usize] = if order == 2 { -1 } else { 0 };
-            live[slot as usize] = if width > 0 { -1 } else { 0 };
-            bias[slot as usize] = super::bias(width);
+            // One bounds check for the plane; the lane is below 8.
+            let c = &mut self.coding[slot as usize / 8];
+            let lane = slot as usize % 8;
+            c.trend[lane] = if order == 2 { -1 } else { 0 };
+            c.live[lane] = if width > 0 { -1 } else { 0 };
+            c.bias[lane] = super::bias(width);
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         let first = if block {
@@ -277,14 +268,16 @@ impl PackCache {
         for &p in &g.stored_planes {
             let p = p as usize;
             let (mut a, mut b) = (self.x0[p], self.x1[p]);
-            let (trend, live, bias) = (self.trend[p], self.live[p], self.bias[p]);
+            let c = &self.coding[p];
+            let [trend, live, bias] = [c.trend, c.live, c.bias].map(i32x8::from);
             let step = g.step[p];
-            for r in first..keys {
-                let at = (BEFORE + r) * np + p;
-                let z: i32x8 = bytemuck::cast(self.rows[at]);
+            let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
+            for row in rows.chunks_exact_mut(np) {
+                let v = &mut row[p];
+                let z: i32x8 = bytemuck::cast(*v);
                 let x = b + ((b - a) & trend) + ((z & live) - bias);
                 (a, b) = (b, x);
-                self.rows[at] = super::dequantize_lanes(x, step);
+                *v = super::dequantize_lanes(x, step);
             }
             (self.x0[p], self.x1[p]) = (a, b);
         }
@@ -337,6 +330,20 @@ impl PackCache {
             }
         }
     }
+}
+
+/// How the 8 lanes of a plane code a segment.
+#[derive(Clone, Copy, Debug, Default)]
+struct PlaneCoding {
+    /// -1 in lanes predicted by the line through their last two values
+    /// (order 2), 0 in lanes predicted by the last.
+    trend: [i32; 8],
+    /// -1 in lanes whose residuals have a width above 0 (stored and not on
+    /// the prediction).
+    live: [i32; 8],
+    /// What the residuals are stored above their value (`super::bias` of
+    /// their width).
+    bias: [i32; 8],
 }
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
