@@ -70,7 +70,7 @@ fn every_format_loads_as_tcb_loads_it() {
         want.sort();
         assert_eq!(names, want, "{name}");
         // Every one carries a skeleton (glTF's joints in its node order);
-        // the .tcbc (format 2) the one it was written with.
+        // the .tcbc the one it was written with.
         assert!(asset.skeleton().is_some(), "{name}");
         if name == "cmu.tcbc" {
             assert_eq!(asset.skeleton(), reference.skeleton.as_ref());
