@@ -682,28 +682,8 @@ fn cmu_capture_in_both_rotation_modes() {
     }
 }
 
-/// Cases and seed: deterministic by default so that CI cannot flake;
-/// `PROPTEST_CASES` and `PROPTEST_RNG_SEED` override them for deeper runs.
-fn config(cases: u32) -> ProptestConfig {
-    let env = ProptestConfig::default();
-    let set = |name: &str| std::env::var_os(name).is_some();
-    ProptestConfig {
-        cases: if set("PROPTEST_CASES") {
-            env.cases
-        } else {
-            cases
-        },
-        rng_seed: if set("PROPTEST_RNG_SEED") {
-            env.rng_seed
-        } else {
-            proptest::test_runner::RngSeed::Fixed(0x7cb_1984)
-        },
-        ..env
-    }
-}
-
 proptest! {
-    #![proptest_config(config(64))]
+    #![proptest_config(tcb_test_support::proptest_config(64))]
 
     #[test]
     fn runtime_equals_reference(seed in any::<u64>(), channels in 0..80usize) {
