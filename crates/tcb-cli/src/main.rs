@@ -1031,13 +1031,16 @@ fn write_packed_tracks(out: &mut String, head: &tcb_runtime::PackSource) -> Resu
     writeln!(out, "tracks:")?;
     writeln!(
         out,
-        "  {:<32} {:<6} {:>7} {:>14}",
+        "  {:<32} {:<6} {:>7} {:>14}  relative to",
         "name", "kind", "stored", "step"
     )?;
     for t in &head.tracks {
+        let center = t.center.map_or(String::new(), |c| {
+            format!("  [{:.4}, {:.4}, {:.4}, {:.4}]", c[0], c[1], c[2], c[3])
+        });
         writeln!(
             out,
-            "  {:<32} {:<6} {:>7} {:>14e}",
+            "  {:<32} {:<6} {:>7} {:>14e}{center}",
             t.name,
             t.kind.name(),
             t.stored(),

@@ -39,9 +39,16 @@ fn rows(inst: &mut Instance, t: f64, n: usize) -> Vec<f32> {
 #[test]
 fn packed_cmu_plays_its_reference() {
     let (_, source) = cmu();
-    // The root turns past w = 0: it keeps 4 components; the rest rebuild w.
-    let rebuilt = source.tracks.iter().filter(|t| t.rebuild_w).count();
-    assert!(rebuilt > 25, "{rebuilt}");
+    // The root turns past w = 0: it is kept relative to its center, and
+    // every rotation rebuilds w (the root's center is the decoder's path
+    // that multiplies a block by its centers, checked bit for bit below).
+    let rotations = source.tracks.iter().filter(|t| t.kind.dim() == 4);
+    assert!(rotations.clone().all(|t| t.rebuild_w));
+    let centered: Vec<&str> = rotations
+        .filter(|t| t.center.is_some())
+        .map(|t| t.name.as_str())
+        .collect();
+    assert_eq!(centered, ["Hips.rotation"]);
     for block in [16, 64, 1024] {
         plays_its_reference(&source, block);
     }
@@ -127,7 +134,8 @@ fn file_round_trip() {
 }
 
 /// The skeleton a file keeps reads back; a file of an older version
-/// (1: no skeleton section; 2: zigzag residuals) or a newer one is refused
+/// (1: no skeleton section; 2: zigzag residuals; 3: a stored segment
+/// table, no centers, no header-less lanes) or a newer one is refused
 /// in one line that says so; a skeleton whose joint names a later parent,
 /// or whose rest is not finite, is refused in one line.
 #[test]
@@ -155,13 +163,13 @@ fn skeleton_round_trip_and_other_versions() {
         b
     };
     packed.skeleton = None;
-    for (version, says) in [(1u32, "older"), (2, "older"), (4, "newer")] {
+    for (version, says) in [(1u32, "older"), (2, "older"), (3, "older"), (5, "newer")] {
         let mut b = packed.to_bytes();
         b[8..12].copy_from_slice(&version.to_le_bytes());
         let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
         assert!(
             msg.starts_with(&format!(
-                ".tcbc version {version}; this build reads version 3"
+                ".tcbc version {version}; this build reads version 4"
             )) && msg.contains(says)
                 && !msg.contains('\n'),
             "{msg}"
@@ -257,6 +265,7 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
         tcb: Tcb::DEFAULT,
         step: 0.5,
         rebuild_w: false,
+        center: None,
         values: vec![vec![1, 1]],
     };
     let mut source = PackSource {
@@ -272,4 +281,71 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
     source.tracks.clear();
     let e = Packed::encode(&source).unwrap_err().to_string();
     assert!(e.contains("no tracks"), "{e}");
+}
+
+/// A component whose every segment is on the line (a constant track) has
+/// no headers: a clip of constant zeros is a stream of no bits at all, and
+/// plays its value; a lane table that claims a base width above 32 is
+/// refused, and a center that is not a unit quaternion too.
+#[test]
+fn constant_tracks_have_no_headers_and_centers_are_unit() {
+    use tcb_core::{Tcb, TrackKind, TrackSettings};
+    let track = |name: &str, kind: TrackKind, value: i32| tcb_runtime::PackTrack {
+        name: name.into(),
+        kind,
+        settings: TrackSettings::default(),
+        tcb: Tcb::DEFAULT,
+        step: 0.25,
+        rebuild_w: false,
+        center: None,
+        values: vec![vec![value; 100]; kind.dim()],
+    };
+    let zeros = PackSource {
+        name: "flat".into(),
+        start: 0.0,
+        interval: 0.5,
+        keys: 100,
+        tracks: vec![
+            track("a", TrackKind::Vec3, 0),
+            track("b", TrackKind::Scalar, 0),
+        ],
+    };
+    let packed = Packed::encode(&zeros).unwrap();
+    assert_eq!(packed.stream_bits(), 0);
+    let mut ones = zeros.clone();
+    ones.tracks[1] = track("b", TrackKind::Scalar, 4);
+    let bytes = Packed::encode(&ones).unwrap().to_bytes();
+    let clip = Arc::new(Clip::from_bytes(&bytes).unwrap());
+    clip.verify_packed().unwrap();
+    let b = clip.track("b").unwrap();
+    assert_eq!(Instance::new(clip).sample(17.3).scalar(b), Some(1.0));
+
+    let reseal = |mut b: Vec<u8>| {
+        let crc = crc32fast::hash(&b[24..]);
+        b[20..24].copy_from_slice(&crc.to_le_bytes());
+        b
+    };
+    // The lane table is the three rows of 4 lanes before the stream's
+    // length (0 bytes of stream) and the joint count (0).
+    let base = bytes.len() - 4 - 4 - 4;
+    let mut lying = bytes.clone();
+    lying[base] = 33;
+    let msg = Packed::from_bytes(&reseal(lying)).unwrap_err().to_string();
+    assert!(msg.contains("base width of 33"), "{msg}");
+
+    let mut turned = ones.clone();
+    let mut q = track("q", TrackKind::Quat, 0);
+    q.settings.rotation = RotationMode::Hermite;
+    q.settings.hemisphere = tcb_core::Hemisphere::Keep;
+    q.values = vec![vec![0; 100], vec![0; 100], vec![0; 100]];
+    q.rebuild_w = true;
+    q.step = 1.0 / 1024.0;
+    q.center = Some([0.0, 0.6, 0.0, 0.8]);
+    turned.tracks.push(q.clone());
+    let clip = Clip::from_packed(Arc::new(Packed::encode(&turned).unwrap())).unwrap();
+    clip.verify_packed().unwrap();
+    q.center = Some([0.0, 0.6, 0.0, 0.7]);
+    turned.tracks[2] = q;
+    let msg = Packed::encode(&turned).unwrap_err().to_string();
+    assert!(msg.contains("not a unit quaternion"), "{msg}");
 }

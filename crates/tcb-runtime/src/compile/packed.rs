@@ -30,7 +30,11 @@ impl Clip {
     /// grid's times and a few bytes per component; see
     /// [`verify_packed`](Self::verify_packed) for the check of every key.
     pub fn from_packed(packed: Arc<Packed>) -> Result<Clip, PackError> {
-        packed.check_structure()?;
+        if packed.segment_table()? != packed.seg_at {
+            return Err(PackError(
+                "the packed stream disagrees with its segment table".into(),
+            ));
+        }
         packed.head().validate_head()?;
         Clip::from_checked(packed)
     }
@@ -189,6 +193,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
     let mut step = vec![[0.0f32; 8]; np];
     let mut weights = vec![[[0.0f32; 8]; 4]; np];
     let mut rebuild = vec![[true; 8]; g.hq_blocks];
+    let mut center: Vec<Option<[[f32; 8]; 4]>> = vec![None; g.hq_blocks];
     let rot_from = g.vec_blocks;
     for (t, slot) in head.tracks.iter().zip(clip.layout.tracks()) {
         // Every interior key's weights are key 1's (`PackSource::validate`).
@@ -212,6 +217,13 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
             let at = slot.index[0];
             let b = (at / 8 - rot_from) / 4;
             rebuild[b][at % 8] = t.rebuild_w;
+            if let Some(r) = t.center {
+                let identity = [[0.0; 8], [0.0; 8], [0.0; 8], [1.0; 8]];
+                let planes = center[b].get_or_insert(identity);
+                for (plane, x) in planes.iter_mut().zip(r) {
+                    plane[at % 8] = x;
+                }
+            }
         }
     }
     // The first and last keys, then the 4 sentinel pseudo-keys (see
@@ -223,6 +235,12 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
             table.extend_from_slice(section);
         }
     }
+    let (headed, headed_base) = lane_slot
+        .iter()
+        .zip(&packed.base_width)
+        .filter(|(_, base)| **base != crate::pack::FLAT)
+        .map(|(slot, base)| (*slot, u32::from(*base)))
+        .unzip();
     let mut stored_planes: Vec<u32> = lane_slot.iter().map(|at| at / 8).collect();
     stored_planes.sort_unstable();
     stored_planes.dedup();
@@ -232,12 +250,18 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
         keys: n,
         planes: np,
         lane_slot,
+        headed,
+        headed_base,
         step: step.into_iter().map(f32x8::new).collect(),
         weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
         rot_from,
         rebuild: rebuild
             .into_iter()
             .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))
+            .collect(),
+        center: center
+            .into_iter()
+            .map(|c| c.map(|planes| planes.map(f32x8::new)))
             .collect(),
         table,
     }

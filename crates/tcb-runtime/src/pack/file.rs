@@ -59,10 +59,10 @@ impl<'a> Reader<'a> {
     /// refused before anything is allocated for it).
     fn tracks(&mut self, file_len: usize) -> Result<Vec<PackTrack>, PackError> {
         let count = self.u32("the track count")? as usize;
-        // A track takes at least 42 bytes (an empty name's length, 10 bytes
-        // of settings, tension, continuity, bias and step): refuse counts
-        // the file cannot hold.
-        if count > self.bytes.len() / 42 {
+        // A track takes at least 20 bytes (an empty name's length, 10 bytes
+        // of settings, the tension flag, the step and the center flag):
+        // refuse counts the file cannot hold.
+        if count > self.bytes.len() / 20 {
             return err(format!(
                 "{count} tracks claimed in a file of {file_len} bytes"
             ));
@@ -83,40 +83,35 @@ impl<'a> Reader<'a> {
         let abs_bits = self.take(lanes, "the block widths")?.to_vec();
         let delta_bits = self.take(lanes, "the block widths")?.to_vec();
         let base_width = self.take(lanes, "the base widths")?.to_vec();
-        let all = abs_bits.iter().chain(&delta_bits).chain(&base_width);
+        let all = abs_bits.iter().chain(&delta_bits);
         if let Some(b) = all.into_iter().find(|b| **b > 31) {
             return err(format!("a block width of {b} bits (at most 31)"));
+        }
+        if let Some(b) = base_width.iter().find(|b| **b > super::FLAT) {
+            return err(format!(
+                "a base width of {b} bits (at most 31, or {} for a lane without headers)",
+                super::FLAT
+            ));
         }
         Ok([abs_bits, delta_bits, base_width])
     }
 
-    /// The segment table and the stream of `keys` keys of `lanes` lanes:
-    /// the table's first bits, the stream as words and its length in
-    /// bytes.
-    fn stream(
-        &mut self,
-        keys: usize,
-        lanes: usize,
-    ) -> Result<(Vec<u32>, Vec<u64>, usize), PackError> {
-        let segments = self.u32("the segment count")? as usize;
-        if keys < 2 || segments != keys.div_ceil(SEGMENT_KEYS) + 1 {
-            return err(format!("{segments} segment entries for {keys} keys"));
-        }
-        let table = self.take(4 * segments, "the segment table")?;
-        let seg_at: Vec<u32> = table
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect();
+    /// The stream of `keys` keys of `lanes` lanes with headers: as words,
+    /// and its length in bytes. (Where each segment starts is not stored: the
+    /// reader walks the stream's headers, [`Packed::segment_table`].)
+    fn stream(&mut self, keys: usize, lanes: usize) -> Result<(Vec<u64>, usize), PackError> {
+        let segments = keys.div_ceil(SEGMENT_KEYS);
         let len = self.u32("the stream length")? as usize;
-        let stream = super::to_words(self.take(len, "the stream")?);
-        // Every segment spends at least 2 bits per lane on its header: a
-        // file cannot describe more keys than that.
-        if (segments - 1).saturating_mul(lanes).saturating_mul(2) > 8 * len {
+        // Every segment spends at least 2 bits per lane with headers on
+        // them: a file cannot describe more keys than that (checked before
+        // the stream is copied).
+        if keys < 2 || segments.saturating_mul(lanes).saturating_mul(2) > 8 * len {
             return err(format!(
-                "{keys} keys of {lanes} lanes claimed in a stream of {len} bytes"
+                "{keys} keys of {lanes} lanes with headers claimed in a stream of {len} bytes"
             ));
         }
-        Ok((seg_at, stream, len))
+        let stream = super::to_words(self.take(len, "the stream")?);
+        Ok((stream, len))
     }
 
     /// The skeleton section (since version 2): a joint count (0: none), then per
@@ -183,12 +178,26 @@ impl<'a> Reader<'a> {
         let rotation = r.pick(RotationMode::ALL, &what("rotation mode"))?;
         let hemisphere = r.pick(Hemisphere::ALL, &what("hemisphere"))?;
         let rebuild_w = r.pick(&[false, true], &what("rebuild_w"))?;
-        let tcb = Tcb::new(
-            r.f64(&what("tension"))?,
-            r.f64(&what("continuity"))?,
-            r.f64(&what("bias"))?,
-        );
+        // Tension, continuity and bias, where not all 0.
+        let tcb = if r.pick(&[false, true], &what("tension flag"))? {
+            Tcb::new(
+                r.f64(&what("tension"))?,
+                r.f64(&what("continuity"))?,
+                r.f64(&what("bias"))?,
+            )
+        } else {
+            Tcb::DEFAULT
+        };
         let step = r.f32(&what("step"))?;
+        let center = if r.pick(&[false, true], &what("center flag"))? {
+            let mut c = [0.0f32; 4];
+            for x in &mut c {
+                *x = r.f32(&what("center"))?;
+            }
+            Some(c)
+        } else {
+            None
+        };
         let settings = TrackSettings {
             tangent_rule,
             ends,
@@ -206,6 +215,7 @@ impl<'a> Reader<'a> {
             tcb,
             step,
             rebuild_w,
+            center,
             values: Vec::new(),
         })
     }
@@ -286,19 +296,22 @@ impl Packed {
             w.u8(ix(RotationMode::ALL.iter().position(|v| *v == s.rotation)));
             w.u8(ix(Hemisphere::ALL.iter().position(|v| *v == s.hemisphere)));
             w.u8(u8::from(t.rebuild_w));
-            w.f64(t.tcb.tension);
-            w.f64(t.tcb.continuity);
-            w.f64(t.tcb.bias);
+            let tcb = [t.tcb.tension, t.tcb.continuity, t.tcb.bias];
+            let given = tcb.iter().any(|x| x.to_bits() != 0);
+            w.u8(u8::from(given));
+            for x in tcb.iter().filter(|_| given) {
+                w.f64(*x);
+            }
             w.f32(t.step);
+            w.u8(u8::from(t.center.is_some()));
+            for x in t.center.iter().flatten() {
+                w.f32(*x);
+            }
         }
         w.len(self.abs_bits.len());
         w.0.extend_from_slice(&self.abs_bits);
         w.0.extend_from_slice(&self.delta_bits);
         w.0.extend_from_slice(&self.base_width);
-        w.len(self.seg_at.len());
-        for s in &self.seg_at {
-            w.u32(*s);
-        }
         let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
         w.len(self.stream_len);
         w.0.extend_from_slice(&bytes[..self.stream_len]);
@@ -339,7 +352,7 @@ impl Packed {
 
     /// [`from_bytes`](Self::from_bytes) without decoding the stream: the
     /// header, checksum, lengths, settings and the stream's structure
-    /// ([`Packed::check_structure`]) checked, not the integers (what
+    /// ([`Packed::segment_table`]) checked, not the integers (what
     /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
     /// decoding every key takes a few).
     pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
@@ -368,7 +381,8 @@ impl Packed {
         }
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
         let [abs_bits, delta_bits, base_width] = r.block_widths(stored)?;
-        let (seg_at, stream, len) = r.stream(keys, stored)?;
+        let headed = base_width.iter().filter(|b| **b != super::FLAT).count();
+        let (stream, len) = r.stream(keys, headed)?;
         let skeleton = r.skeleton()?;
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
@@ -385,14 +399,15 @@ impl Packed {
             abs_bits,
             delta_bits,
             base_width,
-            seg_at,
+            seg_at: Vec::new(),
             stream,
             stream_len: len,
             note,
             skeleton,
         };
         packed.head.validate_head()?;
-        packed.check_structure()?;
+        let mut packed = packed;
+        packed.seg_at = packed.segment_table()?;
         Ok(packed)
     }
 }
@@ -406,7 +421,7 @@ fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != VERSION {
         let why = if version < VERSION {
-            "written by an older tcb, whose residuals this build does not decode: compress the source again"
+            "written by an older tcb, in a layout this build does not read: compress the source again"
         } else {
             "written by a newer tcb"
         };

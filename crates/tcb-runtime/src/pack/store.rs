@@ -43,6 +43,10 @@ pub(crate) struct PackedKeys {
     pub planes: usize,
     /// Per stream lane, its plane and lane in the group (`8 plane + lane`).
     pub lane_slot: Vec<u32>,
+    /// The slots of the stream lanes with headers (not
+    /// [`FLAT`](super::FLAT)), in the stream's order, and their base widths.
+    pub headed: Vec<u32>,
+    pub headed_base: Vec<u32>,
     /// Per plane: the quantization step of each lane (0 where not stored).
     pub step: Vec<f32x8>,
     /// Per plane: `in_a, in_b, out_a, out_b` of each lane.
@@ -54,6 +58,9 @@ pub(crate) struct PackedKeys {
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
     pub rebuild: Vec<f32x8>,
+    /// Per rotation block: the centers its keys are relative to (the
+    /// identity in lanes without one), if a lane has one.
+    pub center: Vec<Option<[f32x8; 4]>>,
     /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
     /// (`n ..= n+3`), `planes` vectors each.
     pub table: Vec<f32x8>,
@@ -73,6 +80,7 @@ impl PackedKeys {
             + 4 * self.lane_slot.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
             + 8 * self.rebuild.len()
+            + std::mem::size_of::<Option<[f32x8; 4]>>() * self.center.len()
     }
 
     /// The controls of the segment from key `a` to key `b`: a real segment
@@ -145,7 +153,8 @@ pub(crate) struct PackCache {
     valid: usize,
     /// The first key of the segment whose tangents `m` holds.
     seg: usize,
-    /// Per stream lane: its width in the segment `cur`.
+    /// Per stream lane with headers (`PackedKeys::headed`): its width in
+    /// the segment `cur`.
     widths: Vec<u32>,
     /// Per plane, how its lanes code the segment `cur`.
     coding: Vec<PlaneCoding>,
@@ -167,12 +176,17 @@ impl PackedKeys {
     /// A cache for [`segment`](Self::segment), per instance.
     pub fn cache(&self) -> PackCache {
         let np = self.planes;
+        // Lanes without headers keep width 0 on the line (order 2).
+        let mut coding = vec![PlaneCoding::default(); np];
+        for &slot in &self.lane_slot {
+            coding[slot as usize / 8].trend[slot as usize % 8] = -1;
+        }
         PackCache {
             cur: usize::MAX,
             valid: 0,
             seg: usize::MAX,
-            widths: vec![0; self.lane_slot.len()],
-            coding: vec![PlaneCoding::default(); np],
+            widths: vec![0; self.headed.len()],
+            coding,
             flat: vec![i32x8::ZERO; np],
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
@@ -232,11 +246,9 @@ impl PackCache {
         let mut pos = g.packed.seg_at[j] as usize;
         if block {
             // A block's first headers code against the lanes' base widths.
-            for (w, &base) in self.widths.iter_mut().zip(&g.packed.base_width) {
-                *w = base.into();
-            }
+            self.widths.copy_from_slice(&g.headed_base);
         }
-        for (w, &slot) in self.widths.iter_mut().zip(&g.lane_slot) {
+        for (w, &slot) in self.widths.iter_mut().zip(&g.headed) {
             let (order, width, used) = read_header(words, pos, *w);
             pos += used;
             *w = width;
@@ -259,7 +271,7 @@ impl PackCache {
         let stride = 8 * np;
         let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
         let base = (BEFORE + first) * stride;
-        for (&w, &slot) in self.widths.iter().zip(&g.lane_slot) {
+        for (&w, &slot) in self.widths.iter().zip(&g.headed) {
             if w > 0 {
                 UNPACK[w as usize](words, pos, &mut rows[base + slot as usize..], stride);
                 pos += w as usize * (keys - first);
@@ -317,16 +329,22 @@ impl PackCache {
         first
     }
 
-    /// Rebuild `w` of the rotations that store three components, in the
-    /// segment's rows `rows`.
+    /// Rebuild `w` of the rotations that store three components, and turn
+    /// the keys of rotations with a center by it (`PackTrack::value`), in
+    /// the segment's rows `rows`.
     fn rebuild(&mut self, g: &PackedKeys, rows: std::ops::Range<usize>) {
         let np = g.planes;
         for r in rows {
             let row = &mut self.rows[(BEFORE + r) * np..][..np];
             let rot = &mut row[g.rot_from..];
-            for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
+            let blocks = rot.chunks_exact_mut(4).zip(&g.rebuild).zip(&g.center);
+            for ((block, mask), center) in blocks {
                 let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
                 block[3] = (*mask & w) | (!*mask & block[3]);
+                if let Some(c) = center {
+                    let q = [block[0], block[1], block[2], block[3]];
+                    block.copy_from_slice(&tcb_core::quat::mul(c, &q));
+                }
             }
         }
     }
