@@ -244,6 +244,7 @@ fn usage_errors() {
 
 #[test]
 fn every_bad_input_is_one_clear_line_and_no_csv() {
+    // Kept whole: a case table, one row per bad input and the line it must print.
     let q = r#""kind": "quat", "times": [0, 1, 2], "values": [[0,0,0,1],[0,0,0.5,0.8660254],[0,0,0,1]]"#;
     let cases: Vec<(&str, String, &str, &str)> = vec![
         (

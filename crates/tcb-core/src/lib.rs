@@ -15,7 +15,7 @@
 //! | [`ease`] | 3ds Max ease to / ease from |
 //! | [`track`] | [`Track`], the reference spline for `f32`, `Vec2`, `Vec3`, `Vec4` |
 //! | [`rotation`] | [`RotationTrack`]: `squad` and `hermite` on quaternions |
-//! | [`clip`] | [`Clip`]: named tracks sampled together |
+//! | `clip` | [`Clip`]: named tracks sampled together |
 //! | [`sample_times`] | the paper's inbetweens, frame grids |
 //! | [`simd`] | the formulas over lane types the runtime's kernels share (not a stable API) |
 //!
@@ -45,9 +45,9 @@
 
 #![forbid(unsafe_code)]
 
-pub mod clip;
+mod clip;
 pub mod ease;
-pub mod error;
+mod error;
 pub mod params;
 pub mod quat;
 pub mod rotation;

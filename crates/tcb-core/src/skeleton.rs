@@ -59,6 +59,11 @@ pub struct Joint {
 /// Joints, parents before children: every joint's parent comes before it
 /// ([`Skeleton::new`] and [`Skeleton::push`] refuse anything else), so one
 /// pass in order composes model-space transforms.
+///
+/// ```compile_fail
+/// // The joints are private: only `new` and `push`, which check the order, build one.
+/// let s = tcb_core::skeleton::Skeleton { joints: Vec::new() };
+/// ```
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Skeleton {
     joints: Vec<Joint>,

@@ -73,6 +73,7 @@ fn instance(clip: *const TcbClip, flags: u32) -> *mut TcbInstance {
 /// bit, and its model matrices are `SkeletonBinding`'s.
 #[test]
 fn cmu_rows_and_matrices_match_the_runtime() {
+    // Kept whole: one clip, instance and skeleton handle run through every check, as a C caller's would.
     let path = data("cmu-01_01.bvh");
     let clip = load(&path);
     let loaded = tcb_io::load(&path).unwrap();
@@ -189,6 +190,7 @@ fn cmu_rows_and_matrices_match_the_runtime() {
 /// message naming the argument; counts give 0; frees ignore NULL.
 #[test]
 fn null_pointers_are_refused() {
+    // Kept whole: a table of calls, each entry point with NULL in one argument at a time.
     let clip = load_memory(BVH.as_bytes(), "bvh").1;
     let inst = instance(clip, 0);
     let name = c("Hips.rotation");
@@ -394,6 +396,7 @@ fn null_pointers_are_refused() {
 /// nothing is written into it.
 #[test]
 fn wrong_lengths_write_nothing() {
+    // Kept whole: a table of calls, each buffer argument one length off at a time.
     let clip = load_memory(BVH.as_bytes(), "bvh").1;
     let inst = instance(clip, TCB_INSTANCE_VELOCITIES);
     // SAFETY: live handles; buffers at least as long as the lengths given.
@@ -569,6 +572,7 @@ fn bad_files_give_a_status_and_a_message() {
 /// loads from bytes and from a `.tcbc` file and plays as `Clip::from_bytes`.
 #[test]
 fn memory_files_and_packed_clips() {
+    // Kept whole: every load reads the same files from one temporary folder, removed at the end.
     let dir = std::env::temp_dir().join(format!("tcb-ffi-pack-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bvh_path = dir.join("two.bvh");
@@ -673,6 +677,7 @@ fn memory_files_and_packed_clips() {
 /// and mismatched layouts refused without a write.
 #[test]
 fn rigs_blends_and_playback() {
+    // Kept whole: one set of rig, instance and pose handles runs through every step, then is freed in any order (itself checked).
     let (_, clip) = load_memory(BVH.as_bytes(), "bvh");
     let path = std::env::temp_dir().join(format!("tcb-ffi-rig-{}.bvh", std::process::id()));
     std::fs::write(&path, BVH).unwrap();

@@ -2,7 +2,8 @@
 //! (as `tcb import` reads it) and compared with what the export reported.
 
 use arbitrary::Unstructured;
-use tcb_core::TrackKind;
+use tcb_core::{Clip, TrackKind};
+use tcb_io::ClipDoc;
 use tcb_io::gltf_export::{Container, ExportOptions, export as export_gltf};
 
 /// A structured clip (as `runtime`'s) whose tracks are named for glTF
@@ -20,23 +21,7 @@ pub fn export(data: &[u8]) {
     let Ok(mut doc) = crate::inputs::arbitrary_doc(&mut u) else {
         return;
     };
-    let mut weights = 0;
-    for (i, t) in doc.tracks.iter_mut().enumerate() {
-        if matches!(t.kind, TrackKind::Vec2 | TrackKind::Vec4) && !u.ratio(1, 16u8).unwrap_or(false)
-        {
-            t.kind = TrackKind::Vec3;
-        }
-        t.name = match t.kind {
-            TrackKind::Vec3 if u.ratio(1, 3u8).unwrap_or(false) => format!("n{i}.scale"),
-            TrackKind::Vec3 => format!("n{i}.translation"),
-            TrackKind::Quat => format!("n{i}.rotation"),
-            TrackKind::Scalar => {
-                weights += 1;
-                format!("m.weights.{}", weights - 1)
-            }
-            _ => format!("n{i}.other"),
-        };
-    }
+    name_for_gltf(&mut doc, &mut u);
     let Ok(clip) = doc.build() else {
         return;
     };
@@ -54,17 +39,88 @@ pub fn export(data: &[u8]) {
             return;
         }
     };
-    let back = match tcb_io::gltf_import::import(&bytes, None, None, "fuzz") {
-        Ok(g) => g.doc.build().unwrap_or_else(|e| {
-            panic!("an export that imports but does not build: {e} ({container:?})")
-        }),
-        Err(e) => panic!("an export that cannot be read back: {e} ({container:?})"),
-    };
+    let back = read_back(&bytes, container);
     assert_eq!(
         back.tracks().len(),
         clip.tracks().len(),
         "tracks read back ({container:?})"
     );
+    let check = check_times(&mut u, &clip, &back);
+    let offsets = offsets_in(&clip, &back);
+    let (mut va, mut vb) = (
+        vec![0.0f32; clip.channel_count()],
+        vec![0.0f32; back.channel_count()],
+    );
+    for &t in &check {
+        clip.sample_into(t, &mut va, None);
+        back.sample_into(t, &mut vb, None);
+        let mut at = 0;
+        for (track, &bt) in clip.tracks().iter().zip(&offsets) {
+            let dim = track.data.kind().dim();
+            let a = &va[at..at + dim];
+            at += dim;
+            let keys = track.data.times();
+            if !(keys[0]..=keys[keys.len() - 1]).contains(&t) || a.iter().any(|x| !x.is_finite()) {
+                continue;
+            }
+            let b = &vb[bt..bt + dim];
+            let e = read_back_error(a, b, track.data.kind());
+            // By name: the report's order is not the clip's when there are
+            // weight tracks (see `crates/tcb-io/tests/export_read_back.rs`).
+            let stated = report
+                .tracks
+                .iter()
+                .find(|r| r.name == track.name)
+                .expect("every track reported")
+                .error();
+            assert!(
+                e <= stated.unwrap_or(0.0) + 1e-5,
+                "{} at {t} ({container:?}, max_error {max_error}): {a:?} read back as {b:?}, \
+                 off by {e}, reported {stated:?}",
+                track.name
+            );
+        }
+    }
+}
+
+/// Names the tracks for glTF targets: vec2 and vec4 tracks mostly made
+/// vec3 (1 in 16 kept, to be refused), vec3 a node's scale (1 in 3) or
+/// translation, rotations a node's rotation, scalars the mesh's weights in
+/// order.
+fn name_for_gltf(doc: &mut ClipDoc, u: &mut Unstructured) {
+    let mut weights = 0;
+    for (i, t) in doc.tracks.iter_mut().enumerate() {
+        if matches!(t.kind, TrackKind::Vec2 | TrackKind::Vec4) && !u.ratio(1, 16u8).unwrap_or(false)
+        {
+            t.kind = TrackKind::Vec3;
+        }
+        t.name = match t.kind {
+            TrackKind::Vec3 if u.ratio(1, 3u8).unwrap_or(false) => format!("n{i}.scale"),
+            TrackKind::Vec3 => format!("n{i}.translation"),
+            TrackKind::Quat => format!("n{i}.rotation"),
+            TrackKind::Scalar => {
+                weights += 1;
+                format!("m.weights.{}", weights - 1)
+            }
+            _ => format!("n{i}.other"),
+        };
+    }
+}
+
+/// The exported bytes imported (as `tcb import` reads them) and built;
+/// panics if either step fails.
+fn read_back(bytes: &[u8], container: Container) -> Clip {
+    match tcb_io::gltf_import::import(bytes, None, None, "fuzz") {
+        Ok(g) => g.doc.build().unwrap_or_else(|e| {
+            panic!("an export that imports but does not build: {e} ({container:?})")
+        }),
+        Err(e) => panic!("an export that cannot be read back: {e} ({container:?})"),
+    }
+}
+
+/// The times to compare at: the keys of both clips, 7 points between each
+/// two of them, and a few edge times.
+fn check_times(u: &mut Unstructured, clip: &Clip, back: &Clip) -> Vec<f64> {
     let mut times = clip.key_times();
     times.extend(back.key_times());
     times.sort_by(f64::total_cmp);
@@ -74,10 +130,14 @@ pub fn export(data: &[u8]) {
         check.extend((0..8).map(|i| w[0] + (w[1] - w[0]) * f64::from(i) / 8.0));
     }
     check.extend(times.last());
-    check.extend(crate::edges::edge_times(&mut u, &times, 16));
-    // Where each track is in `back` (glTF groups channels by node).
-    let offsets: Vec<usize> = clip
-        .tracks()
+    check.extend(crate::edges::edge_times(u, &times, 16));
+    check
+}
+
+/// Where each of `clip`'s tracks starts in `back`'s rows (glTF groups
+/// channels by node); panics on a track not read back.
+fn offsets_in(clip: &Clip, back: &Clip) -> Vec<usize> {
+    clip.tracks()
         .iter()
         .map(|t| {
             let mut at = 0;
@@ -89,54 +149,28 @@ pub fn export(data: &[u8]) {
             }
             panic!("track {} not read back", t.name)
         })
-        .collect();
-    let (mut va, mut vb) = (
-        vec![0.0f32; clip.channel_count()],
-        vec![0.0f32; back.channel_count()],
-    );
-    for &t in &check {
-        clip.sample_into(t, &mut va, None);
-        back.sample_into(t, &mut vb, None);
-        let mut at = 0;
-        for (track, &bt) in clip.tracks().iter().zip(&offsets) {
-            // By name: the report's order is not the clip's when there are
-            // weight tracks (see `crates/tcb-io/tests/export_read_back.rs`).
-            let reported = report
-                .tracks
-                .iter()
-                .find(|r| r.name == track.name)
-                .expect("every track reported");
-            let dim = track.data.kind().dim();
-            let a = &va[at..at + dim];
-            at += dim;
-            let keys = track.data.times();
-            if !(keys[0]..=keys[keys.len() - 1]).contains(&t) || a.iter().any(|x| !x.is_finite()) {
-                continue;
-            }
-            let b = &vb[bt..bt + dim];
-            let d = |s: f32| {
-                (0..dim)
-                    .map(|c| f64::from((a[c] - s * b[c]).abs() / a[c].abs().max(1.0)))
-                    // NaN kept: a NaN read back is as far off as can be.
-                    .fold(0.0, |m: f64, x| if x.is_nan() || x > m { x } else { m })
-            };
-            let e = if track.data.kind() == TrackKind::Quat {
-                let (p, n) = (d(1.0), d(-1.0));
-                if p.is_nan() || n.is_nan() {
-                    f64::NAN
-                } else {
-                    p.min(n)
-                }
-            } else {
-                d(1.0)
-            };
-            let stated = reported.error();
-            assert!(
-                e <= stated.unwrap_or(0.0) + 1e-5,
-                "{} at {t} ({container:?}, max_error {max_error}): {a:?} read back as {b:?}, \
-                 off by {e}, reported {stated:?}",
-                track.name
-            );
+        .collect()
+}
+
+/// How far `b` (read back) is from `a` (exported): the largest channel
+/// difference relative to max(1, |a|), rotations up to sign; NaN if any
+/// channel's difference is NaN.
+fn read_back_error(a: &[f32], b: &[f32], kind: TrackKind) -> f64 {
+    let d = |s: f32| {
+        a.iter()
+            .zip(b)
+            .map(|(&x, &y)| f64::from((x - s * y).abs() / x.abs().max(1.0)))
+            // NaN kept: a NaN read back is as far off as can be.
+            .fold(0.0, |m: f64, x| if x.is_nan() || x > m { x } else { m })
+    };
+    if kind == TrackKind::Quat {
+        let (p, n) = (d(1.0), d(-1.0));
+        if p.is_nan() || n.is_nan() {
+            f64::NAN
+        } else {
+            p.min(n)
         }
+    } else {
+        d(1.0)
     }
 }

@@ -367,21 +367,12 @@ struct PackInput {
     tamper: Option<usize>,
 }
 
+/// Draws a [`PackInput`]: the grid ([`pack_times`]), up to 12 track kinds,
+/// one `pre` and `post` for all, then per track its document
+/// ([`pack_track`]), tcb and quantization step ([`pack_step`]), and
+/// sometimes a track to tamper with.
 fn arbitrary_pack(u: &mut Unstructured) -> arbitrary::Result<PackInput> {
-    let keys = u.int_in_range(2..=200usize)?;
-    let start = match u.int_in_range(0..=7u8)? {
-        0 => f64::arbitrary(u)?,
-        1 => f64::from(i32::arbitrary(u)?) * 1e3 + 0.1,
-        2 => *u.choose(&[1e6 + 0.1, 1e9 / 3.0, -1e7, 3.15e7, 1e-300])?,
-        _ => f64::from(i16::arbitrary(u)?) / 64.0,
-    };
-    let interval = match u.int_in_range(0..=7u8)? {
-        0 => f64::arbitrary(u)?.abs(),
-        1 => *u.choose(&[1e-9, 1e-6, 1.0 / 3.0, 0.1, 1e3, 1e6, 1e12, 1e300])?,
-        2 | 3 => 1.0 / f64::from(u.int_in_range(1..=240u16)?),
-        _ => f64::from(u.int_in_range(1..=u16::MAX)?) / 4096.0,
-    };
-    let times: Vec<f64> = (0..keys).map(|k| start + k as f64 * interval).collect();
+    let times = pack_times(u)?;
     let kinds: Vec<TrackKind> = (0..u.int_in_range(1..=12u8)?)
         .map(|_| u.choose(&TrackKind::ALL).copied())
         .collect::<arbitrary::Result<_>>()?;
@@ -400,49 +391,12 @@ fn arbitrary_pack(u: &mut Unstructured) -> arbitrary::Result<PackInput> {
     let mut tracks = Vec::with_capacity(kinds.len());
     let (mut steps, mut tcbs) = (Vec::new(), Vec::new());
     for (i, &kind) in kinds.iter().enumerate() {
-        let ends = *u.choose(Ends::ALL)?;
-        let mut values = if kind == TrackKind::Quat && u.ratio(3, 4)? {
-            rotations(u, keys)?
-        } else {
-            vectors(u, keys)?
-        };
-        if ends == Ends::Cyclic {
-            values[keys - 1] = values[0];
-        }
-        let rotation = match ends {
-            Ends::Natural => RotationMode::Hermite,
-            _ => *u.choose(RotationMode::ALL)?,
-        };
-        tracks.push(TrackDoc {
-            name: format!("t{i}"),
-            kind,
-            times: times.clone(),
-            values,
-            keys: Vec::new(),
-            settings: SettingsDoc {
-                tangent_rule: Some(*u.choose(TangentRule::ALL)?),
-                ends: Some(ends),
-                match_speed: Some(bool::arbitrary(u)?),
-                continuity_fade: Some(bool::arbitrary(u)?),
-                tcb: None,
-                pre: Some(pre),
-                post: Some(post),
-                rotation: Some(rotation),
-                hemisphere: Some(*u.choose(Hemisphere::ALL)?),
-            },
-        });
+        tracks.push(pack_track(u, i, kind, &times, (pre, post))?);
         tcbs.push(match u.int_in_range(0..=3u8)? {
             0 => Tcb::DEFAULT,
             _ => Tcb::from_array(tcb3(u)?),
         });
-        steps.push(match u.int_in_range(0..=15u8)? {
-            0 => f32::arbitrary(u)?,
-            1 => *u.choose(&[1e-45, f32::MIN_POSITIVE, 1e-30, 1e-12, 1e20, f32::MAX])?,
-            _ => {
-                let fine = 0.5f32.powi(u.int_in_range(0..=24i32)?);
-                fine * (1.0 + f32::from(u8::arbitrary(u)?) / 256.0)
-            }
-        });
+        steps.push(pack_step(u)?);
     }
     let tamper = if u.ratio(1, 32)? {
         Some(usize::from(u8::arbitrary(u)?))
@@ -459,6 +413,84 @@ fn arbitrary_pack(u: &mut Unstructured) -> arbitrary::Result<PackInput> {
         steps,
         tcb: tcbs,
         tamper,
+    })
+}
+
+/// 2 to 200 key times on one even grid: a start from anywhere (large,
+/// tiny, awkward fractions) and an interval from 1e-9 to 1e300 (or any
+/// positive f64).
+fn pack_times(u: &mut Unstructured) -> arbitrary::Result<Vec<f64>> {
+    let keys = u.int_in_range(2..=200usize)?;
+    let start = match u.int_in_range(0..=7u8)? {
+        0 => f64::arbitrary(u)?,
+        1 => f64::from(i32::arbitrary(u)?) * 1e3 + 0.1,
+        2 => *u.choose(&[1e6 + 0.1, 1e9 / 3.0, -1e7, 3.15e7, 1e-300])?,
+        _ => f64::from(i16::arbitrary(u)?) / 64.0,
+    };
+    let interval = match u.int_in_range(0..=7u8)? {
+        0 => f64::arbitrary(u)?.abs(),
+        1 => *u.choose(&[1e-9, 1e-6, 1.0 / 3.0, 0.1, 1e3, 1e6, 1e12, 1e300])?,
+        2 | 3 => 1.0 / f64::from(u.int_in_range(1..=240u16)?),
+        _ => f64::from(u.int_in_range(1..=u16::MAX)?) / 4096.0,
+    };
+    Ok((0..keys).map(|k| start + k as f64 * interval).collect())
+}
+
+/// Track `i` of `kind` on `times`: its values (rotations for 3 in 4
+/// rotation tracks, else [`vectors`]; the last equal to the first for
+/// cyclic ends), its ends, rotation mode (`hermite` for natural ends) and
+/// settings, with the clip's `pre` and `post`.
+fn pack_track(
+    u: &mut Unstructured,
+    i: usize,
+    kind: TrackKind,
+    times: &[f64],
+    (pre, post): (Extrapolation, Extrapolation),
+) -> arbitrary::Result<TrackDoc> {
+    let keys = times.len();
+    let ends = *u.choose(Ends::ALL)?;
+    let mut values = if kind == TrackKind::Quat && u.ratio(3, 4)? {
+        rotations(u, keys)?
+    } else {
+        vectors(u, keys)?
+    };
+    if ends == Ends::Cyclic {
+        values[keys - 1] = values[0];
+    }
+    let rotation = match ends {
+        Ends::Natural => RotationMode::Hermite,
+        _ => *u.choose(RotationMode::ALL)?,
+    };
+    Ok(TrackDoc {
+        name: format!("t{i}"),
+        kind,
+        times: times.to_vec(),
+        values,
+        keys: Vec::new(),
+        settings: SettingsDoc {
+            tangent_rule: Some(*u.choose(TangentRule::ALL)?),
+            ends: Some(ends),
+            match_speed: Some(bool::arbitrary(u)?),
+            continuity_fade: Some(bool::arbitrary(u)?),
+            tcb: None,
+            pre: Some(pre),
+            post: Some(post),
+            rotation: Some(rotation),
+            hemisphere: Some(*u.choose(Hemisphere::ALL)?),
+        },
+    })
+}
+
+/// A track's quantization step: mostly a power of two from 1 to 2^-24
+/// times 1 to 2, sometimes any f32 or an extreme one (denormal, huge).
+fn pack_step(u: &mut Unstructured) -> arbitrary::Result<f32> {
+    Ok(match u.int_in_range(0..=15u8)? {
+        0 => f32::arbitrary(u)?,
+        1 => *u.choose(&[1e-45, f32::MIN_POSITIVE, 1e-30, 1e-12, 1e20, f32::MAX])?,
+        _ => {
+            let fine = 0.5f32.powi(u.int_in_range(0..=24i32)?);
+            fine * (1.0 + f32::from(u8::arbitrary(u)?) / 256.0)
+        }
     })
 }
 

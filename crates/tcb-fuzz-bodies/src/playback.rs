@@ -65,16 +65,61 @@ pub fn playback(data: &[u8]) {
     let Ok(clip) = doc.build() else {
         return;
     };
-    let Ok(mode) = u.choose(&[
+    let Some(mode) = choose_mode(&mut u) else {
+        return;
+    };
+    let speed = choose_speed(&mut u);
+    let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
+    if !speed.is_finite() {
+        let refused = Instance::new(compiled).set_playback(mode, speed);
+        assert!(refused.is_err(), "a speed of {speed} accepted");
+        return;
+    }
+    let rigged = u.ratio(1, 3u8).unwrap_or(false);
+    let rest = crate::inputs::value(&mut u).unwrap_or([0.5; 4]);
+    let times = instance_times(&mut u, &clip, speed);
+    let play = Player {
+        compiled,
+        mode,
+        speed,
+    };
+    let rig = rigged.then(|| reversed_rig(&clip, rest));
+    let mut playing = play.plain();
+    let mut rig_playing = rig.as_ref().map(|r| play.rigged(r));
+    let mut reference = Reference::new(&clip);
+    for &t in &times {
+        let got = row(&mut playing, t);
+        let seek = row(&mut play.plain(), t);
+        assert!(
+            same(&got.0, &seek.0) && same(&got.1, &seek.1),
+            "{mode:?} x{speed}: forward playback differs from a seek at {t}"
+        );
+        let (c, rate) = play.check_clip_time(&clip, t);
+        play.check_plain(&got, t, c, rate);
+        reference.check(&got, mode, speed, t, c, rate);
+        if let (Some(rig), Some(inst)) = (&rig, &mut rig_playing) {
+            play.check_rig(&clip, rig, inst, &got, t);
+        }
+    }
+}
+
+/// The playback mode, from the input (`None` when it runs out).
+fn choose_mode(u: &mut Unstructured) -> Option<Playback> {
+    u.choose(&[
         Playback::Clip,
         Playback::Loop,
         Playback::Clamp,
         Playback::PingPong,
-    ]) else {
-        return;
-    };
-    let mode = *mode;
-    let speed = match u.int_in_range(0..=5u8).unwrap_or(0) {
+    ])
+    .ok()
+    .copied()
+}
+
+/// The speed: 1, one of the edge speeds (signed zeros, tiny, huge, the
+/// largest finite), any f64 (infinities and NaN included), or a small
+/// fraction.
+fn choose_speed(u: &mut Unstructured) -> f64 {
+    match u.int_in_range(0..=5u8).unwrap_or(0) {
         0 => 1.0,
         1 => *u
             .choose(&[
@@ -92,20 +137,16 @@ pub fn playback(data: &[u8]) {
                 -f64::MAX,
             ])
             .unwrap_or(&1.0),
-        2 => f64::arbitrary(&mut u).unwrap_or(1.0),
-        _ => f64::from(i16::arbitrary(&mut u).unwrap_or(1)) / 256.0,
-    };
-    let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
-    if !speed.is_finite() {
-        let refused = Instance::new(compiled).set_playback(mode, speed);
-        assert!(refused.is_err(), "a speed of {speed} accepted");
-        return;
+        2 => f64::arbitrary(u).unwrap_or(1.0),
+        _ => f64::from(i16::arbitrary(u).unwrap_or(1)) / 256.0,
     }
-    let rigged = u.ratio(1, 3u8).unwrap_or(false);
-    let rest = crate::inputs::value(&mut u).unwrap_or([0.5; 4]);
-    // Edge times in clip time, then divided by the speed: instance times.
+}
+
+/// Edge times in clip time, then half of them again divided by the speed:
+/// instance times whose clip times land near the keys.
+fn instance_times(u: &mut Unstructured, clip: &tcb_core::Clip, speed: f64) -> Vec<f64> {
     let keys: Vec<f64> = clip.key_times().into_iter().take(200).collect();
-    let mut times = edge_times(&mut u, &keys, 48);
+    let mut times = edge_times(u, &keys, 48);
     if speed != 0.0 && speed.is_finite() {
         let n = times.len();
         times.extend_from_within(..n / 2);
@@ -113,61 +154,77 @@ pub fn playback(data: &[u8]) {
             *t /= speed;
         }
     }
-    let make = || {
-        let mut i = Instance::new(compiled.clone()).with_velocities();
-        i.set_playback(mode, speed).expect("a finite speed");
-        i
-    };
-    // The clip's tracks reversed, then one the clip lacks.
-    let rig = rigged.then(|| {
-        let mut tracks: Vec<RigTrack> = clip
-            .tracks()
-            .iter()
-            .rev()
-            .map(|t| RigTrack {
-                name: t.name.clone(),
-                kind: t.data.kind(),
-                rest: [0.0, 0.0, 0.0, 1.0],
-            })
-            .collect();
-        tracks.push(RigTrack {
-            name: "fuzz.extra".into(),
-            kind: TrackKind::Vec4,
-            rest: rest.map(|x| if x.is_finite() { x } else { 0.5 }),
-        });
-        Arc::new(Rig::new(tracks).expect("distinct names, finite rests"))
+    times
+}
+
+/// A rig of the clip's tracks reversed, then one the clip lacks
+/// (`fuzz.extra`, a vec4 at `rest`, made finite).
+fn reversed_rig(clip: &tcb_core::Clip, rest: [f32; 4]) -> Arc<Rig> {
+    let mut tracks: Vec<RigTrack> = clip
+        .tracks()
+        .iter()
+        .rev()
+        .map(|t| RigTrack {
+            name: t.name.clone(),
+            kind: t.data.kind(),
+            rest: [0.0, 0.0, 0.0, 1.0],
+        })
+        .collect();
+    tracks.push(RigTrack {
+        name: "fuzz.extra".into(),
+        kind: TrackKind::Vec4,
+        rest: rest.map(|x| if x.is_finite() { x } else { 0.5 }),
     });
-    let make_rigged = |rig: &Arc<Rig>| {
-        let mut i = Instance::with_rig(compiled.clone(), rig)
+    Arc::new(Rig::new(tracks).expect("distinct names, finite rests"))
+}
+
+/// The values and velocities `i` samples at `t`, in its pose's layout.
+fn row(i: &mut Instance, t: f64) -> (Vec<f32>, Vec<f32>) {
+    let channels: usize = i
+        .pose()
+        .layout()
+        .tracks()
+        .iter()
+        .map(|s| s.kind().dim())
+        .sum();
+    let (mut v, mut d) = (vec![0.0f32; channels], vec![0.0f32; channels]);
+    i.sample(t).write_row(&mut v, Some(&mut d));
+    (v, d)
+}
+
+/// The compiled clip and the mode and speed it is played in.
+struct Player {
+    compiled: Arc<tcb_runtime::Clip>,
+    mode: Playback,
+    speed: f64,
+}
+
+impl Player {
+    /// A fresh instance with velocities, in the mode and at the speed.
+    fn plain(&self) -> Instance {
+        let mut i = Instance::new(self.compiled.clone()).with_velocities();
+        i.set_playback(self.mode, self.speed)
+            .expect("a finite speed");
+        i
+    }
+
+    /// A fresh instance through `rig`, with velocities, in the mode and at
+    /// the speed.
+    fn rigged(&self, rig: &Arc<Rig>) -> Instance {
+        let mut i = Instance::with_rig(self.compiled.clone(), rig)
             .expect("every track in the rig")
             .with_velocities();
-        i.set_playback(mode, speed).expect("a finite speed");
+        i.set_playback(self.mode, self.speed)
+            .expect("a finite speed");
         i
-    };
-    let n = clip.channel_count();
-    let row = |i: &mut Instance, t: f64| {
-        let channels: usize = i
-            .pose()
-            .layout()
-            .tracks()
-            .iter()
-            .map(|s| s.kind().dim())
-            .sum();
-        let (mut v, mut d) = (vec![0.0f32; channels], vec![0.0f32; channels]);
-        i.sample(t).write_row(&mut v, Some(&mut d));
-        (v, d)
-    };
-    let mut playing = make();
-    let mut rig_playing = rig.as_ref().map(make_rigged);
-    let (mut want, mut want_v) = (vec![0.0f32; n], vec![0.0f32; n]);
-    let range = clip.time_range();
-    for &t in &times {
-        let got = row(&mut playing, t);
-        let seek = row(&mut make(), t);
-        assert!(
-            same(&got.0, &seek.0) && same(&got.1, &seek.1),
-            "{mode:?} x{speed}: forward playback differs from a seek at {t}"
-        );
+    }
+
+    /// The clip time and velocity factor of `t` ([`clip_time`]), checked
+    /// to be within the keys in `Loop`, `Clamp` and `PingPong` when `t` is
+    /// finite.
+    fn check_clip_time(&self, clip: &tcb_core::Clip, t: f64) -> (f64, f32) {
+        let (mode, speed) = (self.mode, self.speed);
+        let range = clip.time_range();
         let (c, rate) = clip_time(mode, speed, t, range);
         if let (Some((t0, t1)), true) = (range, mode != Playback::Clip && t.is_finite()) {
             assert!(
@@ -175,7 +232,14 @@ pub fn playback(data: &[u8]) {
                 "{mode:?} x{speed} at {t}: clip time {c} outside the keys"
             );
         }
-        let mut plain = Instance::new(compiled.clone()).with_velocities();
+        (c, rate)
+    }
+
+    /// `got` (sampled at `t`) equals a plain instance's row at the clip
+    /// time `c`, its velocities times `rate`.
+    fn check_plain(&self, got: &(Vec<f32>, Vec<f32>), t: f64, c: f64, rate: f32) {
+        let (mode, speed) = (self.mode, self.speed);
+        let mut plain = Instance::new(self.compiled.clone()).with_velocities();
         let (pv, mut pd) = row(&mut plain, c);
         pd.iter_mut().for_each(|x| *x *= rate);
         assert!(
@@ -183,17 +247,99 @@ pub fn playback(data: &[u8]) {
             "{mode:?} x{speed} at {t} (clip time {c}, velocity x{rate}): \
              instance {got:?}, plain instance {pv:?} {pd:?}"
         );
-        clip.sample_into(c, &mut want, Some(&mut want_v));
+    }
+
+    /// Through the rig: forward playback equals a seek, each of the clip's
+    /// tracks equals `got` (the instance without the rig) and the extra
+    /// track holds its rest value with velocity 0.
+    fn check_rig(
+        &self,
+        clip: &tcb_core::Clip,
+        rig: &Arc<Rig>,
+        inst: &mut Instance,
+        got: &(Vec<f32>, Vec<f32>),
+        t: f64,
+    ) {
+        let (mode, speed) = (self.mode, self.speed);
+        let (rv, rd) = row(inst, t);
+        let seek = row(&mut self.rigged(rig), t);
+        assert!(
+            same(&rv, &seek.0) && same(&rd, &seek.1),
+            "rig {mode:?} x{speed}: forward playback differs from a seek at {t}"
+        );
+        // Rig order: the clip's tracks reversed, then the extra one.
+        let mut ra = 0;
+        for rt in rig.tracks() {
+            let dim = rt.kind.dim();
+            let rr = ra..ra + dim;
+            ra += dim;
+            let (v, d) = (&rv[rr.clone()], &rd[rr]);
+            match clip.tracks().iter().position(|c| c.name == rt.name) {
+                Some(i) => {
+                    let ca: usize = clip.tracks()[..i].iter().map(|c| c.data.kind().dim()).sum();
+                    let cr = ca..ca + dim;
+                    assert!(
+                        same(v, &got.0[cr.clone()]) && same(d, &got.1[cr.clone()]),
+                        "rig {} {mode:?} x{speed} at {t}: {v:?} {d:?}, without the rig \
+                         {:?} {:?}",
+                        rt.name,
+                        &got.0[cr.clone()],
+                        &got.1[cr]
+                    );
+                }
+                None => assert!(
+                    same(v, &rt.rest[..dim]) && d.iter().all(|x| *x == 0.0),
+                    "rig {} (not in the clip) at {t}: {v:?} {d:?}, rest {:?}",
+                    rt.name,
+                    rt.rest
+                ),
+            }
+        }
+    }
+}
+
+/// The scalar reference and the rows it samples into.
+struct Reference<'a> {
+    clip: &'a tcb_core::Clip,
+    want: Vec<f32>,
+    want_v: Vec<f32>,
+}
+
+impl<'a> Reference<'a> {
+    /// Rows for `clip`'s channels.
+    fn new(clip: &'a tcb_core::Clip) -> Self {
+        let n = clip.channel_count();
+        Self {
+            clip,
+            want: vec![0.0; n],
+            want_v: vec![0.0; n],
+        }
+    }
+
+    /// `got` (sampled at `t`) against the reference at the clip time `c`,
+    /// velocities times `rate`: vector channels equal as numbers where the
+    /// reference is finite, rotations within 1e-6 up to sign.
+    fn check(
+        &mut self,
+        got: &(Vec<f32>, Vec<f32>),
+        mode: Playback,
+        speed: f64,
+        t: f64,
+        c: f64,
+        rate: f32,
+    ) {
+        let (want, want_v) = (&mut self.want, &mut self.want_v);
+        self.clip.sample_into(c, want, Some(want_v));
         want_v.iter_mut().for_each(|x| *x *= rate);
         let mut at = 0;
-        for track in clip.tracks() {
+        for track in self.clip.tracks() {
             let r = at..at + track.data.kind().dim();
             at = r.end;
             if let TrackData::Quat(_) = track.data {
                 assert_rotation(&got.0[r.clone()], &want[r], &track.name, t);
                 continue;
             }
-            for (what, g, w) in [("value", &got.0, &want), ("velocity", &got.1, &want_v)] {
+            for (what, g, w) in [("value", &got.0, &*want), ("velocity", &got.1, &*want_v)] {
                 let (g, w) = (&g[r.clone()], &w[r.clone()]);
                 assert!(
                     w.iter().any(|x| !x.is_finite()) || same(g, w),
@@ -201,43 +347,6 @@ pub fn playback(data: &[u8]) {
                      reference {w:?}",
                     track.name
                 );
-            }
-        }
-        if let (Some(rig), Some(inst)) = (&rig, &mut rig_playing) {
-            let (rv, rd) = row(inst, t);
-            let seek = row(&mut make_rigged(rig), t);
-            assert!(
-                same(&rv, &seek.0) && same(&rd, &seek.1),
-                "rig {mode:?} x{speed}: forward playback differs from a seek at {t}"
-            );
-            // Rig order: the clip's tracks reversed, then the extra one.
-            let mut ra = 0;
-            for rt in rig.tracks() {
-                let dim = rt.kind.dim();
-                let rr = ra..ra + dim;
-                ra += dim;
-                let (v, d) = (&rv[rr.clone()], &rd[rr]);
-                match clip.tracks().iter().position(|c| c.name == rt.name) {
-                    Some(i) => {
-                        let ca: usize =
-                            clip.tracks()[..i].iter().map(|c| c.data.kind().dim()).sum();
-                        let cr = ca..ca + dim;
-                        assert!(
-                            same(v, &got.0[cr.clone()]) && same(d, &got.1[cr.clone()]),
-                            "rig {} {mode:?} x{speed} at {t}: {v:?} {d:?}, without the rig \
-                             {:?} {:?}",
-                            rt.name,
-                            &got.0[cr.clone()],
-                            &got.1[cr]
-                        );
-                    }
-                    None => assert!(
-                        same(v, &rt.rest[..dim]) && d.iter().all(|x| *x == 0.0),
-                        "rig {} (not in the clip) at {t}: {v:?} {d:?}, rest {:?}",
-                        rt.name,
-                        rt.rest
-                    ),
-                }
             }
         }
     }

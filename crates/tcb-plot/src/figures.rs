@@ -35,6 +35,7 @@ fn titled(title: &str) -> Plot {
     }
 }
 
+/// A figure's plot of a 2D path (components x and y), titled.
 fn path(title: &str) -> Plot {
     Plot {
         mode: Mode::Path { components: [0, 1] },
@@ -42,39 +43,60 @@ fn path(title: &str) -> Plot {
     }
 }
 
+/// A figure drawn from the clip at `clip`.
+fn figure(name: &'static str, clip: &'static str, plot: Plot) -> Figure {
+    Figure { name, clip, plot }
+}
+
 /// Every figure, in the order docs/guide.md shows them, then the
 /// README's (a test names the first one's clip).
 pub fn figures() -> Vec<Figure> {
+    let mut all = paper_figures();
+    all.extend(guide_figures());
+    all.push(readme_figure());
+    all
+}
+
+/// The paper's figures 3 to 6, redrawn: tension, continuity, bias and the
+/// careening ball.
+fn paper_figures() -> Vec<Figure> {
     vec![
-        Figure {
-            name: "tension.svg",
-            clip: "examples/clips/tension.json",
-            plot: path("Tension -1, 0, 1 (Kochanek & Bartels, fig. 3)"),
-        },
-        Figure {
-            name: "continuity.svg",
-            clip: "examples/clips/continuity.json",
-            plot: path("Continuity -1, 0, 1 (fig. 4)"),
-        },
-        Figure {
-            name: "bias.svg",
-            clip: "examples/clips/bias.json",
-            plot: path("Bias -1, 0, 1 (fig. 5)"),
-        },
-        Figure {
-            name: "careen.svg",
-            clip: "examples/clips/careen.json",
-            plot: path("A ball careens off a tree (fig. 6)"),
-        },
-        Figure {
-            name: "spacing-path.svg",
-            clip: "examples/clips/spacing.json",
-            plot: path("Uneven key spacing: the four tangent rules (Eberly)"),
-        },
-        Figure {
-            name: "spacing-speed.svg",
-            clip: "examples/clips/spacing.json",
-            plot: Plot {
+        figure(
+            "tension.svg",
+            "examples/clips/tension.json",
+            path("Tension -1, 0, 1 (Kochanek & Bartels, fig. 3)"),
+        ),
+        figure(
+            "continuity.svg",
+            "examples/clips/continuity.json",
+            path("Continuity -1, 0, 1 (fig. 4)"),
+        ),
+        figure(
+            "bias.svg",
+            "examples/clips/bias.json",
+            path("Bias -1, 0, 1 (fig. 5)"),
+        ),
+        figure(
+            "careen.svg",
+            "examples/clips/careen.json",
+            path("A ball careens off a tree (fig. 6)"),
+        ),
+    ]
+}
+
+/// The guide's own figures: uneven key spacing (path and speed), ease,
+/// the extrapolation modes and squad against hermite.
+fn guide_figures() -> Vec<Figure> {
+    vec![
+        figure(
+            "spacing-path.svg",
+            "examples/clips/spacing.json",
+            path("Uneven key spacing: the four tangent rules (Eberly)"),
+        ),
+        figure(
+            "spacing-speed.svg",
+            "examples/clips/spacing.json",
+            Plot {
                 mode: Mode::Speed,
                 inbetweens: Some(0),
                 from: Some(0.0),
@@ -83,47 +105,49 @@ pub fn figures() -> Vec<Figure> {
                     "Speed under the four tangent rules (Eberly): only 'uniform' jumps at the keys",
                 )
             },
-        },
-        Figure {
-            name: "ease.svg",
-            clip: "examples/clips/ease.json",
-            plot: Plot {
+        ),
+        figure(
+            "ease.svg",
+            "examples/clips/ease.json",
+            Plot {
                 inbetweens: Some(8),
                 from: Some(0.0),
                 to: Some(2.0),
                 ..titled("Ease to and from the middle key: 0, 0.5, 1 (section 6)")
             },
-        },
-        Figure {
-            name: "extrapolation.svg",
-            clip: "examples/clips/modes.json",
-            plot: Plot {
+        ),
+        figure(
+            "extrapolation.svg",
+            "examples/clips/modes.json",
+            Plot {
                 from: Some(-1.5),
                 to: Some(2.5),
                 ..titled("Each pre/post mode outside the keys")
             },
-        },
-        Figure {
-            name: "rotation.svg",
-            clip: "examples/clips/spin.json",
-            plot: Plot {
+        ),
+        figure(
+            "rotation.svg",
+            "examples/clips/spin.json",
+            Plot {
                 tracks: vec!["top.squad".into(), "top.hermite".into()],
                 from: Some(0.0),
                 to: Some(2.0),
                 ..titled("Squad against hermite on the same rotation keys")
             },
-        },
-        Figure {
-            name: "parameters.svg",
-            clip: "examples/clips/parameters.json",
-            plot: Plot {
-                inbetweens: Some(0),
-                from: Some(0.0),
-                to: Some(4.0),
-                ..titled(
-                    "The same five keys: tension, continuity and bias (Kochanek & Bartels 1984)",
-                )
-            },
-        },
+        ),
     ]
+}
+
+/// The README's figure: one set of keys under each parameter.
+fn readme_figure() -> Figure {
+    figure(
+        "parameters.svg",
+        "examples/clips/parameters.json",
+        Plot {
+            inbetweens: Some(0),
+            from: Some(0.0),
+            to: Some(4.0),
+            ..titled("The same five keys: tension, continuity and bias (Kochanek & Bartels 1984)")
+        },
+    )
 }

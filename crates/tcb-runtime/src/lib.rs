@@ -57,11 +57,11 @@ mod kernel;
 mod layout;
 mod loose;
 pub mod pack;
-pub mod pose;
+mod pose;
 mod quant;
 pub mod rig;
 mod segment;
-pub mod skeleton;
+mod skeleton;
 mod store;
 
 #[cfg(feature = "rayon")]

@@ -273,3 +273,132 @@ fn the_check_finds_a_circle() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The `pub mod`s of the crate at `src` whose file declares no public item
+/// that the root does not re-export (`pub use name::{..}`): a public path
+/// to nothing new. A `pub use` or an item-making macro (`named_enum!`) in
+/// the module counts as an item of its own.
+fn empty_pub_mods(src: &Path) -> Vec<String> {
+    let root = code(&src.join("lib.rs"));
+    let mut empty = Vec::new();
+    for line in root.lines() {
+        let Some(name) = line
+            .strip_prefix("pub mod ")
+            .and_then(|l| l.trim().strip_suffix(';'))
+        else {
+            continue;
+        };
+        let file = [
+            src.join(format!("{name}.rs")),
+            src.join(name).join("mod.rs"),
+        ]
+        .into_iter()
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| panic!("{}: no file for `pub mod {name}`", src.display()));
+        // What the root re-exports from it, `pub use name::{A, b::C};` up to the `;`.
+        let mut reexported = BTreeSet::new();
+        let prefix = format!("pub use {name}::");
+        let mut rest = &root[..];
+        while let Some(at) = rest.find(&prefix) {
+            rest = &rest[at + prefix.len()..];
+            let end = rest.find(';').unwrap_or(rest.len());
+            for part in rest[..end].split(|c: char| "{},".contains(c)) {
+                let last = part.trim().rsplit("::").next().unwrap_or("");
+                let last = last.split(" as ").next().unwrap_or("").trim();
+                if !last.is_empty() {
+                    reexported.insert(last.to_string());
+                }
+            }
+        }
+        let own = code(&file).lines().any(|l| {
+            if l.ends_with("! {") && !l.starts_with(' ') && !l.starts_with("macro_rules") {
+                return true;
+            }
+            let Some(item) = l.strip_prefix("pub ") else {
+                return false;
+            };
+            let words: Vec<&str> = item
+                .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .filter(|w| !w.is_empty())
+                .collect();
+            let kinds = [
+                "fn", "struct", "enum", "trait", "const", "static", "type", "mod",
+            ];
+            match words.iter().position(|w| kinds.contains(w) || *w == "use") {
+                Some(i) if words[i] == "use" => true,
+                // `const fn f`: the name follows the last keyword.
+                Some(i) => {
+                    let mut j = i;
+                    while words.get(j).is_some_and(|w| kinds.contains(w)) {
+                        j += 1;
+                    }
+                    words.get(j).is_some_and(|w| !reexported.contains(*w))
+                }
+                None => false,
+            }
+        });
+        if !own {
+            empty.push(name.to_string());
+        }
+    }
+    empty
+}
+
+/// Issue 31: a `pub mod` whose items all stand at the crate's root too is
+/// a second path to the same things; such modules are private. Kept public
+/// on purpose, for their module page: tcb-runtime's `clip` (the compiled
+/// layout) and `rig` (rig order against a clip's), tcb-core's `vector` (the
+/// vector interface the tangent rules are written against) and
+/// tcb-bench's `baseline` (what the scalar baseline does); and, until the
+/// work on those files lands, tcb-fit's `compress` and tcb-io's `error`.
+#[test]
+fn every_pub_mod_exports_something_of_its_own() {
+    let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let kept = [
+        "tcb-runtime::clip",
+        "tcb-runtime::rig",
+        "tcb-core::vector",
+        "tcb-bench::baseline",
+        "tcb-fit::compress",
+        "tcb-io::error",
+    ];
+    let mut found = Vec::new();
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&crates).unwrap() {
+        let dir = entry.unwrap().path();
+        if !dir.join("src/lib.rs").is_file() {
+            continue;
+        }
+        checked += 1;
+        let krate = dir.file_name().unwrap().to_string_lossy().into_owned();
+        for m in empty_pub_mods(&dir.join("src")) {
+            let m = format!("{krate}::{m}");
+            if !kept.contains(&m.as_str()) {
+                found.push(m);
+            }
+        }
+    }
+    assert!(checked >= 7, "{checked} library crates found");
+    assert!(
+        found.is_empty(),
+        "`pub mod`s that export nothing the root does not (make them private):\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_check_finds_a_pub_mod_that_exports_nothing() {
+    let dir = std::env::temp_dir().join(format!("tcb-pub-mods-{}", std::process::id()));
+    let src = dir.join("src");
+    std::fs::create_dir_all(src.join("b")).unwrap();
+    std::fs::write(
+        src.join("lib.rs"),
+        "pub mod a;\npub mod b;\npub mod c;\npub use a::{X, f as g};\npub use b::Y;\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("a.rs"), "pub struct X;\npub const fn f() {}\n").unwrap();
+    std::fs::write(src.join("b/mod.rs"), "pub struct Y;\npub enum Z {}\n").unwrap();
+    std::fs::write(src.join("c.rs"), "pub(crate) struct W;\n// pub struct V;\n").unwrap();
+    assert_eq!(empty_pub_mods(&src), ["a", "c"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

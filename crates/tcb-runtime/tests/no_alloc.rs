@@ -1,52 +1,13 @@
-#![allow(unsafe_code)] // a counting global allocator is unsafe by nature; test-only
 //! Steady playback allocates nothing: sampling, velocities, the reference
 //! fallbacks and blending, counted by a global allocator on the sampling
 //! thread only (the test harness's own threads may allocate meanwhile: one
 //! run in CI-like conditions saw 4 such allocations).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::sync::Arc;
-
-struct Counting;
-
-thread_local! {
-    /// Whether this thread's allocations are counted (no destructor, no
-    /// allocation to access).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-    /// This thread's counted allocations, and the bytes they asked for
-    /// (reallocations count their new size): per thread, so that tests
-    /// running side by side do not count each other's.
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-    static BYTES: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count(bytes: usize) {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        BYTES.with(|c| c.set(c.get() + bytes));
-    }
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count(layout.size());
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count(new_size);
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use tcb_test_support::{CountingAllocator, count_allocations};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn steady_playback_and_blending_allocate_nothing() {
@@ -103,30 +64,28 @@ fn steady_playback_and_blending_allocate_nothing() {
         // Warm up once.
         a.sample(0.0);
         b.sample(0.0);
-        let before = ALLOCATIONS.with(Cell::get);
-        COUNTING.with(|c| c.set(true));
-        for frame in 0..2000 {
-            let t = -3.0 + frame as f64 / 120.0;
-            a.sample(t);
-            b.sample(t * 0.5 + 1e6);
-            tcb_runtime::blend(&mut out, &[(a.pose(), 0.7), (b.pose(), 0.3)], None).unwrap();
-            tcb_runtime::blend(
-                &mut out,
-                &[(a.pose(), 1.0), (b.pose(), 1.0)],
-                Some(&[&mask, &mask]),
-            )
-            .unwrap();
-            r.sample(t * 0.25);
-            tcb_runtime::blend::add(&mut rest, r.pose(), r.pose(), 0.5, None).unwrap();
-            tcb_runtime::blend::add(&mut out, a.pose(), b.pose(), 0.5, Some(&mask)).unwrap();
-        }
-        COUNTING.with(|c| c.set(false));
-        let after = ALLOCATIONS.with(Cell::get);
+        let ((), counted) = count_allocations(|| {
+            for frame in 0..2000 {
+                let t = -3.0 + frame as f64 / 120.0;
+                a.sample(t);
+                b.sample(t * 0.5 + 1e6);
+                tcb_runtime::blend(&mut out, &[(a.pose(), 0.7), (b.pose(), 0.3)], None).unwrap();
+                tcb_runtime::blend(
+                    &mut out,
+                    &[(a.pose(), 1.0), (b.pose(), 1.0)],
+                    Some(&[&mask, &mask]),
+                )
+                .unwrap();
+                r.sample(t * 0.25);
+                tcb_runtime::blend::add(&mut rest, r.pose(), r.pose(), 0.5, None).unwrap();
+                tcb_runtime::blend::add(&mut out, a.pose(), b.pose(), 0.5, Some(&mask)).unwrap();
+            }
+        });
         assert_eq!(
-            after - before,
+            counted.count,
             0,
             "{} allocations in 2000 frames of {}",
-            after - before,
+            counted.count,
             clip.name()
         );
     }
@@ -153,11 +112,8 @@ fn loading_a_packed_clip_allocates_no_keys() {
     }
     let asked = |source: &tcb_runtime::PackSource| {
         let bytes = tcb_runtime::Packed::encode(source).unwrap().to_bytes();
-        let before = BYTES.with(Cell::get);
-        COUNTING.with(|c| c.set(true));
-        let clip = tcb_runtime::Clip::from_bytes(&bytes).unwrap();
-        COUNTING.with(|c| c.set(false));
-        let asked = BYTES.with(Cell::get) - before;
+        let (clip, counted) = count_allocations(|| tcb_runtime::Clip::from_bytes(&bytes).unwrap());
+        let asked = counted.bytes;
         // The full check is apart, and holds.
         clip.verify_packed().unwrap();
         (asked, bytes.len())

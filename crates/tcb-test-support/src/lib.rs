@@ -2,6 +2,11 @@
 //! dev-dependency only, which `cargo package` leaves out of the published
 //! manifests).
 
+mod alloc;
+
+pub use alloc::{
+    Allocations, CountingAllocator, count_allocations, start_counting, stop_counting, take_counted,
+};
 use proptest::test_runner::{Config, RngSeed};
 use std::fmt::Debug;
 
