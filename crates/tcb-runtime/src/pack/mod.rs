@@ -1254,9 +1254,10 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads (version 3: residuals
-/// stored offset by half their range; 1 and 2 stored them zigzag-coded and
-/// are refused with a one-line error).
+/// The format version this build writes and reads (version 4: rotations
+/// whose `w` changes sign kept relative to a center, constant components
+/// without headers, no stored segment table; older versions are refused
+/// with a one-line error).
 pub const VERSION: u32 = 4;
 
 mod file;
