@@ -261,7 +261,8 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
             .collect(),
         center: center
             .into_iter()
-            .map(|c| c.map(|planes| planes.map(f32x8::new)))
+            .enumerate()
+            .filter_map(|(b, c)| c.map(|planes| (b, planes.map(f32x8::new))))
             .collect(),
         table,
     }

@@ -58,9 +58,10 @@ pub(crate) struct PackedKeys {
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
     pub rebuild: Vec<f32x8>,
-    /// Per rotation block: the centers its keys are relative to (the
-    /// identity in lanes without one), if a lane has one.
-    pub center: Vec<Option<[f32x8; 4]>>,
+    /// The rotation blocks with a lane whose keys are relative to a center
+    /// (`PackTrack::center`): the block, and per plane the centers (the
+    /// identity in lanes without one).
+    pub center: Vec<(usize, [f32x8; 4])>,
     /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
     /// (`n ..= n+3`), `planes` vectors each.
     pub table: Vec<f32x8>,
@@ -80,7 +81,7 @@ impl PackedKeys {
             + 4 * self.lane_slot.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
             + 8 * self.rebuild.len()
-            + std::mem::size_of::<Option<[f32x8; 4]>>() * self.center.len()
+            + std::mem::size_of::<(usize, [f32x8; 4])>() * self.center.len()
     }
 
     /// The controls of the segment from key `a` to key `b`: a real segment
@@ -119,22 +120,42 @@ impl PackedKeys {
         let (np, n) = (self.planes, self.keys);
         let mut m = std::mem::take(&mut c.m);
         let (m0, m1) = m.split_at_mut(np);
-        if a > 0 {
-            let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
-            let rows = x.iter().zip(y).zip(z);
-            for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
-                *m = (*y - *x) * w[2] + (*z - *y) * w[3];
+        if a > 0 && b < n - 1 {
+            // Both (all but the end segments): the chord P_b - P_a once.
+            let (v, x) = (c.ring(a - 1, np), c.ring(a, np));
+            let (y, z) = (c.ring(b, np), c.ring(b + 1, np));
+            let rows = v.iter().zip(x).zip(y.iter().zip(z));
+            let out = m0.iter_mut().zip(m1.iter_mut());
+            for (((m0, m1), ((v, x), (y, z))), w) in out.zip(rows).zip(&self.weights) {
+                let chord = *y - *x;
+                *m0 = tangent(*x - *v, chord, w[2], w[3]);
+                *m1 = tangent(chord, *z - *y, w[0], w[1]);
             }
-        }
-        if b < n - 1 {
-            let (x, y, z) = (c.ring(a, np), c.ring(b, np), c.ring(b + 1, np));
-            let rows = x.iter().zip(y).zip(z);
-            for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
-                *m = (*y - *x) * w[0] + (*z - *y) * w[1];
+        } else {
+            if a > 0 {
+                let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
+                let rows = x.iter().zip(y).zip(z);
+                for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
+                    *m = tangent(*y - *x, *z - *y, w[2], w[3]);
+                }
+            }
+            if b < n - 1 {
+                let (x, y, z) = (c.ring(a, np), c.ring(b, np), c.ring(b + 1, np));
+                let rows = x.iter().zip(y).zip(z);
+                for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
+                    *m = tangent(*y - *x, *z - *y, w[0], w[1]);
+                }
             }
         }
         c.m = m;
     }
+}
+
+/// The tangent rule on a key's two chords (`P_k - P_{k-1}`, `P_{k+1} -
+/// P_k`) with its weights, as `tcb_core::Track` computes it in f32.
+#[inline(always)]
+fn tangent(before: f32x8, after: f32x8, wa: f32x8, wb: f32x8) -> f32x8 {
+    before * wa + after * wb
 }
 
 /// Rows of the decoded keys' window: the three keys before the current
@@ -337,13 +358,14 @@ impl PackCache {
         for r in rows {
             let row = &mut self.rows[(BEFORE + r) * np..][..np];
             let rot = &mut row[g.rot_from..];
-            let blocks = rot.chunks_exact_mut(4).zip(&g.rebuild).zip(&g.center);
-            for ((block, mask), center) in blocks {
+            for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
                 let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
                 block[3] = (*mask & w) | (!*mask & block[3]);
-                if let Some(c) = center {
-                    let q = [block[0], block[1], block[2], block[3]];
-                    block.copy_from_slice(&tcb_core::quat::mul(c, &q));
+            }
+            for (b, c) in &g.center {
+                if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
+                    let q = tcb_core::quat::mul(c, &[block[0], block[1], block[2], block[3]]);
+                    block.copy_from_slice(&q);
                 }
             }
         }
