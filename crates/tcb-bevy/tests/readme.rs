@@ -17,9 +17,10 @@ fn the_readme_shows_the_example_that_compiles() {
     assert!(block.lines().count() <= 20, "keep it short");
 }
 
-/// The workspace's README keeps its bevy section short and points here.
+/// The workspace's README shows the same lines (issue 32: the README shows
+/// what a bevy user adds), keeps its bevy section short and points here.
 #[test]
-fn the_workspace_readme_points_here() {
+fn the_workspace_readme_shows_them_and_points_here() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
     let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
     let section = &readme[readme
@@ -27,5 +28,15 @@ fn the_workspace_readme_points_here() {
         .expect("the README's bevy section")..];
     let section = &section[..section[3..].find("\n## ").map_or(section.len(), |e| e + 3)];
     assert!(section.contains("(crates/tcb-bevy/README.md)"));
-    assert!(section.lines().count() <= 12, "keep it short");
+    let example = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/readme.rs"
+    ))
+    .unwrap();
+    let code = &example[example.find("use bevy::prelude::*;").unwrap()..];
+    assert!(
+        section.contains(&format!("```rust,ignore\n{code}```")),
+        "README.md's bevy block differs from crates/tcb-bevy/examples/readme.rs"
+    );
+    assert!(section.lines().count() <= 32, "keep it short");
 }
