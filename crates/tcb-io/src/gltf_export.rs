@@ -31,6 +31,23 @@
 //! the track is not exact: it is read back as `tcb import` reads it and
 //! measured against the clip, and that error is reported
 //! ([`TrackExport::time_rounding`]).
+//!
+//! The error reported for a resampled or moved track is a bound, not a
+//! few samples: between the keys of both curves and the ends of the
+//! clip's ease phases a vector track and its read-back are polynomials
+//! of degree 6 or less in time, and 33 samples of each interval bound
+//! their difference, and the least `|value|` it is divided by, everywhere
+//! in it:
+//!
+//! ```text
+//! error <= max over samples i of
+//!          (max(|d_i|, |d_i+1|) + 0.13 range(d)) / max(1, min(|v_i|, |v_i+1|) - 0.13 range(v))
+//! ```
+//!
+//! with `d` the difference, `v` the clip's value (0 in place of the
+//! second term where it changes sign) and 0.13 from Markov's inequality
+//! for degree 6 at 32 intervals. A track whose read-back overflows f32
+//! where the clip is finite is refused.
 
 use crate::error::Error;
 use gltf::json;
@@ -38,6 +55,7 @@ use json::accessor::Type as AccessorType;
 use json::animation::Interpolation;
 use json::validation::{Checked, USize64};
 use std::path::Path;
+use tcb_core::ease::SegmentEase;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value as TcbValue};
 
@@ -76,8 +94,9 @@ pub struct TimeRounding {
     pub largest_shift: f64,
     /// The largest difference from the reference (relative to max(1,
     /// |value|)) of the track as `tcb import` reads the export back,
-    /// measured at the keys, the stored times and 7 points between each
-    /// two of them, widened to bound the difference between the points.
+    /// bounded over every interval between the keys, the stored times and
+    /// the ends of ease phases from 33 points in each (see the module
+    /// docs).
     pub error: f64,
 }
 
@@ -751,6 +770,14 @@ fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written,
     } else {
         0.0
     };
+    if measured == f64::INFINITY {
+        return Err(Error::import(format!(
+            "track '{name}': as glTF's f32 keys and tangents, its curve overflows f32 between \
+             keys where the clip's is finite (tangents far larger than its values); it cannot \
+             be exported: bring its tension, continuity, bias and explicit tangents within a \
+             few units"
+        )));
+    }
     let report = TrackExport {
         name: name.to_string(),
         resampled_error: fit.map(|f| f.max(measured)),
@@ -828,33 +855,156 @@ fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::
 /// `max|p| <= max|p(x_i)| / (1 - 12/64) = 1.23 max|p(x_i)|`.
 const BETWEEN_POINTS: f64 = 1.25;
 
-/// The largest difference between `data` and `back` (relative to max(1,
-/// |value|), rotations up to sign) at the keys of both and 7 points
-/// between each two, `data` held at its end values outside its keys as
-/// glTF holds them; times [`BETWEEN_POINTS`], so that it bounds the
-/// difference between the points too.
+/// Points per interval at which [`read_back_error`] samples both curves.
+const READ_BACK_POINTS: usize = 32;
+
+/// How far a polynomial of degree 6 or less can stray from the line
+/// between two neighbours of [`READ_BACK_POINTS`] + 1 evenly spaced samples
+/// of it, as a fraction of the range of the samples. The second derivative
+/// of such a `p` over an interval of length 1 is at most `1680 max|p - c|`
+/// (Markov: `4 n² (n² - 1) / 3`), so a line between points `h = 1/32`
+/// apart misses by at most `1680 h² / 8 = 0.205 max|p - c|`; with `c` the
+/// middle of the samples' range `r`, `max|p - c| <= (r / 2) / (1 - 0.205)`,
+/// and the miss is at most `0.129 r`.
+const BETWEEN_SAMPLES: f64 = 0.13;
+
+/// An upper bound of the difference between `data` and `back`
+/// (relative to max(1, |value|), rotations up to sign) wherever `data` is
+/// finite, `data` held at its end values outside its keys as glTF holds
+/// them: what a reader of the export gets, resampling and f32 key times
+/// included. Both are sampled at [`READ_BACK_POINTS`] + 1 points of each
+/// interval between the keys of both and the ends of `data`'s ease
+/// phases, where both are polynomials of degree 6 or less in time (a
+/// cubic of an eased parameter, against a cubic) for vector tracks.
+/// Between two samples, the difference is bounded by the larger of its
+/// two ends plus [`BETWEEN_SAMPLES`] of its range in the interval, and
+/// divided by max(1, the least `|value|` there) bounded the same way (0
+/// where the value changes sign). The value's range matters: a curve that
+/// crosses zero between keys 1e12 apart is held to the absolute
+/// difference there, which f32 keys and tangents of that size cannot
+/// keep small (issue 29 class 6). Rotations are normalized, not
+/// polynomials; their components are at most 1, and the same bound is a
+/// close estimate there. Infinite where `back` is not finite and `data`
+/// is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
     let own = data.times();
     let (first, last) = (own[0], own[own.len() - 1]);
-    let mut times: Vec<f64> = own.iter().chain(back.times()).copied().collect();
+    let mut times: Vec<f64> = own
+        .iter()
+        .chain(back.times())
+        .copied()
+        .chain(ease_phases(data))
+        .collect();
     times.sort_by(f64::total_cmp);
     times.dedup();
-    let (mut want, mut got) = ([0.0f32; 4], [0.0f32; 4]);
+    let mut want = vec![[0.0f32; 4]; READ_BACK_POINTS + 1];
+    let mut got = want.clone();
     let mut worst = 0.0f64;
-    let mut at = |t: f64| {
-        data.sample_into(t.clamp(first, last), &mut want[..dim], None);
-        back.sample_into(t, &mut got[..dim], None);
-        worst = worst.max(difference(&want[..dim], &got[..dim], rotation));
-    };
     for w in times.windows(2) {
-        for i in 0..8 {
-            at(w[0] + (w[1] - w[0]) * f64::from(i) / 8.0);
+        for (i, (want, got)) in want.iter_mut().zip(&mut got).enumerate() {
+            let t = if i == READ_BACK_POINTS {
+                w[1]
+            } else {
+                w[0] + (w[1] - w[0]) * i as f64 / READ_BACK_POINTS as f64
+            };
+            data.sample_into(t.clamp(first, last), &mut want[..dim], None);
+            back.sample_into(t, &mut got[..dim], None);
+        }
+        worst = worst.max(interval_error(&want, &got, dim, rotation));
+        if worst == f64::INFINITY {
+            break;
         }
     }
-    at(times[times.len() - 1]);
-    worst * BETWEEN_POINTS
+    worst
+}
+
+/// [`read_back_error`]'s bound over one interval from the samples `want`
+/// and `got` (`dim` components each) at its evenly spaced points.
+fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, rotation: bool) -> f64 {
+    // A rotation read back on the other hemisphere is the same rotation:
+    // one sign for the interval, the closer one.
+    let sign = if rotation {
+        let off = |s: f64| -> f64 {
+            want.iter()
+                .zip(got)
+                .map(|(w, g)| {
+                    (0..4)
+                        .map(|c| (f64::from(w[c]) - s * f64::from(g[c])).abs())
+                        .sum::<f64>()
+                })
+                .filter(|x| !x.is_nan())
+                .sum()
+        };
+        if off(-1.0) < off(1.0) { -1.0 } else { 1.0 }
+    } else {
+        1.0
+    };
+    let mut worst = 0.0f64;
+    for c in 0..dim {
+        let w: Vec<f64> = want.iter().map(|v| f64::from(v[c])).collect();
+        let g: Vec<f64> = got.iter().map(|v| sign * f64::from(v[c])).collect();
+        if w.iter()
+            .zip(&g)
+            .any(|(w, g)| w.is_finite() && !g.is_finite())
+        {
+            return f64::INFINITY;
+        }
+        if w.iter().any(|x| !x.is_finite()) {
+            // The clip itself is not finite here (tangents that overflow
+            // f32): no polynomial to bound; where it is finite, as is.
+            let pointwise = w.iter().zip(&g).filter(|(w, _)| w.is_finite());
+            for (w, g) in pointwise {
+                worst = worst.max((w - g).abs() / w.abs().max(1.0));
+            }
+            continue;
+        }
+        let d: Vec<f64> = w.iter().zip(&g).map(|(w, g)| w - g).collect();
+        let range = |x: &[f64]| {
+            x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - x.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let (d_slack, w_slack) = (BETWEEN_SAMPLES * range(&d), BETWEEN_SAMPLES * range(&w));
+        for i in 0..d.len() - 1 {
+            let off = d[i].abs().max(d[i + 1].abs()) + d_slack;
+            let least = if w[i].signum() == w[i + 1].signum() {
+                w[i].abs().min(w[i + 1].abs()) - w_slack
+            } else {
+                0.0
+            };
+            worst = worst.max(off / least.max(1.0));
+        }
+    }
+    worst
+}
+
+/// The times inside `data`'s segments where an ease changes phase
+/// (`u = a` and `u = 1 - e`): the eased curve is one polynomial in time
+/// between them.
+fn ease_phases(data: &TrackData) -> Vec<f64> {
+    fn of(times: &[f64], eases: impl Iterator<Item = SegmentEase>) -> Vec<f64> {
+        let mut out = Vec::new();
+        for (k, e) in eases.enumerate().take(times.len() - 1) {
+            let (t0, t1) = (times[k], times[k + 1]);
+            for u in [e.from(), 1.0 - e.to()] {
+                if u > 0.0 && u < 1.0 {
+                    out.push(t0 + (t1 - t0) * u);
+                }
+            }
+        }
+        out
+    }
+    fn vector<V: TcbValue>(t: &Track<V>) -> Vec<f64> {
+        of(t.times(), t.segments().iter().map(|s| s.ease))
+    }
+    match data {
+        TrackData::Scalar(t) => vector(t),
+        TrackData::Vec2(t) => vector(t),
+        TrackData::Vec3(t) => vector(t),
+        TrackData::Vec4(t) => vector(t),
+        TrackData::Quat(r) => of(r.times(), r.eases().iter().copied()),
+    }
 }
 
 /// The sampler of `data` in the shape glTF can hold, and the resampling's own error (`None`: written as it is).
