@@ -35,19 +35,19 @@
 //! The error reported for a resampled or moved track is a bound, not a
 //! few samples: between the keys of both curves and the ends of the
 //! clip's ease phases a vector track and its read-back are polynomials
-//! of degree 6 or less in time, and 33 samples of each interval bound
-//! their difference, and the least `|value|` it is divided by, everywhere
-//! in it:
+//! in time (of degree 3, or 6 where the clip is eased), and 9 (33 where
+//! eased) samples of each interval bound their difference, and the least
+//! `|value|` it is divided by, everywhere in it:
 //!
 //! ```text
 //! error <= max over samples i of
-//!          (max(|d_i|, |d_i+1|) + 0.13 range(d)) / max(1, min(|v_i|, |v_i+1|) - 0.13 range(v))
+//!          (max(|d_i|, |d_i+1|) + s range(d)) / max(1, min(|v_i|, |v_i+1|) - s range(v))
 //! ```
 //!
 //! with `d` the difference, `v` the clip's value (0 in place of the
-//! second term where it changes sign) and 0.13 from Markov's inequality
-//! for degree 6 at 32 intervals. A track whose read-back overflows f32
-//! where the clip is finite is refused.
+//! second term where it changes sign) and `s` from Markov's inequality:
+//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. A track
+//! whose read-back overflows f32 where the clip is finite is refused.
 
 use crate::error::Error;
 use gltf::json;
@@ -95,8 +95,8 @@ pub struct TimeRounding {
     /// The largest difference from the reference (relative to max(1,
     /// |value|)) of the track as `tcb import` reads the export back,
     /// bounded over every interval between the keys, the stored times and
-    /// the ends of ease phases from 33 points in each (see the module
-    /// docs).
+    /// the ends of ease phases from 9 points in each (33 where eased; see
+    /// the module docs).
     pub error: f64,
 }
 
@@ -855,34 +855,37 @@ fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::
 /// `max|p| <= max|p(x_i)| / (1 - 12/64) = 1.23 max|p(x_i)|`.
 const BETWEEN_POINTS: f64 = 1.25;
 
-/// Points per interval at which [`read_back_error`] samples both curves.
-const READ_BACK_POINTS: usize = 32;
-
-/// How far a polynomial of degree 6 or less can stray from the line
-/// between two neighbours of [`READ_BACK_POINTS`] + 1 evenly spaced samples
-/// of it, as a fraction of the range of the samples. The second derivative
-/// of such a `p` over an interval of length 1 is at most `1680 max|p - c|`
-/// (Markov: `4 n² (n² - 1) / 3`), so a line between points `h = 1/32`
-/// apart misses by at most `1680 h² / 8 = 0.205 max|p - c|`; with `c` the
-/// middle of the samples' range `r`, `max|p - c| <= (r / 2) / (1 - 0.205)`,
-/// and the miss is at most `0.129 r`.
-const BETWEEN_SAMPLES: f64 = 0.13;
+/// How [`read_back_error`] samples an interval where the clip is a
+/// polynomial of degree 3 or less in time (no ease) and where it is one of
+/// degree 6 (an eased cubic): points per interval, and how far such a
+/// polynomial can stray from the line between two neighbouring samples,
+/// as a fraction of the range of the samples.
+///
+/// For degree `n` over an interval of length 1 the second derivative is at
+/// most `K max|p - c|` (Markov: `K = 4 n² (n² - 1) / 3`, 96 for `n = 3`,
+/// 1680 for `n = 6`), so a line between points `h` apart misses by at most
+/// `m = K h² / 8` of `max|p - c|`; with `c` the middle of the samples'
+/// range `r`, `max|p - c| <= (r / 2) / (1 - m)`, and the miss is at most
+/// `m / (1 - m) r / 2`: 0.115 r for `n = 3` at 8 intervals (`m = 0.1875`),
+/// 0.129 r for `n = 6` at 32 (`m = 0.205`).
+const CUBIC_SAMPLING: (usize, f64) = (8, 0.116);
+/// See [`CUBIC_SAMPLING`].
+const EASED_SAMPLING: (usize, f64) = (32, 0.13);
 
 /// An upper bound of the difference between `data` and `back`
 /// (relative to max(1, |value|), rotations up to sign) wherever `data` is
 /// finite, `data` held at its end values outside its keys as glTF holds
 /// them: what a reader of the export gets, resampling and f32 key times
-/// included. Both are sampled at [`READ_BACK_POINTS`] + 1 points of each
-/// interval between the keys of both and the ends of `data`'s ease
-/// phases, where both are polynomials of degree 6 or less in time (a
-/// cubic of an eased parameter, against a cubic) for vector tracks.
-/// Between two samples, the difference is bounded by the larger of its
-/// two ends plus [`BETWEEN_SAMPLES`] of its range in the interval, and
-/// divided by max(1, the least `|value|` there) bounded the same way (0
-/// where the value changes sign). The value's range matters: a curve that
-/// crosses zero between keys 1e12 apart is held to the absolute
-/// difference there, which f32 keys and tangents of that size cannot
-/// keep small (issue 29 class 6). Rotations are normalized, not
+/// included. Both are sampled at evenly spaced points of each interval
+/// between the keys of both and the ends of `data`'s ease phases, where
+/// for vector tracks both are polynomials in time ([`CUBIC_SAMPLING`],
+/// [`EASED_SAMPLING`]). Between two samples, the difference is bounded by
+/// the larger of its two ends plus a fraction of its range in the
+/// interval, and divided by max(1, the least `|value|` there) bounded the
+/// same way (0 where the value changes sign). The value's range matters:
+/// a curve that crosses zero between keys 1e12 apart is held to the
+/// absolute difference there, which f32 keys and tangents of that size
+/// cannot keep small (issue 29 class 6). Rotations are normalized, not
 /// polynomials; their components are at most 1, and the same bound is a
 /// close estimate there. Infinite where `back` is not finite and `data`
 /// is.
@@ -891,28 +894,41 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let rotation = data.kind() == TrackKind::Quat;
     let own = data.times();
     let (first, last) = (own[0], own[own.len() - 1]);
-    let mut times: Vec<f64> = own
-        .iter()
-        .chain(back.times())
-        .copied()
-        .chain(ease_phases(data))
-        .collect();
+    let eased = eased_segments(data);
+    let mut times: Vec<f64> = own.iter().chain(back.times()).copied().collect();
+    for &(t0, t1, e) in &eased {
+        // Where an ease changes phase, `u = a` and `u = 1 - e`: one
+        // polynomial in time on each side.
+        times.extend(
+            [e.from(), 1.0 - e.to()]
+                .into_iter()
+                .filter(|u| *u > 0.0 && *u < 1.0)
+                .map(|u| t0 + (t1 - t0) * u),
+        );
+    }
     times.sort_by(f64::total_cmp);
     times.dedup();
-    let mut want = vec![[0.0f32; 4]; READ_BACK_POINTS + 1];
+    let mut want = vec![[0.0f32; 4]; EASED_SAMPLING.0 + 1];
     let mut got = want.clone();
     let mut worst = 0.0f64;
     for w in times.windows(2) {
-        for (i, (want, got)) in want.iter_mut().zip(&mut got).enumerate() {
-            let t = if i == READ_BACK_POINTS {
+        let mid = 0.5 * (w[0] + w[1]);
+        let (points, slack) = if eased.iter().any(|&(t0, t1, _)| t0 < mid && mid < t1) {
+            EASED_SAMPLING
+        } else {
+            CUBIC_SAMPLING
+        };
+        for (i, (want, got)) in want.iter_mut().zip(&mut got).take(points + 1).enumerate() {
+            let t = if i == points {
                 w[1]
             } else {
-                w[0] + (w[1] - w[0]) * i as f64 / READ_BACK_POINTS as f64
+                w[0] + (w[1] - w[0]) * i as f64 / points as f64
             };
             data.sample_into(t.clamp(first, last), &mut want[..dim], None);
             back.sample_into(t, &mut got[..dim], None);
         }
-        worst = worst.max(interval_error(&want, &got, dim, rotation));
+        let e = interval_error(&want[..=points], &got[..=points], dim, rotation, slack);
+        worst = worst.max(e);
         if worst == f64::INFINITY {
             break;
         }
@@ -921,8 +937,15 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
 }
 
 /// [`read_back_error`]'s bound over one interval from the samples `want`
-/// and `got` (`dim` components each) at its evenly spaced points.
-fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, rotation: bool) -> f64 {
+/// and `got` (`dim` components each) at its evenly spaced points, a
+/// polynomial straying `slack` of its samples' range between two of them.
+fn interval_error(
+    want: &[[f32; 4]],
+    got: &[[f32; 4]],
+    dim: usize,
+    rotation: bool,
+    slack: f64,
+) -> f64 {
     // A rotation read back on the other hemisphere is the same rotation:
     // one sign for the interval, the closer one.
     let sign = if rotation {
@@ -965,7 +988,7 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, rotation: boo
             x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                 - x.iter().copied().fold(f64::INFINITY, f64::min)
         };
-        let (d_slack, w_slack) = (BETWEEN_SAMPLES * range(&d), BETWEEN_SAMPLES * range(&w));
+        let (d_slack, w_slack) = (slack * range(&d), slack * range(&w));
         for i in 0..d.len() - 1 {
             let off = d[i].abs().max(d[i + 1].abs()) + d_slack;
             let least = if w[i].signum() == w[i + 1].signum() {
@@ -979,23 +1002,16 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, rotation: boo
     worst
 }
 
-/// The times inside `data`'s segments where an ease changes phase
-/// (`u = a` and `u = 1 - e`): the eased curve is one polynomial in time
-/// between them.
-fn ease_phases(data: &TrackData) -> Vec<f64> {
-    fn of(times: &[f64], eases: impl Iterator<Item = SegmentEase>) -> Vec<f64> {
-        let mut out = Vec::new();
-        for (k, e) in eases.enumerate().take(times.len() - 1) {
-            let (t0, t1) = (times[k], times[k + 1]);
-            for u in [e.from(), 1.0 - e.to()] {
-                if u > 0.0 && u < 1.0 {
-                    out.push(t0 + (t1 - t0) * u);
-                }
-            }
-        }
-        out
+/// `data`'s eased segments: start and end time, and the ease.
+fn eased_segments(data: &TrackData) -> Vec<(f64, f64, SegmentEase)> {
+    fn of(times: &[f64], eases: impl Iterator<Item = SegmentEase>) -> Vec<(f64, f64, SegmentEase)> {
+        eases
+            .zip(times.windows(2))
+            .filter(|(e, _)| !e.is_none())
+            .map(|(e, w)| (w[0], w[1], e))
+            .collect()
     }
-    fn vector<V: TcbValue>(t: &Track<V>) -> Vec<f64> {
+    fn vector<V: TcbValue>(t: &Track<V>) -> Vec<(f64, f64, SegmentEase)> {
         of(t.times(), t.segments().iter().map(|s| s.ease))
     }
     match data {
