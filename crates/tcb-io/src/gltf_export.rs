@@ -322,7 +322,8 @@ impl Reference<'_> {
 }
 
 /// `got` against `want` relative to max(1, |value|), rotations up to sign:
-/// the error [`resample`] and the read-back check measure.
+/// the error [`resample`] measures at its check points (what is reported
+/// is [`read_back_error`]'s bound, where larger).
 fn difference(want: &[f32], got: &[f32], rotation: bool) -> f64 {
     let diff = |s: f32| {
         want.iter()
