@@ -73,19 +73,37 @@ pub struct TrackExport {
     /// `None` when every time written is the track's own (an f32); else
     /// what rounding them to glTF's f32 key times did.
     pub time_rounding: Option<TimeRounding>,
+    /// `None` when the track is resampled, its times moved, or it reads
+    /// back within [`F32_ROUNDING`] of the clip; else, for a track written
+    /// as its own curve on its own times, the largest difference from the
+    /// reference (relative to max(1, |value|)) that storing its values and
+    /// tangents in f32 left (bounded as [`TimeRounding::error`] is).
+    /// Tangents large beside a value can come back an ulp off, far off the
+    /// value (`per_second` avoids it where an f32 allows).
+    pub f32_rounding: Option<f64>,
 }
 
 impl TrackExport {
     /// `None` when exact; else the largest difference from the reference
     /// (relative to max(1, |value|)) that a reader of the export gets,
-    /// resampling and f32 key times included.
+    /// resampling, f32 key times and f32 tangents included.
     pub fn error(&self) -> Option<f64> {
-        match (self.resampled_error, self.time_rounding) {
-            (None, None) => None,
-            (e, r) => Some(e.unwrap_or(0.0).max(r.map_or(0.0, |r| r.error))),
+        match (self.resampled_error, self.time_rounding, self.f32_rounding) {
+            (None, None, None) => None,
+            (e, r, t) => Some(
+                e.unwrap_or(0.0)
+                    .max(r.map_or(0.0, |r| r.error))
+                    .max(t.unwrap_or(0.0)),
+            ),
         }
     }
 }
+
+/// Below this, a track written as its own curve on its own times is
+/// reported exact ([`TrackExport::f32_rounding`]): the f32 rounding of
+/// its values themselves (a unit rotation written in f32 and normalized
+/// again by the reader is some 3e-8 off), which any f32 file has.
+pub const F32_ROUNDING: f64 = 1e-6;
 
 /// What glTF's f32 key times did to a track whose times are not all f32s.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -152,8 +170,8 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
         // glTF key times are f32, and readers take the span from those:
         // divide by that span so that `tangent * span` gives M back.
         let d = (f64::from(times[k + 1] as f32) - f64::from(times[k] as f32)) as f32;
-        tout[k] = arr(s.m0).iter().map(|m| m / d).collect();
-        tin[k + 1] = arr(s.m1).iter().map(|m| m / d).collect();
+        tout[k] = arr(s.m0).iter().map(|&m| per_second(m, d)).collect();
+        tin[k + 1] = arr(s.m1).iter().map(|&m| per_second(m, d)).collect();
     }
     // tin[0] and tout[n - 1] stay zero: no segment uses them.
     Cubic {
@@ -162,6 +180,22 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
         tin,
         tout,
     }
+}
+
+/// The time-unit tangent glTF stores for `m` (value per segment) over the
+/// f32 span `d`: `m / d`, or the f32 next to it (up to 4 steps away) that
+/// a reader's f32 `tangent * d` (`tcb import`'s) turns back into `m`
+/// exactly. `m / d` rounded alone can come back an ulp of `m` off, which
+/// is far off a value small beside its tangent (issue 29 class 6).
+fn per_second(m: f32, d: f32) -> f32 {
+    let tau = m / d;
+    let mut candidates = [tau; 9];
+    let (mut up, mut down) = (tau, tau);
+    for pair in candidates[1..].chunks_mut(2) {
+        (up, down) = (up.next_up(), down.next_down());
+        pair.copy_from_slice(&[up, down]);
+    }
+    candidates.into_iter().find(|c| c * d == m).unwrap_or(tau)
 }
 
 /// How glTF can hold a vector track: STEP, its own cubic, or resampled.
@@ -761,16 +795,14 @@ fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written,
         .zip(&sampler.times)
         .map(|(&t, &f)| (f64::from(f) - t).abs())
         .fold(0.0, f64::max);
-    let measured = if fit.is_some() || largest_shift > 0.0 {
-        let back = read_back(data.kind(), &sampler).map_err(|e| {
-            Error::import(format!(
-                "track '{name}': its glTF keys would not read back ({e})"
-            ))
-        })?;
-        read_back_error(data, &back)
-    } else {
-        0.0
-    };
+    // Every track is read back, the exact ones too: their tangents are
+    // stored per second in f32 and may not come back bit for bit.
+    let back = read_back(data.kind(), &sampler).map_err(|e| {
+        Error::import(format!(
+            "track '{name}': its glTF keys would not read back ({e})"
+        ))
+    })?;
+    let measured = read_back_error(data, &back);
     if measured == f64::INFINITY {
         return Err(Error::import(format!(
             "track '{name}': as glTF's f32 keys and tangents, its curve overflows f32 between \
@@ -786,6 +818,8 @@ fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written,
             largest_shift,
             error: measured,
         }),
+        f32_rounding: (fit.is_none() && largest_shift == 0.0 && measured > F32_ROUNDING)
+            .then_some(measured),
     };
     Ok(Written {
         sampler,
@@ -1042,9 +1076,18 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
             match r.hermite_track() {
                 Some(h) if !interps.contains(&Interp::Linear) => exact_shape(h),
                 _ if interps.iter().all(|i| *i == Interp::Step) => Shape::Step,
-                // glTF LINEAR is slerp (shortest path; the keys are already
-                // on one hemisphere, so the same path).
-                _ if !eased && interps.iter().all(|i| *i == Interp::Linear) => Shape::Linear,
+                // glTF LINEAR is slerp the short way (glTF 2.0, Appendix:
+                // `a = arccos(|q_k . q_k+1|)`); ours goes the long way
+                // between keys on opposite hemispheres (`hemisphere: keep`),
+                // so only keys on one hemisphere, as written in f32.
+                _ if !eased
+                    && interps.iter().all(|i| *i == Interp::Linear)
+                    && r.keys()
+                        .windows(2)
+                        .all(|w| w[0].as_quat().dot(w[1].as_quat()) > 0.0) =>
+                {
+                    Shape::Linear
+                }
                 _ => Shape::Resample,
             }
         }

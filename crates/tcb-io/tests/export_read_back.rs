@@ -174,3 +174,60 @@ fn translation_after_a_huge_key_reads_back_within_its_report() {
          "match_speed": false, "rotation": "hermite"}]}"#;
     assert_eq!(read_back(text, 0.1), Ok(Vec::new()));
 }
+
+/// Two rotations of one `linear` (slerp) segment whose keys are on
+/// opposite hemispheres, kept so (`hemisphere: keep`): the clip's slerp
+/// goes the long way, glTF's `LINEAR` always takes the short one (glTF
+/// 2.0, Appendix: `a = arccos(|q_k . q_k+1|)`). Written as `LINEAR` and
+/// reported exact, they read back 0.018 and 0.27 off (third `export` run).
+#[test]
+fn a_long_way_slerp_is_not_written_as_gltf_linear() {
+    let long_way = [
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant", "match_speed": false,
+              "tcb": [2.652637070546139e-308, 8.696840865203948e-217, 0.19], "pre": "repeat", "post": "reset",
+              "rotation": "hermite", "hemisphere": "keep"},
+              "tracks": [{"name": "n1.rotation", "kind": "quat", "times": [2.375, 4.1953125],
+                "values": [[1.1921387, 1.1921387, 1.1921387, -4.9570312], [1.2304688, 1.1921387, 1.1921387, 1.1921387]],
+                "keys": [{"tcb": [0.19, 0.4, 0.85], "interp": "linear", "in": [1.1921387, -1.1914062, -1.0668945, -1.0668945]}, {}],
+                "tcb": [0.19, 0.19, 0.19], "pre": "reset", "post": "reset", "rotation": "hermite", "hemisphere": "keep"}]}"#,
+            0.1,
+        ),
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"ends": "copy", "continuity_fade": false,
+              "tcb": [-0.01, -0.01, -0.01], "pre": "oscillate", "post": "oscillate", "rotation": "hermite", "hemisphere": "keep"},
+              "tracks": [{"name": "n1.rotation", "kind": "quat", "times": [-7.125, -4.2734375],
+                "values": [[6.8171387, -0.17578125, 6.909231e+35, 0.8520508], [2.9238281, 7.2038574, -1.416748, -7.5927734]],
+                "keys": [{"tcb": [-0.36, -0.39, 0.94], "interp": "linear", "in": [-0.99780273, 5.4804688, -1.5673828, -2.572754]}, {}]}]}"#,
+            1e-5,
+        ),
+    ];
+    for (text, max_error) in long_way {
+        assert_eq!(read_back(text, max_error), Ok(Vec::new()));
+    }
+}
+
+/// Vector tracks written as their own cubic (reported exact) whose
+/// tangents are large beside a component's value (a tension of 32.5; a
+/// continuity of 7.5e21): glTF stores `M / D` in f32 and a reader
+/// multiplies it back by `D`, so `M` can come back an ulp off, which
+/// moved a component of -33.4 by 0.002 (5.8e-5 relative) and one of
+/// 3.0e18 by 1.2e-5 relative (third `export` run).
+#[test]
+fn an_exact_cubic_reads_back_exactly_or_says_how_far() {
+    let big_tangents = [
+        r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant"},
+          "tracks": [{"name": "n1.translation", "kind": "vec3", "times": [-11.5, -8.9296875, -6.359375],
+            "values": [[0, -7.140318e-17, 6.915039], [6.0908203, 6.963135, -5.709961], [0.040039062, 0, 0]],
+            "tcb": [32.50197275169194, 32.501960784313724, 32.501960784313724]}]}"#,
+        r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "adjusted", "ends": "zero",
+          "match_speed": true, "continuity_fade": true, "tcb": [0.59, 8.245487130265901e+136, 0.92], "rotation": "squad"},
+          "tracks": [{"name": "n0.translation", "kind": "vec3", "times": [-5.75, -5.2109375, -5.046875, -2.9921875],
+            "values": [[7.9399414, 4.501709, 3.85083], [2.7524414, 0, 0], [0.6274414, 0.6274414, 4.0024414], [4.501709, 3.85083, -1.4496031e-17]],
+            "tangent_rule": "uniform", "ends": "zero", "match_speed": false, "continuity_fade": true,
+            "tcb": [0.86, 7.486063613721379e+21, -0.7], "pre": "constant", "rotation": "squad", "hemisphere": "keep"}]}"#,
+    ];
+    for text in big_tangents {
+        assert_eq!(read_back(text, 1e-5), Ok(Vec::new()));
+    }
+}
