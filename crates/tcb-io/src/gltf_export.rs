@@ -46,8 +46,10 @@
 //!
 //! with `d` the difference, `v` the clip's value (0 in place of the
 //! second term where it changes sign) and `s` from Markov's inequality:
-//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. A track
-//! whose read-back overflows f32 where the clip is finite is refused.
+//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Rotations
+//! are normalized (or squad), no polynomials: their error is an estimate
+//! from samples taken more densely wherever either curve turns fast. A
+//! track whose read-back overflows f32 where the clip is finite is refused.
 
 use crate::error::Error;
 use gltf::json;
@@ -908,22 +910,22 @@ const CUBIC_SAMPLING: (usize, f64) = (8, 0.116);
 const EASED_SAMPLING: (usize, f64) = (32, 0.13);
 
 /// An upper bound of the difference between `data` and `back`
-/// (relative to max(1, |value|), rotations up to sign) wherever `data` is
-/// finite, `data` held at its end values outside its keys as glTF holds
-/// them: what a reader of the export gets, resampling and f32 key times
-/// included. Both are sampled at evenly spaced points of each interval
-/// between the keys of both and the ends of `data`'s ease phases, where
-/// for vector tracks both are polynomials in time ([`CUBIC_SAMPLING`],
-/// [`EASED_SAMPLING`]). Between two samples, the difference is bounded by
-/// the larger of its two ends plus a fraction of its range in the
-/// interval, and divided by max(1, the least `|value|` there) bounded the
-/// same way (0 where the value changes sign). The value's range matters:
-/// a curve that crosses zero between keys 1e12 apart is held to the
-/// absolute difference there, which f32 keys and tangents of that size
-/// cannot keep small (issue 29 class 6). Rotations are normalized, not
-/// polynomials; their components are at most 1, and the same bound is a
-/// close estimate there. Infinite where `back` is not finite and `data`
-/// is.
+/// (relative to max(1, |value|)) wherever `data` is finite, `data` held at
+/// its end values outside its keys as glTF holds them: what a reader of
+/// the export gets, resampling and f32 key times included. Both are
+/// sampled at evenly spaced points of each interval between the keys of
+/// both and the ends of `data`'s ease phases, where for vector tracks
+/// both are polynomials in time ([`CUBIC_SAMPLING`], [`EASED_SAMPLING`]).
+/// Between two samples, the difference is bounded by the larger of its two
+/// ends plus a fraction of its range in the interval, and divided by
+/// max(1, the least `|value|` there) bounded the same way (0 where the
+/// value changes sign). The value's range matters: a curve that crosses
+/// zero between keys 1e12 apart is held to the absolute difference there,
+/// which f32 keys and tangents of that size cannot keep small (issue 29
+/// class 6). Rotations (up to sign) are no polynomials: for them an
+/// estimate that samples where they turn fast
+/// ([`rotation_interval_error`]). Infinite where `back` is not finite and
+/// `data` is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
@@ -953,6 +955,19 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
         } else {
             CUBIC_SAMPLING
         };
+        if rotation {
+            let sample = |t: f64| {
+                let (mut a, mut b) = ([0.0f32; 4], [0.0f32; 4]);
+                data.sample_into(t.clamp(first, last), &mut a, None);
+                back.sample_into(t, &mut b, None);
+                (a, b)
+            };
+            worst = worst.max(rotation_interval_error(sample, w[0], w[1], points));
+            if worst == f64::INFINITY {
+                break;
+            }
+            continue;
+        }
         for (i, (want, got)) in want.iter_mut().zip(&mut got).take(points + 1).enumerate() {
             let t = if i == points {
                 w[1]
@@ -962,7 +977,7 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
             data.sample_into(t.clamp(first, last), &mut want[..dim], None);
             back.sample_into(t, &mut got[..dim], None);
         }
-        let e = interval_error(&want[..=points], &got[..=points], dim, rotation, slack);
+        let e = interval_error(&want[..=points], &got[..=points], dim, slack);
         worst = worst.max(e);
         if worst == f64::INFINITY {
             break;
@@ -974,35 +989,11 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
 /// [`read_back_error`]'s bound over one interval from the samples `want`
 /// and `got` (`dim` components each) at its evenly spaced points, a
 /// polynomial straying `slack` of its samples' range between two of them.
-fn interval_error(
-    want: &[[f32; 4]],
-    got: &[[f32; 4]],
-    dim: usize,
-    rotation: bool,
-    slack: f64,
-) -> f64 {
-    // A rotation read back on the other hemisphere is the same rotation:
-    // one sign for the interval, the closer one.
-    let sign = if rotation {
-        let off = |s: f64| -> f64 {
-            want.iter()
-                .zip(got)
-                .map(|(w, g)| {
-                    (0..4)
-                        .map(|c| (f64::from(w[c]) - s * f64::from(g[c])).abs())
-                        .sum::<f64>()
-                })
-                .filter(|x| !x.is_nan())
-                .sum()
-        };
-        if off(-1.0) < off(1.0) { -1.0 } else { 1.0 }
-    } else {
-        1.0
-    };
+fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -> f64 {
     let mut worst = 0.0f64;
     for c in 0..dim {
         let w: Vec<f64> = want.iter().map(|v| f64::from(v[c])).collect();
-        let g: Vec<f64> = got.iter().map(|v| sign * f64::from(v[c])).collect();
+        let g: Vec<f64> = got.iter().map(|v| f64::from(v[c])).collect();
         if w.iter()
             .zip(&g)
             .any(|(w, g)| w.is_finite() && !g.is_finite())
@@ -1033,6 +1024,76 @@ fn interval_error(
             };
             worst = worst.max(off / least.max(1.0));
         }
+    }
+    worst
+}
+
+/// How far apart (largest component) two neighbouring samples of a
+/// rotation may be before [`rotation_interval_error`] samples between them.
+const ROTATION_STEP: f32 = 0.02;
+/// The most samples [`rotation_interval_error`] takes in one interval.
+const ROTATION_SAMPLES: usize = 4096;
+
+/// [`read_back_error`]'s estimate over one interval `[a, b]` for a
+/// rotation, from `sample(t)` (the clip's and the read-back's): `points`
+/// evenly spaced samples, and more between any two where either curve
+/// moves more than [`ROTATION_STEP`] (down to f64's resolution, up to
+/// [`ROTATION_SAMPLES`]). Between two samples, the difference (up to sign,
+/// the better one at both ends) is taken as the larger of its two ends
+/// plus half its change: an estimate, not a bound (a rotation is
+/// normalized, or squad, not a polynomial), but one that follows the
+/// curves where they turn fast, as a squad between far keys or a curve
+/// leaving a key with a huge tangent does (issue 29 class 6: reported
+/// 0.0024, read back 1.0 off one f32 step after a key).
+fn rotation_interval_error(
+    sample: impl Fn(f64) -> ([f32; 4], [f32; 4]),
+    a: f64,
+    b: f64,
+    points: usize,
+) -> f64 {
+    let step = |p: &[f32; 4], q: &[f32; 4]| (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
+    let mut samples: Vec<(f64, [f32; 4], [f32; 4])> = (0..=points)
+        .map(|i| {
+            let t = if i == points {
+                b
+            } else {
+                a + (b - a) * i as f64 / points as f64
+            };
+            let (w, g) = sample(t);
+            (t, w, g)
+        })
+        .collect();
+    let mut i = 0;
+    while i + 1 < samples.len() {
+        let ((t0, w0, g0), (t1, w1, g1)) = (samples[i], samples[i + 1]);
+        let mid = 0.5 * (t0 + t1);
+        let fast = step(&w0, &w1) > ROTATION_STEP || step(&g0, &g1) > ROTATION_STEP;
+        if fast && t0 < mid && mid < t1 && samples.len() < ROTATION_SAMPLES {
+            let (w, g) = sample(mid);
+            samples.insert(i + 1, (mid, w, g));
+        } else {
+            i += 1;
+        }
+    }
+    let mut worst = 0.0f64;
+    for pair in samples.windows(2) {
+        let ((_, w0, g0), (_, w1, g1)) = (pair[0], pair[1]);
+        if w0.iter().chain(&w1).any(|x| !x.is_finite()) {
+            continue; // the clip itself is not finite here
+        }
+        if g0.iter().chain(&g1).any(|x| !x.is_finite()) {
+            return f64::INFINITY;
+        }
+        let at = |s: f64| {
+            (0..4)
+                .map(|c| {
+                    let d0 = f64::from(w0[c]) - s * f64::from(g0[c]);
+                    let d1 = f64::from(w1[c]) - s * f64::from(g1[c]);
+                    d0.abs().max(d1.abs()) + 0.5 * (d1 - d0).abs()
+                })
+                .fold(0.0, f64::max)
+        };
+        worst = worst.max(at(1.0).min(at(-1.0)));
     }
     worst
 }

@@ -231,3 +231,40 @@ fn an_exact_cubic_reads_back_exactly_or_says_how_far() {
         assert_eq!(read_back(text, 1e-5), Ok(Vec::new()));
     }
 }
+
+/// Resampled rotations (squad between keys far apart, a hermite curve
+/// with a tangent of 1.5e13 leaving a key) whose read-back moves far faster
+/// than 9 samples of an interval see: reported 0.0024 to 0.9, they read
+/// back up to 1.0 off, one f32 step after a key (third `export` run). A
+/// rotation is no polynomial, so its samples are refined where either curve
+/// moves fast between two of them.
+#[test]
+fn a_fast_rotation_reads_back_within_its_report() {
+    let fast = [
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant", "match_speed": false, "tcb": [8.645627431777608e-217, 0.19, 0.26]}, "tracks": [{"name": "n1.rotation", "kind": "quat", "times": [2.375, 2.6796875], "values": [[2.8234863, 8.297478e+33, 8.653828e+31, 1.1921387], [-0.00048828125, 1.2497559, 1.1921387, 1.1921387]], "keys": [{"tcb": [0.19, 0.19, -0.95], "ease": [0.3515625, 0.6875], "interp": "curve"}, {"tcb": [9.25761160100159e+102, 0.85, 0.85], "ease": [0.6640625, 0.3671875], "interp": "linear", "in": [14660155000000.0, 2.520752, 5.333252, 5.333252], "out": [-7.284424, 4.64624, 3.503418, -7.284424]}], "ends": "natural", "post": "reset", "rotation": "hermite", "hemisphere": "keep"}]}"#,
+            0.1,
+        ),
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant"}, "tracks": [{"name": "n0.rotation", "kind": "quat", "times": [-11.5, -8.9296875, -6.359375], "values": [[1.2275391, 1.1921387, -5.709961, -5.709961], [-5.709961, -5.709961, -5.709961, -5.709961], [-5.709961, -5.709961, -5.709961, -5.727783]], "keys": [{"tcb": [-3.635361573737018e-132, 0.64, 32.501960784313724]}, {}, {}]}]}"#,
+            0.00001,
+        ),
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant"}, "tracks": [{"name": "n2.rotation", "kind": "quat", "times": [-11.5, -11.4453125, 21.056660251691937], "values": [[1.7668e-41, 0, -0.7509804, -4.015869], [-5.703369, -5.709961, -5.709961, -5.709961], [1.1921387, -5.7453613, -5.709961, -5.709961]], "keys": [{"tcb": [1.13, 1.13, 1.13], "ease": [0.8828125, 0.8828125], "interp": "step", "in": [-5.709961, -5.709961, -5.709961, -5.709961]}, {}, {"in": [-6.1557617, -6.14917, -6.14917, -6.14917], "out": [-6.14917, -6.14917, -6.14917, -6.14917]}], "tangent_rule": "adjusted", "ends": "zero", "match_speed": true, "continuity_fade": true, "tcb": [-0.99, -0.99, -0.99], "pre": "reset", "post": "reset", "rotation": "hermite", "hemisphere": "keep"}]}"#,
+            0.001,
+        ),
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant", "hemisphere": "keep"}, "tracks": [{"name": "n3.rotation", "kind": "quat", "times": [-11.5, -8.8046875, -6.109375], "values": [[-5.208008, -1.0830078, -0.00024414062, -0.00024414062], [0.99975586, 1.1831055, 1.0625, 1.0666504], [5.3791504, -5.709961, -5.709961, -5.709961]], "tcb": [0.97, 1.05, 1.1]}]}"#,
+            0.00001,
+        ),
+        (
+            r#"{"format": "tcb-clip/1", "name": "fuzz", "defaults": {"tangent_rule": "secant"}, "tracks": [{"name": "n2.rotation", "kind": "quat", "times": [-11.5, -8.9296875, -8.546875], "values": [[1.9657704e-24, 1.9657704e-24, 1.9657704e-24, 1.9657704e-24], [1.9657704e-24, 1.9657704e-24, -4.8618027e-17, -5.709961], [-5.709961, -5.709961, -5.709961, -4.1875]], "post": "repeat"}]}"#,
+            0.0000001,
+        ),
+    ];
+    let mut bad = Vec::new();
+    for (text, max_error) in fast {
+        bad.extend(read_back(text, max_error).unwrap());
+    }
+    assert_eq!(bad, Vec::<String>::new());
+}
