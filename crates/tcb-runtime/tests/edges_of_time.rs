@@ -303,10 +303,11 @@ fn squad_on_a_segment_a_few_ulps_long() {
 /// one ulp before its last key (`fuzz/open/playback-final-step-reference-early-*`,
 /// the `playback` target's 20-minute run of 2026-12-05): the runtime holds
 /// the step's key (math.md: it "stays P_k"), the reference gives the last
-/// key [2.63, 0.094, 6.41] a hair early. Why the reference does here and
-/// not in `a_time_just_before_a_final_step_key` is not known yet.
+/// key [2.63, 0.094, 6.41] a hair early: `tcb_core::Track::evaluate`
+/// snaps to the last key where the segment parameter `u` is 1, and here
+/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1.
 #[test]
-#[ignore = "issue 29 class 2: one ulp before a final step key the reference gives the last key, the runtime holds the step's"]
+#[ignore = "issue 29 class 2: one ulp before a final step key the reference gives the last key (its u rounds to 1), the runtime holds the step's"]
 fn a_final_step_one_ulp_before_its_last_key() {
     let clip = clip(
         r#"{"format": "tcb-clip/1", "defaults": {"tangent_rule": "uniform", "continuity_fade": false, "post": "linear"},
