@@ -31,6 +31,25 @@
 //! the track is not exact: it is read back as `tcb import` reads it and
 //! measured against the clip, and that error is reported
 //! ([`TrackExport::time_rounding`]).
+//!
+//! The error reported for a resampled or moved track is a bound, not a
+//! few samples: between the keys of both curves and the ends of the
+//! clip's ease phases a vector track and its read-back are polynomials
+//! in time (of degree 3, or 6 where the clip is eased), and 9 (33 where
+//! eased) samples of each interval bound their difference, and the least
+//! `|value|` it is divided by, everywhere in it:
+//!
+//! ```text
+//! error <= max over samples i of
+//!          (max(|d_i|, |d_i+1|) + s range(d)) / max(1, min(|v_i|, |v_i+1|) - s range(v))
+//! ```
+//!
+//! with `d` the difference, `v` the clip's value (0 in place of the
+//! second term where it changes sign) and `s` from Markov's inequality:
+//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Rotations
+//! are normalized (or squad), no polynomials: their error is an estimate
+//! from samples taken more densely wherever either curve turns fast. A
+//! track whose read-back overflows f32 where the clip is finite is refused.
 
 use crate::error::Error;
 use gltf::json;
@@ -38,6 +57,7 @@ use json::accessor::Type as AccessorType;
 use json::animation::Interpolation;
 use json::validation::{Checked, USize64};
 use std::path::Path;
+use tcb_core::ease::SegmentEase;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, TrackKind, Value as TcbValue};
 
@@ -55,19 +75,37 @@ pub struct TrackExport {
     /// `None` when every time written is the track's own (an f32); else
     /// what rounding them to glTF's f32 key times did.
     pub time_rounding: Option<TimeRounding>,
+    /// `None` when the track is resampled, its times moved, or it reads
+    /// back within [`F32_ROUNDING`] of the clip; else, for a track written
+    /// as its own curve on its own times, the largest difference from the
+    /// reference (relative to max(1, |value|)) that storing its values and
+    /// tangents in f32 left (bounded as [`TimeRounding::error`] is).
+    /// Tangents large beside a value can come back an ulp off, far off the
+    /// value (`per_second` avoids it where an f32 allows).
+    pub f32_rounding: Option<f64>,
 }
 
 impl TrackExport {
     /// `None` when exact; else the largest difference from the reference
     /// (relative to max(1, |value|)) that a reader of the export gets,
-    /// resampling and f32 key times included.
+    /// resampling, f32 key times and f32 tangents included.
     pub fn error(&self) -> Option<f64> {
-        match (self.resampled_error, self.time_rounding) {
-            (None, None) => None,
-            (e, r) => Some(e.unwrap_or(0.0).max(r.map_or(0.0, |r| r.error))),
+        match (self.resampled_error, self.time_rounding, self.f32_rounding) {
+            (None, None, None) => None,
+            (e, r, t) => Some(
+                e.unwrap_or(0.0)
+                    .max(r.map_or(0.0, |r| r.error))
+                    .max(t.unwrap_or(0.0)),
+            ),
         }
     }
 }
+
+/// Below this, a track written as its own curve on its own times is
+/// reported exact ([`TrackExport::f32_rounding`]): the f32 rounding of
+/// its values themselves (a unit rotation written in f32 and normalized
+/// again by the reader is some 3e-8 off), which any f32 file has.
+pub const F32_ROUNDING: f64 = 1e-6;
 
 /// What glTF's f32 key times did to a track whose times are not all f32s.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,8 +114,9 @@ pub struct TimeRounding {
     pub largest_shift: f64,
     /// The largest difference from the reference (relative to max(1,
     /// |value|)) of the track as `tcb import` reads the export back,
-    /// measured at the keys, the stored times and 7 points between each
-    /// two of them, widened to bound the difference between the points.
+    /// bounded over every interval between the keys, the stored times and
+    /// the ends of ease phases from 9 points in each (33 where eased; see
+    /// the module docs).
     pub error: f64,
 }
 
@@ -133,8 +172,8 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
         // glTF key times are f32, and readers take the span from those:
         // divide by that span so that `tangent * span` gives M back.
         let d = (f64::from(times[k + 1] as f32) - f64::from(times[k] as f32)) as f32;
-        tout[k] = arr(s.m0).iter().map(|m| m / d).collect();
-        tin[k + 1] = arr(s.m1).iter().map(|m| m / d).collect();
+        tout[k] = arr(s.m0).iter().map(|&m| per_second(m, d)).collect();
+        tin[k + 1] = arr(s.m1).iter().map(|&m| per_second(m, d)).collect();
     }
     // tin[0] and tout[n - 1] stay zero: no segment uses them.
     Cubic {
@@ -143,6 +182,22 @@ fn exact_cubic<V: TcbValue>(t: &Track<V>) -> Cubic {
         tin,
         tout,
     }
+}
+
+/// The time-unit tangent glTF stores for `m` (value per segment) over the
+/// f32 span `d`: `m / d`, or the f32 next to it (up to 4 steps away) that
+/// a reader's f32 `tangent * d` (`tcb import`'s) turns back into `m`
+/// exactly. `m / d` rounded alone can come back an ulp of `m` off, which
+/// is far off a value small beside its tangent (issue 29 class 6).
+fn per_second(m: f32, d: f32) -> f32 {
+    let tau = m / d;
+    let mut candidates = [tau; 9];
+    let (mut up, mut down) = (tau, tau);
+    for pair in candidates[1..].chunks_mut(2) {
+        (up, down) = (up.next_up(), down.next_down());
+        pair.copy_from_slice(&[up, down]);
+    }
+    candidates.into_iter().find(|c| c * d == m).unwrap_or(tau)
 }
 
 /// How glTF can hold a vector track: STEP, its own cubic, or resampled.
@@ -303,7 +358,8 @@ impl Reference<'_> {
 }
 
 /// `got` against `want` relative to max(1, |value|), rotations up to sign:
-/// the error [`resample`] and the read-back check measure.
+/// the error [`resample`] measures at its check points (what is reported
+/// is [`read_back_error`]'s bound, where larger).
 fn difference(want: &[f32], got: &[f32], rotation: bool) -> f64 {
     let diff = |s: f32| {
         want.iter()
@@ -741,16 +797,22 @@ fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written,
         .zip(&sampler.times)
         .map(|(&t, &f)| (f64::from(f) - t).abs())
         .fold(0.0, f64::max);
-    let measured = if fit.is_some() || largest_shift > 0.0 {
-        let back = read_back(data.kind(), &sampler).map_err(|e| {
-            Error::import(format!(
-                "track '{name}': its glTF keys would not read back ({e})"
-            ))
-        })?;
-        read_back_error(data, &back)
-    } else {
-        0.0
-    };
+    // Every track is read back, the exact ones too: their tangents are
+    // stored per second in f32 and may not come back bit for bit.
+    let back = read_back(data.kind(), &sampler).map_err(|e| {
+        Error::import(format!(
+            "track '{name}': its glTF keys would not read back ({e})"
+        ))
+    })?;
+    let measured = read_back_error(data, &back);
+    if measured == f64::INFINITY {
+        return Err(Error::import(format!(
+            "track '{name}': as glTF's f32 keys and tangents, its curve overflows f32 between \
+             keys where the clip's is finite (tangents far larger than its values); it cannot \
+             be exported: bring its tension, continuity, bias and explicit tangents within a \
+             few units"
+        )));
+    }
     let report = TrackExport {
         name: name.to_string(),
         resampled_error: fit.map(|f| f.max(measured)),
@@ -758,6 +820,8 @@ fn export_track(name: &str, data: &TrackData, max_error: f64) -> Result<Written,
             largest_shift,
             error: measured,
         }),
+        f32_rounding: (fit.is_none() && largest_shift == 0.0 && measured > F32_ROUNDING)
+            .then_some(measured),
     };
     Ok(Written {
         sampler,
@@ -828,33 +892,231 @@ fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::
 /// `max|p| <= max|p(x_i)| / (1 - 12/64) = 1.23 max|p(x_i)|`.
 const BETWEEN_POINTS: f64 = 1.25;
 
-/// The largest difference between `data` and `back` (relative to max(1,
-/// |value|), rotations up to sign) at the keys of both and 7 points
-/// between each two, `data` held at its end values outside its keys as
-/// glTF holds them; times [`BETWEEN_POINTS`], so that it bounds the
-/// difference between the points too.
+/// How [`read_back_error`] samples an interval where the clip is a
+/// polynomial of degree 3 or less in time (no ease) and where it is one of
+/// degree 6 (an eased cubic): points per interval, and how far such a
+/// polynomial can stray from the line between two neighbouring samples,
+/// as a fraction of the range of the samples.
+///
+/// For degree `n` over an interval of length 1 the second derivative is at
+/// most `K max|p - c|` (Markov: `K = 4 n² (n² - 1) / 3`, 96 for `n = 3`,
+/// 1680 for `n = 6`), so a line between points `h` apart misses by at most
+/// `m = K h² / 8` of `max|p - c|`; with `c` the middle of the samples'
+/// range `r`, `max|p - c| <= (r / 2) / (1 - m)`, and the miss is at most
+/// `m / (1 - m) r / 2`: 0.115 r for `n = 3` at 8 intervals (`m = 0.1875`),
+/// 0.129 r for `n = 6` at 32 (`m = 0.205`).
+const CUBIC_SAMPLING: (usize, f64) = (8, 0.116);
+/// See [`CUBIC_SAMPLING`].
+const EASED_SAMPLING: (usize, f64) = (32, 0.13);
+
+/// An upper bound of the difference between `data` and `back`
+/// (relative to max(1, |value|)) wherever `data` is finite, `data` held at
+/// its end values outside its keys as glTF holds them: what a reader of
+/// the export gets, resampling and f32 key times included. Both are
+/// sampled at evenly spaced points of each interval between the keys of
+/// both and the ends of `data`'s ease phases, where for vector tracks
+/// both are polynomials in time ([`CUBIC_SAMPLING`], [`EASED_SAMPLING`]).
+/// Between two samples, the difference is bounded by the larger of its two
+/// ends plus a fraction of its range in the interval, and divided by
+/// max(1, the least `|value|` there) bounded the same way (0 where the
+/// value changes sign). The value's range matters: a curve that crosses
+/// zero between keys 1e12 apart is held to the absolute difference there,
+/// which f32 keys and tangents of that size cannot keep small (issue 29
+/// class 6). Rotations (up to sign) are no polynomials: for them an
+/// estimate that samples where they turn fast
+/// ([`rotation_interval_error`]). Infinite where `back` is not finite and
+/// `data` is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
     let own = data.times();
     let (first, last) = (own[0], own[own.len() - 1]);
+    let eased = eased_segments(data);
     let mut times: Vec<f64> = own.iter().chain(back.times()).copied().collect();
+    for &(t0, t1, e) in &eased {
+        // Where an ease changes phase, `u = a` and `u = 1 - e`: one
+        // polynomial in time on each side.
+        times.extend(
+            [e.from(), 1.0 - e.to()]
+                .into_iter()
+                .filter(|u| *u > 0.0 && *u < 1.0)
+                .map(|u| t0 + (t1 - t0) * u),
+        );
+    }
     times.sort_by(f64::total_cmp);
     times.dedup();
-    let (mut want, mut got) = ([0.0f32; 4], [0.0f32; 4]);
+    let mut want = vec![[0.0f32; 4]; EASED_SAMPLING.0 + 1];
+    let mut got = want.clone();
     let mut worst = 0.0f64;
-    let mut at = |t: f64| {
-        data.sample_into(t.clamp(first, last), &mut want[..dim], None);
-        back.sample_into(t, &mut got[..dim], None);
-        worst = worst.max(difference(&want[..dim], &got[..dim], rotation));
-    };
     for w in times.windows(2) {
-        for i in 0..8 {
-            at(w[0] + (w[1] - w[0]) * f64::from(i) / 8.0);
+        let mid = 0.5 * (w[0] + w[1]);
+        let (points, slack) = if eased.iter().any(|&(t0, t1, _)| t0 < mid && mid < t1) {
+            EASED_SAMPLING
+        } else {
+            CUBIC_SAMPLING
+        };
+        if rotation {
+            let sample = |t: f64| {
+                let (mut a, mut b) = ([0.0f32; 4], [0.0f32; 4]);
+                data.sample_into(t.clamp(first, last), &mut a, None);
+                back.sample_into(t, &mut b, None);
+                (a, b)
+            };
+            worst = worst.max(rotation_interval_error(sample, w[0], w[1], points));
+            if worst == f64::INFINITY {
+                break;
+            }
+            continue;
+        }
+        for (i, (want, got)) in want.iter_mut().zip(&mut got).take(points + 1).enumerate() {
+            let t = if i == points {
+                w[1]
+            } else {
+                w[0] + (w[1] - w[0]) * i as f64 / points as f64
+            };
+            data.sample_into(t.clamp(first, last), &mut want[..dim], None);
+            back.sample_into(t, &mut got[..dim], None);
+        }
+        let e = interval_error(&want[..=points], &got[..=points], dim, slack);
+        worst = worst.max(e);
+        if worst == f64::INFINITY {
+            break;
         }
     }
-    at(times[times.len() - 1]);
-    worst * BETWEEN_POINTS
+    worst
+}
+
+/// [`read_back_error`]'s bound over one interval from the samples `want`
+/// and `got` (`dim` components each) at its evenly spaced points, a
+/// polynomial straying `slack` of its samples' range between two of them.
+fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for c in 0..dim {
+        let w: Vec<f64> = want.iter().map(|v| f64::from(v[c])).collect();
+        let g: Vec<f64> = got.iter().map(|v| f64::from(v[c])).collect();
+        if w.iter()
+            .zip(&g)
+            .any(|(w, g)| w.is_finite() && !g.is_finite())
+        {
+            return f64::INFINITY;
+        }
+        if w.iter().any(|x| !x.is_finite()) {
+            // The clip itself is not finite here (tangents that overflow
+            // f32): no polynomial to bound; where it is finite, as is.
+            let pointwise = w.iter().zip(&g).filter(|(w, _)| w.is_finite());
+            for (w, g) in pointwise {
+                worst = worst.max((w - g).abs() / w.abs().max(1.0));
+            }
+            continue;
+        }
+        let d: Vec<f64> = w.iter().zip(&g).map(|(w, g)| w - g).collect();
+        let range = |x: &[f64]| {
+            x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - x.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let (d_slack, w_slack) = (slack * range(&d), slack * range(&w));
+        for i in 0..d.len() - 1 {
+            let off = d[i].abs().max(d[i + 1].abs()) + d_slack;
+            let least = if w[i].signum() == w[i + 1].signum() {
+                w[i].abs().min(w[i + 1].abs()) - w_slack
+            } else {
+                0.0
+            };
+            worst = worst.max(off / least.max(1.0));
+        }
+    }
+    worst
+}
+
+/// How far apart (largest component) two neighbouring samples of a
+/// rotation may be before [`rotation_interval_error`] samples between them.
+const ROTATION_STEP: f32 = 0.02;
+/// The most samples [`rotation_interval_error`] takes in one interval.
+const ROTATION_SAMPLES: usize = 4096;
+
+/// [`read_back_error`]'s estimate over one interval `[a, b]` for a
+/// rotation, from `sample(t)` (the clip's and the read-back's): `points`
+/// evenly spaced samples, and more between any two where either curve
+/// moves more than [`ROTATION_STEP`] (down to f64's resolution, up to
+/// [`ROTATION_SAMPLES`]). Between two samples, the difference (up to sign,
+/// the better one at both ends) is taken as the larger of its two ends
+/// plus half its change: an estimate, not a bound (a rotation is
+/// normalized, or squad, not a polynomial), but one that follows the
+/// curves where they turn fast, as a squad between far keys or a curve
+/// leaving a key with a huge tangent does (issue 29 class 6: reported
+/// 0.0024, read back 1.0 off one f32 step after a key).
+fn rotation_interval_error(
+    sample: impl Fn(f64) -> ([f32; 4], [f32; 4]),
+    a: f64,
+    b: f64,
+    points: usize,
+) -> f64 {
+    let step = |p: &[f32; 4], q: &[f32; 4]| (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max);
+    let mut samples: Vec<(f64, [f32; 4], [f32; 4])> = (0..=points)
+        .map(|i| {
+            let t = if i == points {
+                b
+            } else {
+                a + (b - a) * i as f64 / points as f64
+            };
+            let (w, g) = sample(t);
+            (t, w, g)
+        })
+        .collect();
+    let mut i = 0;
+    while i + 1 < samples.len() {
+        let ((t0, w0, g0), (t1, w1, g1)) = (samples[i], samples[i + 1]);
+        let mid = 0.5 * (t0 + t1);
+        let fast = step(&w0, &w1) > ROTATION_STEP || step(&g0, &g1) > ROTATION_STEP;
+        if fast && t0 < mid && mid < t1 && samples.len() < ROTATION_SAMPLES {
+            let (w, g) = sample(mid);
+            samples.insert(i + 1, (mid, w, g));
+        } else {
+            i += 1;
+        }
+    }
+    let mut worst = 0.0f64;
+    for pair in samples.windows(2) {
+        let ((_, w0, g0), (_, w1, g1)) = (pair[0], pair[1]);
+        if w0.iter().chain(&w1).any(|x| !x.is_finite()) {
+            continue; // the clip itself is not finite here
+        }
+        if g0.iter().chain(&g1).any(|x| !x.is_finite()) {
+            return f64::INFINITY;
+        }
+        let at = |s: f64| {
+            (0..4)
+                .map(|c| {
+                    let d0 = f64::from(w0[c]) - s * f64::from(g0[c]);
+                    let d1 = f64::from(w1[c]) - s * f64::from(g1[c]);
+                    d0.abs().max(d1.abs()) + 0.5 * (d1 - d0).abs()
+                })
+                .fold(0.0, f64::max)
+        };
+        worst = worst.max(at(1.0).min(at(-1.0)));
+    }
+    worst
+}
+
+/// `data`'s eased segments: start and end time, and the ease.
+fn eased_segments(data: &TrackData) -> Vec<(f64, f64, SegmentEase)> {
+    fn of(times: &[f64], eases: impl Iterator<Item = SegmentEase>) -> Vec<(f64, f64, SegmentEase)> {
+        eases
+            .zip(times.windows(2))
+            .filter(|(e, _)| !e.is_none())
+            .map(|(e, w)| (w[0], w[1], e))
+            .collect()
+    }
+    fn vector<V: TcbValue>(t: &Track<V>) -> Vec<(f64, f64, SegmentEase)> {
+        of(t.times(), t.segments().iter().map(|s| s.ease))
+    }
+    match data {
+        TrackData::Scalar(t) => vector(t),
+        TrackData::Vec2(t) => vector(t),
+        TrackData::Vec3(t) => vector(t),
+        TrackData::Vec4(t) => vector(t),
+        TrackData::Quat(r) => of(r.times(), r.eases().iter().copied()),
+    }
 }
 
 /// The sampler of `data` in the shape glTF can hold, and the resampling's own error (`None`: written as it is).
@@ -875,9 +1137,18 @@ fn track_sampler(data: &TrackData, max_error: f64) -> (Sampler, Option<f64>) {
             match r.hermite_track() {
                 Some(h) if !interps.contains(&Interp::Linear) => exact_shape(h),
                 _ if interps.iter().all(|i| *i == Interp::Step) => Shape::Step,
-                // glTF LINEAR is slerp (shortest path; the keys are already
-                // on one hemisphere, so the same path).
-                _ if !eased && interps.iter().all(|i| *i == Interp::Linear) => Shape::Linear,
+                // glTF LINEAR is slerp the short way (glTF 2.0, Appendix:
+                // `a = arccos(|q_k . q_k+1|)`); ours goes the long way
+                // between keys on opposite hemispheres (`hemisphere: keep`),
+                // so only keys on one hemisphere, as written in f32.
+                _ if !eased
+                    && interps.iter().all(|i| *i == Interp::Linear)
+                    && r.keys()
+                        .windows(2)
+                        .all(|w| w[0].as_quat().dot(w[1].as_quat()) > 0.0) =>
+                {
+                    Shape::Linear
+                }
                 _ => Shape::Resample,
             }
         }

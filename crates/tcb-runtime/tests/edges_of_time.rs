@@ -269,17 +269,18 @@ fn finite_times_near_the_ends_of_f64() {
 }
 
 /// A squad rotation whose middle segment is a few ulps long: the runtime
-/// splits squad segments into pieces built at their nominal parameter but
-/// played between split times rounded to f64 (equal to the ends, or to
-/// each other, on a segment this short), so a piece can be played at
-/// parameters it was not built for. Inside and around that segment the
-/// runtime must stay within 1e-6 of the reference.
+/// splits squad segments into pieces played between split times rounded
+/// to f64 (equal to the ends, or to each other, on a segment this short,
+/// and up to half an ulp off their nominal place on any segment). Each
+/// piece must be built for the part of the segment those rounded times
+/// cover, not for its nominal `[j/m, (j+1)/m]`: built at the nominal
+/// parameters, a 17-ulp segment was 0.02 off. Inside and around that
+/// segment the runtime must stay within 1e-6 of the reference.
 #[test]
-#[ignore = "issue 29 class 2: squad pieces of a 17-ulp segment are built at nominal parameters but played between rounded split times (0.02 off)"]
 fn squad_on_a_segment_a_few_ulps_long() {
     let mut bad = Vec::new();
     for start in [1.0, 0.1, 1e3 + 0.1, 1e6 / 3.0] {
-        for len in [1, 2, 3, 5, 8, 17] {
+        for len in [1, 2, 3, 5, 8, 17, 33, 100, 1000] {
             let b = ulps(start, len);
             let text = format!(
                 r#"{{"format": "tcb-clip/1", "tracks": [
@@ -296,4 +297,25 @@ fn squad_on_a_segment_a_few_ulps_long() {
         }
     }
     assert_none(&bad);
+}
+
+/// A final `step` segment (from a key of 1.5e37, after an eased segment)
+/// one ulp before its last key (`fuzz/open/playback-final-step-reference-early-*`,
+/// the `playback` target's 20-minute run of 2026-12-05): the runtime holds
+/// the step's key (math.md: it "stays P_k"), the reference gives the last
+/// key [2.63, 0.094, 6.41] a hair early: `tcb_core::Track::evaluate`
+/// snaps to the last key where the segment parameter `u` is 1, and here
+/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1.
+#[test]
+#[ignore = "issue 29 class 2: one ulp before a final step key the reference gives the last key (its u rounds to 1), the runtime holds the step's"]
+fn a_final_step_one_ulp_before_its_last_key() {
+    let clip = clip(
+        r#"{"format": "tcb-clip/1", "defaults": {"tangent_rule": "uniform", "continuity_fade": false, "post": "linear"},
+          "tracks": [{"name": "t0", "kind": "vec3", "times": [-6.75, -4.1640625, -1.046875],
+            "values": [[0.017578125, -7.099121, -0.34570312], [7.531006, 1.5488568e+37, 2.2719727], [2.631836, 0.09399414, 6.411377]],
+            "keys": [{"ease": [0.7890625, 0.7265625], "interp": "linear", "out": [1.942627, -4.963135, -5.998291]},
+              {"tcb": [-0.54, 0.47, -1.02], "interp": "step", "in": [-4.022949, 0, 0]}, {}],
+            "rotation": "squad", "hemisphere": "keep"}]}"#,
+    );
+    assert_none(&mismatches(&clip, &around(&[-6.75, -4.1640625, -1.046875])));
 }

@@ -236,8 +236,9 @@ fn cubic_holds(
 }
 
 /// A rotation whose segments the cubic misses (`exact`), split: each such
-/// segment becomes 2, 4, 8 or 16 equal pieces, each the cubic through
-/// squad's values and derivatives at its ends, the fewest that pass
+/// segment becomes 2, 4, 8 or 16 pieces between evenly spaced times
+/// (rounded to f64), each the cubic through squad's values and derivatives
+/// at the parameters of its rounded ends, the fewest that pass
 /// [`cubic_holds`]. The keys of the result are the track's own plus the
 /// split points. Segments that cannot be split stay as they were, exact: an
 /// eased or step segment, one too short to split, or one where 16 pieces
@@ -329,16 +330,21 @@ fn split_pieces(
         .filter(|_| grid.ease(k).is_none() && !grid.is_step(k))
         .filter(|_| !(on_group && rot.velocity_only[k + 1]))?;
     [2usize, 4, 8, 16].into_iter().find_map(|m| {
-        let w = 1.0 / m as f64;
         // Split times strictly increasing (not so in f64 on keys a few ulps
         // apart).
         let at = |j: usize| split_time(t0, t1, j, m);
         if (1..=m).any(|j| at(j) <= at(j - 1)) {
             return None;
         }
+        // A piece is played between its split times as they are in f64,
+        // rounded: it covers the segment's parameters from `param(j)` to
+        // `param(j + 1)`, which on a segment a few ulps long are far from
+        // `j / m` (issue 29 class 2: 17 ulps in 16 pieces, 0.02 off).
+        let param = |j: usize| (at(j) - t0) / (t1 - t0);
         (0..m)
             .map(|j| {
-                let (a, b) = (j as f64 * w, (j + 1) as f64 * w);
+                let (a, b) = (param(j), param(j + 1));
+                let w = b - a;
                 let (qa, da) = tcb_core::simd::squad::squad_with_derivative(&c, a);
                 let (qb, db) = tcb_core::simd::squad::squad_with_derivative(&c, b);
                 let ctl: [[f32; 4]; 4] = std::array::from_fn(|i| {
