@@ -28,11 +28,9 @@ fn the_workspace_readme_shows_them_and_points_here() {
         .expect("the README's bevy section")..];
     let section = &section[..section[3..].find("\n## ").map_or(section.len(), |e| e + 3)];
     assert!(section.contains("(crates/tcb-bevy/README.md)"));
-    let example = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/readme.rs"
-    ))
-    .unwrap();
+    let example =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/readme.rs"))
+            .unwrap();
     let code = &example[example.find("use bevy::prelude::*;").unwrap()..];
     assert!(
         section.contains(&format!("```rust,ignore\n{code}```")),
