@@ -408,24 +408,29 @@ fn unpack_none(_: &[u64], _: usize, _: &mut [i32], _: usize) {}
 /// bit of it ([`super::STREAM_PAD`]); a window past them (a stream not
 /// checked) writes nothing.
 fn unpack16<const W: usize>(words: &[u64], pos: usize, out: &mut [i32], stride: usize) {
-    let Some(out) = out.get_mut(..15 * stride + 1) else {
-        return;
-    };
     let Some(src) = words.get(pos >> 6..(pos >> 6) + super::STREAM_PAD) else {
         return;
     };
     let src: &[u64; super::STREAM_PAD] = src.try_into().expect("sliced to the length");
     let (o, per, mask) = (pos & 63, 64 / W, (1u64 << W) - 1);
+    // Into registers first (indices known at compile time, no checks),
+    // then one store per row.
+    let mut v = [0i32; 16];
     let mut i = 0;
     while i < 16 {
         let (at, sh) = ((o + i * W) >> 6, ((o + i * W) & 63) as u32);
         let mut win = (src[at] >> sh) | ((src[at + 1] << 1) << (63 - sh));
         let mut j = 0;
         while j < per && i + j < 16 {
-            out[(i + j) * stride] = (win & mask) as i32;
+            v[i + j] = (win & mask) as i32;
             win >>= W;
             j += 1;
         }
         i += per;
+    }
+    for (row, v) in out.chunks_mut(stride).zip(v) {
+        if let Some(x) = row.first_mut() {
+            *x = v;
+        }
     }
 }
