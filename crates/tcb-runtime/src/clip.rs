@@ -165,9 +165,7 @@ impl Clip {
     pub fn memory_bytes(&self) -> usize {
         use std::mem::{size_of, size_of_val};
         let grid = |g: &TimeGrid| {
-            size_of_val(g.times.as_slice())
-                + size_of_val(g.eases.as_slice())
-                + size_of_val(g.steps.as_slice())
+            g.times.heap_bytes() + size_of_val(g.eases.as_slice()) + size_of_val(g.steps.as_slice())
         };
         let groups: usize = self
             .groups

@@ -30,11 +30,120 @@ use tcb_core::simd::extrapolate::{Mapped, map_time};
 use tcb_core::simd::lane::Lane;
 use tcb_core::track::segment_from;
 
+/// A grid's key times (n >= 2, strictly increasing): listed, or the
+/// packed clip's even grid, `start + k * interval` in f64, which keeps no
+/// list (a `.tcbc` file's memory does not grow with the keys it claims).
+#[derive(Clone, Debug, PartialEq)]
+pub enum KeyTimes {
+    Listed(Vec<f64>),
+    Even {
+        start: f64,
+        interval: f64,
+        keys: usize,
+    },
+}
+
+impl KeyTimes {
+    /// Number of keys.
+    #[inline]
+    pub fn len(&self) -> usize {
+        match self {
+            KeyTimes::Listed(t) => t.len(),
+            KeyTimes::Even { keys, .. } => *keys,
+        }
+    }
+
+    /// Key `k`'s time. (`k as i64 as f64` is `k as f64` for every key
+    /// count a clip can have, in one instruction where `usize` takes ten.)
+    #[inline(always)]
+    pub fn at(&self, k: usize) -> f64 {
+        match self {
+            KeyTimes::Listed(t) => t[k],
+            KeyTimes::Even {
+                start, interval, ..
+            } => start + k as i64 as f64 * interval,
+        }
+    }
+
+    /// The listed times; empty for an even grid (only a packed clip's
+    /// group has one, and it has no loose lanes or exact segments, which
+    /// read this).
+    pub fn listed(&self) -> &[f64] {
+        match self {
+            KeyTimes::Listed(t) => t,
+            KeyTimes::Even { .. } => &[],
+        }
+    }
+
+    /// Every key's time.
+    pub fn to_vec(&self) -> Vec<f64> {
+        (0..self.len()).map(|k| self.at(k)).collect()
+    }
+
+    /// Heap bytes.
+    pub fn heap_bytes(&self) -> usize {
+        std::mem::size_of_val(self.listed())
+    }
+
+    /// Segment k with `at(k) <= time < at(k+1)`, 0 before the keys (or for
+    /// NaN), the last at or after the last key: for listed times from the
+    /// hint ([`tcb_core::track::segment_from`]), for even ones from where
+    /// `time` falls, then checked against the keys' own times.
+    #[inline]
+    fn locate(&self, time: f64, hint: usize) -> usize {
+        let (start, interval, keys) = match self {
+            KeyTimes::Listed(t) => return segment_from(t, time, hint),
+            KeyTimes::Even {
+                start,
+                interval,
+                keys,
+            } => (*start, *interval, *keys),
+        };
+        let last = keys - 2;
+        // Before the keys, or NaN.
+        if time.is_nan() || time < start {
+            return 0;
+        }
+        // Where `time` falls (a saturating cast), then a key either way for
+        // the quotient's rounding; no loop, so no vectorized search.
+        let k = (((time - start) / interval) as i64).max(0) as usize;
+        let k = k.min(last);
+        let k = if k > 0 && self.at(k) > time {
+            k - 1
+        } else if k < last && self.at(k + 1) <= time {
+            k + 1
+        } else {
+            k
+        };
+        if self.at(k) <= time && (k == last || time < self.at(k + 1)) {
+            k
+        } else {
+            self.bisect(time, last)
+        }
+    }
+
+    /// [`locate`](Self::locate) by bisection, for times that the quotient
+    /// places more than a key off.
+    #[cold]
+    fn bisect(&self, time: f64, last: usize) -> usize {
+        let (mut lo, mut hi) = (0, last);
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            if self.at(mid) <= time {
+                lo = mid;
+            } else {
+                hi = mid - 1;
+            }
+        }
+        lo
+    }
+}
+
 /// Key times, segment eases and extrapolation shared by a group of channels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeGrid {
-    /// Key times (n >= 2, strictly increasing).
-    pub times: Vec<f64>,
+    /// Key times.
+    pub times: KeyTimes,
     /// Ease of each of the n-1 segments, or empty when no segment eases.
     pub eases: Vec<SegmentEase>,
     /// Whether each of the n-1 segments is `step` in every channel of the
@@ -122,7 +231,7 @@ impl TimeGrid {
     /// cursor ([`tcb_core::track::segment_from`]).
     #[inline]
     fn locate(&self, time: f64, cursor: &mut Cursor) -> usize {
-        cursor.0 = segment_from(&self.times, time, cursor.0);
+        cursor.0 = self.times.locate(time, cursor.0);
         cursor.0
     }
 
@@ -135,8 +244,9 @@ impl TimeGrid {
     #[inline(always)]
     fn real(&self, time: f64, cursor: &mut Cursor, dir: f32) -> (usize, f64, f32) {
         let k = self.locate(time, cursor);
-        let d = self.times[k + 1] - self.times[k];
-        let u = ((time - self.times[k]) / d).clamp(0.0, 1.0);
+        let (tk, tk1) = (self.times.at(k), self.times.at(k + 1));
+        let d = tk1 - tk;
+        let u = ((time - tk) / d).clamp(0.0, 1.0);
         let (eased, ds_du) = self.ease(k).apply(u);
         // Selects, not a branch: almost no grid has step segments.
         let hold = !self.steps.is_empty() && self.is_step(k);
@@ -152,7 +262,7 @@ impl TimeGrid {
         // Hot (once per group per frame), kept whole: the fast path for a
         // time inside the keys returns before the table's rows below.
         let n = self.times.len();
-        let (t0, tn) = (self.times[0], self.times[n - 1]);
+        let (t0, tn) = (self.times.at(0), self.times.at(n - 1));
         // Most frames are inside the keys, where every mode passes the time
         // through (`map_time`'s own first answer): the rows of a real
         // segment, the table below with its other rows known to be off.
@@ -310,7 +420,7 @@ mod tests {
 
     fn grid(pre: Extrapolation, post: Extrapolation) -> TimeGrid {
         TimeGrid {
-            times: vec![0.0, 1.0, 3.0, 4.0],
+            times: KeyTimes::Listed(vec![0.0, 1.0, 3.0, 4.0]),
             eases: vec![SegmentEase::default(); 3],
             steps: vec![false; 3],
             pre,
@@ -329,6 +439,39 @@ mod tests {
         assert_eq!(g.frame(0.2, &mut c).segment, 1);
         assert_eq!(g.frame(3.9, &mut c).segment, 3);
         assert_eq!(g.frame(1.0, &mut c).segment, 2);
+    }
+
+    /// An even grid finds the segment the list of its times gives, at and
+    /// one ulp either side of every key, between keys and outside them,
+    /// where its times round unevenly (far from 0) too.
+    #[test]
+    fn even_times_locate_as_their_list() {
+        for (start, interval, keys) in [
+            (0.0, 1.0 / 120.0, 50),
+            (1e6, 1.0 / 30.0, 40),
+            (-3.5, 0.1, 7),
+        ] {
+            let even = KeyTimes::Even {
+                start,
+                interval,
+                keys,
+            };
+            let listed = KeyTimes::Listed(even.to_vec());
+            let mut probes = vec![f64::NAN, f64::NEG_INFINITY, f64::INFINITY, start - 1.0];
+            for k in 0..keys {
+                let t = even.at(k);
+                probes.extend([t, t.next_up(), t.next_down(), t + 0.37 * interval]);
+            }
+            for t in probes {
+                for hint in [0, keys / 2, keys] {
+                    assert_eq!(
+                        even.locate(t, hint),
+                        listed.locate(t, hint),
+                        "{t} from {start}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -276,7 +276,7 @@ impl Loose {
             .iter()
             .map(|l| {
                 size_of::<LooseLane>()
-                    + size_of_val(l.grid.times.as_slice())
+                    + l.grid.times.heap_bytes()
                     + size_of_val(l.grid.eases.as_slice())
                     + size_of_val(l.grid.steps.as_slice())
                     + l.key_bytes()
@@ -300,8 +300,8 @@ impl Loose {
                 .map(|h| f64x4::new(std::array::from_fn(|l| lane(4 * h + l).map_or(pad, f))))
                 .collect()
         };
-        let first = |l: &LooseLane| l.grid.times[0];
-        let last = |l: &LooseLane| l.grid.times[l.grid.times.len() - 1];
+        let first = |l: &LooseLane| l.grid.times.at(0);
+        let last = |l: &LooseLane| l.grid.times.at(l.grid.times.len() - 1);
         let t0 = half(&first, 0.0);
         let tn = half(&last, 1.0);
         let modes = |f: fn(&LooseLane) -> Extrapolation| -> Vec<ModeLanes<f64x4>> {
@@ -368,7 +368,7 @@ impl Loose {
     #[inline]
     fn order_time(&self, i: usize) -> f64 {
         match self.order.get(i) {
-            Some(&[l, seg]) => self.lanes[l as usize].grid.times[seg as usize - 1],
+            Some(&[l, seg]) => self.lanes[l as usize].grid.times.at(seg as usize - 1),
             None => f64::INFINITY,
         }
     }
@@ -453,7 +453,7 @@ impl LooseState {
     #[inline(always)]
     fn load_inline(&mut self, loose: &Loose, l: usize, seg: usize) {
         let lane = &loose.lanes[l];
-        let t = lane.grid.times.as_slice();
+        let t = lane.grid.times.listed();
         let n = t.len();
         let (ws, we, d, ease, ka, kb) = if let Some(&[a, b]) = seg
             .checked_sub(1)
@@ -520,7 +520,7 @@ impl LooseState {
     /// sentinels beyond them); the one after `current` first, as forward
     /// playback wants.
     fn segment_for(lane: &LooseLane, current: usize, tm: f64) -> usize {
-        let t = &lane.grid.times;
+        let t = lane.grid.times.listed();
         let n = t.len();
         if tm < t[0] {
             0
@@ -560,7 +560,7 @@ impl LooseState {
         while let Some(&[l, seg]) = loose.order.get(self.next) {
             let (l, seg) = (l as usize, seg as usize);
             let lane = &loose.lanes[l];
-            let t = lane.grid.times.as_slice();
+            let t = lane.grid.times.listed();
             // The entry's time is its segment's first key (`seg >= 1`).
             let start = t[seg - 1];
             if time < start {
@@ -632,7 +632,7 @@ impl LooseState {
     #[inline(never)]
     fn seek(&mut self, loose: &Loose, time: f64) {
         self.next = loose.order.partition_point(|&[l, seg]| {
-            loose.lanes[l as usize].grid.times[seg as usize - 1] <= time
+            loose.lanes[l as usize].grid.times.at(seg as usize - 1) <= time
         });
         self.next_time = loose.order_time(self.next);
         for (l, lane) in loose.lanes.iter().enumerate() {
@@ -642,7 +642,7 @@ impl LooseState {
             // 10.9M), and snapshots of every lane's segment each mean key
             // spacing saved only 8% more for 9.5% more bytes. A NaN `time`
             // finds the pre sentinel, which the frame's refresh replaces.
-            let t = lane.grid.times.as_slice();
+            let t = lane.grid.times.listed();
             let seg = t.partition_point(|&k| k <= time);
             match seg.checked_sub(1).and_then(|k| t.get(k..k + 2)) {
                 Some(&[ws, we]) => self.load_real(loose, l, seg, ws, we),
@@ -944,7 +944,7 @@ fn key_order(lanes: &[LooseLane]) -> (Vec<[u32; 2]>, f64) {
         .iter()
         .enumerate()
         .flat_map(|(l, x)| {
-            let t = &x.grid.times;
+            let t = x.grid.times.listed();
             (1..=t.len()).map(move |seg| (t[seg - 1], index_u32(l), index_u32(seg)))
         })
         .collect();

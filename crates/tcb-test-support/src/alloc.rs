@@ -13,7 +13,7 @@
 //!     let ((), none) = tcb_test_support::count_allocations(|| row.push(1.0));
 //!     assert_eq!(none.count, 0);
 //!     let (_, one) = tcb_test_support::count_allocations(|| vec![0u8; 64]);
-//!     assert_eq!((one.count, one.bytes), (1, 64));
+//!     assert_eq!((one.count, one.bytes, one.largest), (1, 64, 64));
 //! }
 //! ```
 //!
@@ -43,12 +43,14 @@ thread_local! {
     /// other's.
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
     static BYTES: Cell<usize> = const { Cell::new(0) };
+    static LARGEST: Cell<usize> = const { Cell::new(0) };
 }
 
 fn count(bytes: usize) {
     if COUNTING.with(Cell::get) {
         ALLOCATIONS.with(|c| c.set(c.get() + 1));
         BYTES.with(|c| c.set(c.get() + bytes));
+        LARGEST.with(|c| c.set(c.get().max(bytes)));
     }
 }
 
@@ -79,6 +81,8 @@ pub struct Allocations {
     pub count: usize,
     /// The bytes they asked for (a reallocation its new size).
     pub bytes: usize,
+    /// The most bytes one of them asked for.
+    pub largest: usize,
 }
 
 /// Counts this thread's allocations from now until [`stop_counting`].
@@ -99,6 +103,7 @@ pub fn start_counting() {
     let probe = counted();
     ALLOCATIONS.with(|c| c.set(before.count));
     BYTES.with(|c| c.set(before.bytes));
+    LARGEST.with(|c| c.set(before.largest));
     if probe.count == before.count {
         COUNTING.with(|c| c.set(false));
         panic!(
@@ -120,6 +125,7 @@ pub fn take_counted() -> Allocations {
     let taken = counted();
     ALLOCATIONS.with(|c| c.set(0));
     BYTES.with(|c| c.set(0));
+    LARGEST.with(|c| c.set(0));
     taken
 }
 
@@ -128,6 +134,7 @@ fn counted() -> Allocations {
     Allocations {
         count: ALLOCATIONS.with(Cell::get),
         bytes: BYTES.with(Cell::get),
+        largest: LARGEST.with(Cell::get),
     }
 }
 
@@ -146,5 +153,6 @@ pub fn count_allocations<R>(f: impl FnOnce() -> R) -> (R, Allocations) {
     // What was counted before, kept for a caller's own take.
     ALLOCATIONS.with(|c| c.set(before.count));
     BYTES.with(|c| c.set(before.bytes));
+    LARGEST.with(|c| c.set(before.largest));
     (r, during)
 }

@@ -1,6 +1,6 @@
 //! Step 1's pieces: each track's grid and its vector channels' controls.
 
-use crate::grid::TimeGrid;
+use crate::grid::{KeyTimes, TimeGrid};
 use tcb_core::ease::SegmentEase;
 use tcb_core::{Extrapolation, Interp, Track, TrackData, Value};
 
@@ -57,7 +57,7 @@ pub(crate) fn grid_of(data: &TrackData) -> TimeGrid {
         }
     };
     TimeGrid {
-        times: data.times().to_vec(),
+        times: KeyTimes::Listed(data.times().to_vec()),
         eases,
         steps,
         pre: settings.pre,
@@ -76,7 +76,7 @@ pub(crate) type GridKey = (
 
 pub(crate) fn grid_key(g: &TimeGrid) -> GridKey {
     (
-        g.times.iter().map(|t| t.to_bits()).collect(),
+        g.times.listed().iter().map(|t| t.to_bits()).collect(),
         g.eases
             .iter()
             .map(|e| (e.from().to_bits(), e.to().to_bits()))

@@ -2,7 +2,7 @@
 //! lanes of loose rotations.
 
 use super::controls::Controls;
-use crate::grid::TimeGrid;
+use crate::grid::{KeyTimes, TimeGrid};
 use crate::loose::LooseLane;
 use crate::store::HQ_STRIDE;
 use tcb_core::Extrapolation;
@@ -53,7 +53,7 @@ pub(crate) const IDENTITY_PAD: [f32; HQ_STRIDE] = {
 /// A padding lane of loose rotations: the identity at all times.
 pub(crate) fn identity_lane() -> LooseLane {
     let grid = TimeGrid {
-        times: vec![-crate::loose::PAD_SPAN, crate::loose::PAD_SPAN],
+        times: KeyTimes::Listed(vec![-crate::loose::PAD_SPAN, crate::loose::PAD_SPAN]),
         eases: vec![SegmentEase::default()],
         steps: vec![false],
         pre: Extrapolation::Constant,

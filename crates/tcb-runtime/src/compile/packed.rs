@@ -9,7 +9,7 @@
 
 use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
-use crate::grid::TimeGrid;
+use crate::grid::{KeyTimes, TimeGrid};
 use crate::pack::store::PackedKeys;
 use crate::pack::{PackError, Packed, err, key_weights};
 use std::sync::Arc;
@@ -26,13 +26,14 @@ impl Clip {
     /// Compile a packed clip: the runtime keeps its stream and decodes keys
     /// as playback reaches them (see [`crate::pack`]). It decodes the keys
     /// of the stream's first and last blocks only (about 0.3 ms for CMU
-    /// 01_01, where the whole reference would take 30), and allocates the
-    /// grid's times and a few bytes per component; see
+    /// 01_01, where the whole reference would take 30), and allocates a
+    /// few bytes per component (the grid's times are `start + k interval`,
+    /// not a list); see
     /// [`verify_packed`](Self::verify_packed) for the check of every key.
     pub fn from_packed(packed: Arc<Packed>) -> Result<Clip, PackError> {
-        if packed.segment_table()? != packed.seg_at {
+        if packed.stream_structure()? != packed.bits {
             return Err(PackError(
-                "the packed stream disagrees with its segment table".into(),
+                "the packed stream's length disagrees with its structure".into(),
             ));
         }
         packed.head().validate_head()?;
@@ -43,12 +44,16 @@ impl Clip {
     /// head are checked: the end keys' reference compiled, its tables kept,
     /// the grid made the clip's own.
     fn from_checked(packed: Arc<Packed>) -> Result<Clip, PackError> {
-        let times = packed.head().times();
-        let mut clip = compile_ends(&packed, &times)?;
-        let keys = packed_keys(&packed, &clip, &times);
+        let head = packed.head();
+        let mut clip = compile_ends(&packed)?;
+        let keys = packed_keys(&packed, &clip);
         let g = &mut clip.groups[0];
         g.grid = TimeGrid {
-            times,
+            times: KeyTimes::Even {
+                start: head.start,
+                interval: head.interval,
+                keys: head.keys,
+            },
             eases: Vec::new(),
             steps: Vec::new(),
             pre: g.grid.pre,
@@ -77,7 +82,7 @@ impl Clip {
             return err("a packed clip compiles to one group");
         };
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
-        if bits(&want.grid.times) != bits(&got.grid.times) {
+        if bits(&want.grid.times.to_vec()) != bits(&got.grid.times.to_vec()) {
             return err("packed key times miss their reference");
         }
         let lanes = |v: &[f32x8]| -> Vec<u32> {
@@ -149,7 +154,7 @@ impl Clip {
 
 /// The reference of the stream's first and last `END_KEYS` keys (all of
 /// them for a short clip), at their real times, compiled into one group.
-fn compile_ends(packed: &Packed, times: &[f64]) -> Result<Clip, PackError> {
+fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
     let head = packed.head();
     let n = head.keys;
     let at: Vec<usize> = if n <= 2 * END_KEYS {
@@ -163,7 +168,7 @@ fn compile_ends(packed: &Packed, times: &[f64]) -> Result<Clip, PackError> {
     for t in &mut ends.tracks {
         t.values = lanes.by_ref().take(t.stored()).collect();
     }
-    let end_times: Vec<f64> = at.iter().map(|&k| times[k]).collect();
+    let end_times: Vec<f64> = at.iter().map(|&k| head.time(k)).collect();
     let reference = ends.reference(&end_times)?;
     let clip = compile_impl(&reference, &CompileOptions::default(), true);
     if clip.groups.len() != 1 {
@@ -183,7 +188,7 @@ fn compile_ends(packed: &Packed, times: &[f64]) -> Result<Clip, PackError> {
 /// [`compile_ends`]): per lane its slot, step and chord weights, the
 /// rotations whose `w` is rebuilt, and the controls no decoded key gives
 /// (keys 0 and n-1, the sentinels).
-fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
+fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
     let head = packed.head();
     let n = head.keys;
     let g = &clip.groups[0];
@@ -198,7 +203,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip, times: &[f64]) -> PackedKeys {
     for (t, slot) in head.tracks.iter().zip(clip.layout.tracks()) {
         // Every interior key's weights are key 1's (`PackSource::validate`).
         let w = if n > 2 {
-            key_weights(times, t, 1)
+            key_weights(&[0, 1, 2].map(|k| head.time(k)), t, 1)
         } else {
             [0.0; 4]
         };

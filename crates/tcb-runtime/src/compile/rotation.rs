@@ -3,7 +3,7 @@
 
 use super::controls::{Controls, vector_controls};
 use crate::exact::{Exact, ExactTable, SQ_STRIDE};
-use crate::grid::TimeGrid;
+use crate::grid::{KeyTimes, TimeGrid};
 use tcb_core::Interp;
 use tcb_core::ease::SegmentEase;
 use tcb_core::rotation::RotationTrack;
@@ -257,7 +257,7 @@ pub(crate) fn split_rotation(
     on_group: bool,
 ) -> (TimeGrid, RotationControls) {
     let n = grid.times.len();
-    let mut times = vec![grid.times[0]];
+    let mut times = vec![grid.times.at(0)];
     let (mut eases, mut steps) = (Vec::new(), Vec::new());
     let mut out = RotationControls {
         comps: rot.comps.iter().map(|c| vec![c[0]]).collect(),
@@ -274,7 +274,7 @@ pub(crate) fn split_rotation(
         out.piece.push(piece);
     };
     for k in 0..n - 1 {
-        let (t0, t1) = (grid.times[k], grid.times[k + 1]);
+        let (t0, t1) = (grid.times.at(k), grid.times.at(k + 1));
         let pieces = split_pieces(grid, rot, k, on_group);
         let Some(pieces) = pieces else {
             times.push(t1);
@@ -301,7 +301,7 @@ pub(crate) fn split_rotation(
     let ctl = std::array::from_fn(|i| rot.comps[i][n]);
     push(&mut out, ctl, None, false, [0.0, 1.0]);
     let grid = TimeGrid {
-        times,
+        times: KeyTimes::Listed(times),
         eases,
         steps,
         pre: grid.pre,
@@ -325,7 +325,7 @@ fn split_pieces(
     k: usize,
     on_group: bool,
 ) -> Option<Vec<Piece>> {
-    let (t0, t1) = (grid.times[k], grid.times[k + 1]);
+    let (t0, t1) = (grid.times.at(k), grid.times.at(k + 1));
     let c = rot.exact[k + 1]
         .filter(|_| grid.ease(k).is_none() && !grid.is_step(k))
         .filter(|_| !(on_group && rot.velocity_only[k + 1]))?;

@@ -2,11 +2,11 @@
 //!
 //! Little-endian throughout: a 24-byte header (magic, version, length,
 //! CRC-32 of everything after the header), then the description, the
-//! per-lane widths, the segment table and the stream. Reading checks the
+//! per-lane widths, the block table and the stream. Reading checks the
 //! header, the checksum and every length against the bytes left before it
-//! allocates, and refuses a file that claims more keys than its width
-//! fields can describe (so what it allocates grows with the file, not with
-//! what the file claims).
+//! allocates, and refuses a file that claims more keys than its block table
+//! and headers can describe: no allocation is larger than the file (the
+//! key times are not listed, and the block table is read from the file).
 
 use super::{
     MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, VERSION, check_block, err,
@@ -96,11 +96,29 @@ impl<'a> Reader<'a> {
         Ok([abs_bits, delta_bits, base_width])
     }
 
-    /// The stream of `keys` keys of `lanes` lanes with headers: as words,
-    /// and its length in bytes. (Where each segment starts is not stored: the
-    /// reader walks the stream's headers, [`Packed::segment_table`].)
-    fn stream(&mut self, keys: usize, lanes: usize) -> Result<(Vec<u64>, usize), PackError> {
+    /// The stream of `keys` keys of `lanes` lanes with headers in blocks
+    /// of `block` keys: the block table (where each block starts, a `u32`
+    /// each), the stream as words, and its length in bytes. (Where the
+    /// other segments start is not stored: playback reads on from the
+    /// segment before.)
+    fn stream(
+        &mut self,
+        keys: usize,
+        block: usize,
+        lanes: usize,
+    ) -> Result<(Vec<u32>, Vec<u64>, usize), PackError> {
         let segments = keys.div_ceil(SEGMENT_KEYS);
+        let blocks = keys.div_ceil(block);
+        let table = self.take(blocks.saturating_mul(4), "the block table")?;
+        let block_at: Vec<u32> = table
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")))
+            .collect();
+        if block_at.first().is_some_and(|b| *b != 0) || block_at.windows(2).any(|w| w[0] > w[1]) {
+            return err(format!(
+                "{keys} keys in blocks of {block}: the block table's offsets do not start at 0 and increase (the key count or the table is wrong)"
+            ));
+        }
         let len = self.u32("the stream length")? as usize;
         // Every segment spends at least 2 bits per lane with headers on
         // them: a file cannot describe more keys than that (checked before
@@ -111,7 +129,7 @@ impl<'a> Reader<'a> {
             ));
         }
         let stream = super::to_words(self.take(len, "the stream")?);
-        Ok((stream, len))
+        Ok((block_at, stream, len))
     }
 
     /// The skeleton section (since version 2): a joint count (0: none), then per
@@ -312,6 +330,9 @@ impl Packed {
         w.0.extend_from_slice(&self.abs_bits);
         w.0.extend_from_slice(&self.delta_bits);
         w.0.extend_from_slice(&self.base_width);
+        for at in &self.block_at {
+            w.u32(*at);
+        }
         let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
         w.len(self.stream_len);
         w.0.extend_from_slice(&bytes[..self.stream_len]);
@@ -352,7 +373,7 @@ impl Packed {
 
     /// [`from_bytes`](Self::from_bytes) without decoding the stream: the
     /// header, checksum, lengths, settings and the stream's structure
-    /// ([`Packed::segment_table`]) checked, not the integers (what
+    /// ([`Packed::stream_structure`]) checked, not the integers (what
     /// [`crate::Clip::from_bytes`] reads: about 0.1 ms for CMU 01_01 where
     /// decoding every key takes a few).
     pub(crate) fn read(bytes: &[u8]) -> Result<Packed, PackError> {
@@ -382,7 +403,7 @@ impl Packed {
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
         let [abs_bits, delta_bits, base_width] = r.block_widths(stored)?;
         let headed = base_width.iter().filter(|b| **b != super::FLAT).count();
-        let (stream, len) = r.stream(keys, headed)?;
+        let (block_at, stream, len) = r.stream(keys, block, headed)?;
         let skeleton = r.skeleton()?;
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
@@ -399,7 +420,8 @@ impl Packed {
             abs_bits,
             delta_bits,
             base_width,
-            seg_at: Vec::new(),
+            block_at,
+            bits: 0,
             stream,
             stream_len: len,
             note,
@@ -407,7 +429,7 @@ impl Packed {
         };
         packed.head.validate_head()?;
         let mut packed = packed;
-        packed.seg_at = packed.segment_table()?;
+        packed.bits = packed.stream_structure()?;
         Ok(packed)
     }
 }

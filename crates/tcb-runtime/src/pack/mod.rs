@@ -153,9 +153,13 @@ pub(crate) fn err<T>(msg: impl Into<String>) -> Result<T, PackError> {
 impl PackSource {
     /// The key times.
     pub fn times(&self) -> Vec<f64> {
-        (0..self.keys)
-            .map(|k| self.start + k as f64 * self.interval)
-            .collect()
+        (0..self.keys).map(|k| self.time(k)).collect()
+    }
+
+    /// Key `k`'s time: `start + k interval` in f64 (the runtime's
+    /// `KeyTimes::Even` computes it the same way).
+    pub fn time(&self, k: usize) -> f64 {
+        self.start + k as f64 * self.interval
     }
 
     /// Quantize `clip`'s keys: every track on one even grid (to 1e-6 of the
@@ -231,7 +235,7 @@ impl PackSource {
             .tracks
             .first()
             .map(|t| (t.settings.pre, t.settings.post));
-        let intervals = Intervals::of(&self.times());
+        let intervals = Intervals::of(self.keys, |k| self.time(k));
         for t in &self.tracks {
             let at = |m: String| err(format!("track {}: {m}", t.name));
             if t.kind == TrackKind::Quat {
@@ -618,11 +622,14 @@ struct Intervals {
 }
 
 impl Intervals {
-    fn of(times: &[f64]) -> Intervals {
+    /// Of `keys` keys at times `time(k)` (not a list: a loader allocates
+    /// per distinct pair, not per key).
+    fn of(keys: usize, time: impl Fn(usize) -> f64) -> Intervals {
         let mut seen = std::collections::HashMap::new();
         let mut pairs = Vec::new();
-        for k in 1..times.len().saturating_sub(1) {
-            let (d_in, d_out) = (times[k] - times[k - 1], times[k + 1] - times[k]);
+        for k in 1..keys.saturating_sub(1) {
+            let (before, at, after) = (time(k - 1), time(k), time(k + 1));
+            let (d_in, d_out) = (at - before, after - at);
             seen.entry((d_in.to_bits(), d_out.to_bits()))
                 .or_insert_with(|| {
                     pairs.push((d_in, d_out, k));
@@ -798,8 +805,11 @@ pub struct Packed {
     pub(crate) delta_bits: Vec<u8>,
     /// Per lane: the width its header codes against at a block's start.
     pub(crate) base_width: Vec<u8>,
-    /// Per segment its first bit, then the stream's length in bits.
-    pub(crate) seg_at: Vec<u32>,
+    /// Per block its first bit (kept in the file, so that what a reader
+    /// allocates for it is part of what it read).
+    pub(crate) block_at: Vec<u32>,
+    /// The stream's length in bits.
+    pub(crate) bits: usize,
     /// The bits as words, then two words of zeros; its length in bytes.
     pub(crate) stream: Vec<u64>,
     pub(crate) stream_len: usize,
@@ -929,10 +939,12 @@ impl Packed {
             bytes: Vec::new(),
             bits: 0,
         };
-        let mut seg_at = Vec::with_capacity(n.div_ceil(SEGMENT_KEYS) + 1);
+        let mut block_at = Vec::with_capacity(n.div_ceil(block));
         let mut widths = vec![0u32; lanes.len()];
         for (s, chosen) in (0..n).step_by(SEGMENT_KEYS).zip(&chosen) {
-            seg_at.push(bit_offset(w.bits)?);
+            if s % block == 0 {
+                block_at.push(bit_offset(w.bits)?);
+            }
             for (l, &(order, wd)) in chosen.iter().enumerate() {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
@@ -970,7 +982,8 @@ impl Packed {
                 }
             }
         }
-        seg_at.push(bit_offset(w.bits)?);
+        let bits = w.bits;
+        bit_offset(bits)?;
         let stream_len = w.bytes.len();
         let stream = to_words(&w.bytes);
         let mut head = source.clone();
@@ -983,7 +996,8 @@ impl Packed {
             abs_bits,
             delta_bits,
             base_width,
-            seg_at,
+            block_at,
+            bits,
             stream,
             stream_len,
             note: String::new(),
@@ -1008,17 +1022,24 @@ impl Packed {
         Ok(source)
     }
 
-    /// Where each segment starts, then the stream's length in bits: the
-    /// stream's structure walked from bit 0 without decoding a key, every
-    /// segment's headers checked (widths in range), and the stream's bytes
-    /// just enough for its bits. What a reader needs for the runtime never
-    /// to read past the stream or take a width of 32 bits or more; the
-    /// integers themselves are [`decode`](Self::decode)'s to check. (The
-    /// file does not store the table: the reader makes it.)
-    pub(crate) fn segment_table(&self) -> Result<Vec<u32>, PackError> {
+    /// The stream's length in bits, from its structure walked from bit 0
+    /// without decoding a key: every segment's headers checked (widths in
+    /// range), every block starting where the block table says, and the
+    /// stream's bytes just enough for its bits. What a reader needs for the
+    /// runtime never to read past the stream or take a width of 32 bits or
+    /// more; the integers themselves are [`decode`](Self::decode)'s to
+    /// check. Allocates per lane, not per key.
+    pub(crate) fn stream_structure(&self) -> Result<usize, PackError> {
         let (n, lanes) = (self.head.keys, self.abs_bits.len());
         let (mut widths, mut orders) = (vec![0u32; lanes], vec![2u32; lanes]);
-        let mut seg_at = Vec::with_capacity(self.segments() + 1);
+        let per_block = self.block / SEGMENT_KEYS;
+        if self.block_at.len() != n.div_ceil(self.block) {
+            return err(format!(
+                "{} block offsets for {} blocks",
+                self.block_at.len(),
+                n.div_ceil(self.block)
+            ));
+        }
         let mut pos = 0;
         // A stream that ends early says how many keys it was to hold.
         let short = |e: PackError| {
@@ -1031,7 +1052,9 @@ impl Packed {
             }
         };
         for j in 0..self.segments() {
-            seg_at.push(bit_offset(pos)?);
+            if j % per_block == 0 {
+                self.check_block_at(j / per_block, pos)?;
+            }
             self.segment_headers(j, &mut pos, &mut widths, &mut orders)
                 .map_err(short)?;
             let s = j * SEGMENT_KEYS;
@@ -1044,8 +1067,17 @@ impl Packed {
                 self.stream_len
             ));
         }
-        seg_at.push(bit_offset(pos)?);
-        Ok(seg_at)
+        Ok(pos)
+    }
+
+    /// Whether block `b` starts at bit `pos`, as the block table says.
+    fn check_block_at(&self, b: usize, pos: usize) -> Result<(), PackError> {
+        match self.block_at.get(b) {
+            Some(&at) if at as usize == pos => Ok(()),
+            at => err(format!(
+                "block {b} starts at bit {pos} of the packed stream, the table says {at:?}"
+            )),
+        }
     }
 
     /// Segments of the stream (16 keys each, the last maybe fewer).
@@ -1091,18 +1123,16 @@ impl Packed {
         debug_assert!(first_key.is_multiple_of(self.block));
         let mut widths = vec![0u32; lanes];
         let mut orders = vec![2u32; lanes];
+        let per_block = self.block / SEGMENT_KEYS;
         // From the table's entry, but the stream's first segment from bit 0.
         let mut pos = if segs.start == 0 {
             0
         } else {
-            self.seg_at[segs.start] as usize
+            self.block_at[segs.start / per_block] as usize
         };
         for j in segs.clone() {
-            if pos != self.seg_at[j] as usize {
-                return err(format!(
-                    "segment {j} starts at bit {pos}, the table says {}",
-                    self.seg_at[j]
-                ));
+            if j % per_block == 0 {
+                self.check_block_at(j / per_block, pos)?;
             }
             self.segment_headers(j, &mut pos, &mut widths, &mut orders)?;
             let s = j * SEGMENT_KEYS;
@@ -1112,7 +1142,14 @@ impl Packed {
                 None => self.skip_segment(keys, &widths, &mut pos)?,
             }
         }
-        if pos != self.seg_at[segs.end] as usize {
+        let end = if segs.end == self.segments() {
+            Some(self.bits)
+        } else if segs.end.is_multiple_of(per_block) {
+            self.block_at.get(segs.end / per_block).map(|&b| b as usize)
+        } else {
+            None
+        };
+        if end.is_some_and(|end| end != pos) {
             return err("the packed stream's length disagrees with its table");
         }
         Ok(())
@@ -1243,22 +1280,22 @@ impl Packed {
 
     /// Bytes of the encoded stream and its tables (what a runtime keeps).
     pub fn stream_bytes(&self) -> usize {
-        8 * self.stream.len() + 4 * self.seg_at.len() + 3 * self.abs_bits.len()
+        8 * self.stream.len() + 4 * self.block_at.len() + 3 * self.abs_bits.len()
     }
 
     /// Bits of the residuals, widths and block starts.
     pub fn stream_bits(&self) -> usize {
-        *self.seg_at.last().unwrap_or(&0) as usize
+        self.bits
     }
 }
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads (version 4: rotations
-/// whose `w` changes sign kept relative to a center, constant components
-/// without headers, no stored segment table; older versions are refused
-/// with a one-line error).
-pub const VERSION: u32 = 4;
+/// The format version this build writes and reads (version 5: a table of
+/// where each block starts; version 4: rotations whose `w` changes sign
+/// kept relative to a center, constant components without headers; older
+/// versions are refused with a one-line error).
+pub const VERSION: u32 = 5;
 
 mod file;
 pub(crate) mod store;

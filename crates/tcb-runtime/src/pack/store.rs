@@ -174,6 +174,8 @@ pub(crate) struct PackCache {
     valid: usize,
     /// The first key of the segment whose tangents `m` holds.
     seg: usize,
+    /// The stream's bit after segment `cur` (where the next one starts).
+    pos: usize,
     /// Per stream lane with headers (`PackedKeys::headed`): its width in
     /// the segment `cur`.
     widths: Vec<u32>,
@@ -206,6 +208,7 @@ impl PackedKeys {
             cur: usize::MAX,
             valid: 0,
             seg: usize::MAX,
+            pos: 0,
             widths: vec![0; self.headed.len()],
             coding,
             flat: vec![i32x8::ZERO; np],
@@ -264,7 +267,11 @@ impl PackCache {
         }
         self.cur = j;
         let words: &[u64] = &g.packed.stream;
-        let mut pos = g.packed.seg_at[j] as usize;
+        let mut pos = if block {
+            g.packed.block_at[s / g.packed.block] as usize
+        } else {
+            self.pos
+        };
         if block {
             // A block's first headers code against the lanes' base widths.
             self.widths.copy_from_slice(&g.headed_base);
@@ -315,6 +322,7 @@ impl PackCache {
             (self.x0[p], self.x1[p]) = (a, b);
         }
         self.rebuild(g, first..keys);
+        self.pos = pos;
     }
 
     /// A block's first two keys (its start values, then the deltas) into

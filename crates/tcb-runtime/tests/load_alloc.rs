@@ -1,0 +1,74 @@
+//! Loading a `.tcbc` file allocates nothing larger than the file: the key
+//! times are `start + k interval`, not a list, and the block table is read
+//! from the file, so a small file cannot make the reader allocate for the
+//! keys it claims. Counted by a global allocator on the loading thread.
+
+use std::sync::Arc;
+use tcb_core::{Tcb, TrackKind, TrackSettings};
+use tcb_runtime::{Clip, Instance, PackSource, PackTrack, Packed};
+use tcb_test_support::{CountingAllocator, count_allocations};
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+/// The largest allocation `Clip::from_bytes` makes on `bytes`, and the clip.
+fn load(bytes: &[u8]) -> (Clip, usize) {
+    let (clip, counted) = count_allocations(|| Clip::from_bytes(bytes));
+    (clip.unwrap(), counted.largest)
+}
+
+#[test]
+fn a_long_constant_clip_loads_in_less_than_its_file() {
+    // The most keys a packed clip of one track may have, all one value: a
+    // file of its block table and a few bytes, where a list of its key
+    // times would take 32 MiB.
+    let keys = tcb_runtime::pack::MAX_TRACK_KEYS;
+    let track = PackTrack {
+        name: "level".into(),
+        kind: TrackKind::Scalar,
+        settings: TrackSettings::default(),
+        tcb: Tcb::default(),
+        rebuild_w: false,
+        step: 0.25,
+        center: None,
+        values: vec![vec![3; keys]],
+    };
+    let source = PackSource {
+        name: "long".into(),
+        start: 0.0,
+        interval: 1.0 / 120.0,
+        keys,
+        tracks: vec![track],
+    };
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    let (clip, largest) = load(&bytes);
+    assert!(
+        largest <= bytes.len(),
+        "an allocation of {largest} bytes for a file of {}",
+        bytes.len()
+    );
+    let level = clip.track("level").unwrap();
+    let mut play = Instance::new(Arc::new(clip));
+    for t in [0.0, 1.0 / 240.0, 9000.5, 34952.52] {
+        assert_eq!(play.sample(t).scalar(level), Some(0.75), "at {t}");
+    }
+}
+
+#[test]
+fn capture_loads_in_less_than_its_file() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    let options = tcb_io::ImportOptions::default().rotation(tcb_core::RotationMode::Hermite);
+    let cmu = tcb_io::load_with(format!("{root}/data/cmu-01_01.bvh"), &options)
+        .unwrap()
+        .clip;
+    let steps = vec![1.0 / 4096.0; cmu.tracks().len()];
+    let source = PackSource::quantize(&cmu, &steps).unwrap();
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    let (clip, largest) = load(&bytes);
+    assert!(
+        largest <= bytes.len(),
+        "an allocation of {largest} bytes for a file of {}",
+        bytes.len()
+    );
+    clip.verify_packed().unwrap();
+}
