@@ -6,6 +6,7 @@ Timings, ns per pose (SamplingJob of the whole pose, forward at 60 fps; then
 the same plus a LocalToModelJob):
   wall = median over runs of each run's median round (wall clock), with the
          range of the per-run medians
+  best = fastest round over all runs (wall clock)
   cpu  = median over runs of each run's median round in thread CPU time
 """
 import glob
@@ -24,7 +25,7 @@ for path in sorted(glob.glob(os.path.join(res, "*.run*.json"))):
             runs.setdefault(m.group(1), []).append(json.load(f))
 
 print("| ozz animation | joints | bytes (`Animation::size()`) | max error, 3 cm shell | "
-      "ns per pose, `SamplingJob` (wall, range; cpu) | + `LocalToModelJob` (wall, range; cpu) | runs |")
+      "ns per pose, `SamplingJob`: wall (range; best; cpu) | + `LocalToModelJob` | runs |")
 print("|---|---:|---:|---|---|---|---:|")
 for name in sorted(runs):
     rs = runs[name]
@@ -39,8 +40,9 @@ for name in sorted(runs):
 
         def col(key):
             med = [r["animations"][kind][f"{key}_ns"] for r in rs]
+            best = min(r["animations"][kind][f"{key}_ns_min"] for r in rs)
             cpu = statistics.median(r["animations"][kind][f"{key}_cpu_ns"] for r in rs)
-            return f"{statistics.median(med):.0f} ({min(med):.0f}-{max(med):.0f}; {cpu:.0f})"
+            return f"{statistics.median(med):.0f} ({min(med):.0f}-{max(med):.0f}; {best:.0f}; {cpu:.0f})"
 
         label = "`AnimationBuilder`" if kind == "built" else (
             f"`AnimationOptimizer` at {a['tolerance_cm']:g} cm, {a['distance_cm']:g} cm "
