@@ -14,6 +14,13 @@
 // the product of its Euler channels in the order listed (degrees), its local
 // translation its OFFSET (the root: OFFSET + its position channels).
 //
+// Why the BVH and not ozz's gltf2ozz on a file `tcb export` writes: gltf2ozz
+// is part of ozz's import2ozz tool (jsoncpp from extern/, tiny_gltf, its own
+// config and archive writers), more to build without cmake than this file;
+// glTF stores key times as f32, which `tcb export` itself warns moves a
+// 23 s clip's keys; and reading the BVH gives ozz the same local transforms
+// as ../shared/peers/acl, so the peers differ only in what they do with them.
+//
 // Into ozz (0.16): a RawSkeleton of the joints (rest pose: the OFFSET, no
 // rotation) and a RawAnimation in BVH units, its keys at the BVH's frame times:
 // a rotation key per joint per frame, a translation key per frame for the
