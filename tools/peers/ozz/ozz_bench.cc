@@ -17,9 +17,9 @@
 // Why the BVH and not ozz's gltf2ozz on a file `tcb export` writes: gltf2ozz
 // is part of ozz's import2ozz tool (jsoncpp from extern/, tiny_gltf, its own
 // config and archive writers), more to build without cmake than this file;
-// glTF stores key times as f32, which `tcb export` itself warns moves a
-// 23 s clip's keys; and reading the BVH gives ozz the same local transforms
-// as ../shared/peers/acl, so the peers differ only in what they do with them.
+// and reading the BVH gives ozz the same local transforms as
+// ../shared/peers/acl, so the peers differ only in what they do with them.
+// (ozz keeps key times as f32 either way, as glTF does.)
 //
 // Into ozz (0.16): a RawSkeleton of the joints (rest pose: the OFFSET, no
 // rotation) and a RawAnimation in BVH units, its keys at the BVH's frame times:
