@@ -2,7 +2,7 @@
 //! (as `tcb import` reads it) and compared with what the export reported.
 
 use arbitrary::Unstructured;
-use tcb_core::{Clip, TrackKind};
+use tcb_core::{SourceClip, TrackKind};
 use tcb_io::ClipDoc;
 use tcb_io::gltf_export::{Container, ExportOptions, export as export_gltf};
 
@@ -109,7 +109,7 @@ fn name_for_gltf(doc: &mut ClipDoc, u: &mut Unstructured) {
 
 /// The exported bytes imported (as `tcb import` reads them) and built;
 /// panics if either step fails.
-fn read_back(bytes: &[u8], container: Container) -> Clip {
+fn read_back(bytes: &[u8], container: Container) -> SourceClip {
     match tcb_io::gltf_import::import(bytes, None, None, "fuzz") {
         Ok(g) => g.doc.build().unwrap_or_else(|e| {
             panic!("an export that imports but does not build: {e} ({container:?})")
@@ -120,7 +120,7 @@ fn read_back(bytes: &[u8], container: Container) -> Clip {
 
 /// The times to compare at: the keys of both clips, 7 points between each
 /// two of them, and a few edge times.
-fn check_times(u: &mut Unstructured, clip: &Clip, back: &Clip) -> Vec<f64> {
+fn check_times(u: &mut Unstructured, clip: &SourceClip, back: &SourceClip) -> Vec<f64> {
     let mut times = clip.key_times();
     times.extend(back.key_times());
     times.sort_by(f64::total_cmp);
@@ -136,7 +136,7 @@ fn check_times(u: &mut Unstructured, clip: &Clip, back: &Clip) -> Vec<f64> {
 
 /// Where each of `clip`'s tracks starts in `back`'s rows (glTF groups
 /// channels by node); panics on a track not read back.
-fn offsets_in(clip: &Clip, back: &Clip) -> Vec<usize> {
+fn offsets_in(clip: &SourceClip, back: &SourceClip) -> Vec<usize> {
     clip.tracks()
         .iter()
         .map(|t| {
