@@ -25,7 +25,7 @@ mod reduce_readback;
 mod roundtrip;
 
 pub use edges::{edge_time, edge_times, f32_ulps, ulps};
-pub use export::export;
+pub use export::{export, export_and_read_back, read_back_misses};
 use inputs::*;
 pub use inputs::{arbitrary_doc, arbitrary_time};
 pub use playback::{clip_time, playback};
