@@ -105,7 +105,7 @@ def write_golden():
     os.makedirs(GOLDEN, exist_ok=True)
     for path in clips():
         with open(os.path.join(ROOT, path)) as f:
-            clip = tcbref.Clip(json.load(f))
+            clip = tcbref.SourceClip(json.load(f))
         times = sample_times(clip)
         cols = clip.columns()
         stem = os.path.splitext(os.path.basename(path))[0]
@@ -130,7 +130,7 @@ def main():
     errors, checked = [], 0
     for path in clips():
         with open(os.path.join(ROOT, path)) as f:
-            clip = tcbref.Clip(json.load(f))
+            clip = tcbref.SourceClip(json.load(f))
         times = sample_times(clip)
         exp = expected_rows(clip, times)
         for scalar in (False, True):

@@ -359,7 +359,7 @@ def f32(x):
     return struct.unpack("f", struct.pack("f", x))[0]
 
 
-class Clip:
+class SourceClip:
     def __init__(self, doc):
         defaults = doc.get("defaults", {})
         self.tracks = [(t["name"], t["kind"], Track(t, defaults)) for t in doc["tracks"]]

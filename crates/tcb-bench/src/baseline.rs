@@ -117,7 +117,7 @@ fn curve<V: Value>(t: &Track<V>, normalize: bool) -> BaselineTrack {
 impl Baseline {
     /// Build from a validated clip (tangents and inner quaternions come from
     /// tcb-core, computed once).
-    pub fn new(clip: &tcb_core::Clip) -> Self {
+    pub fn new(clip: &tcb_core::SourceClip) -> Self {
         let tracks = clip
             .tracks()
             .iter()

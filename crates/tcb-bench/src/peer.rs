@@ -25,7 +25,7 @@ pub struct SplinesPeer {
 impl SplinesPeer {
     /// Splines for every channel of `clip` (any track kind; rotations as
     /// four components, normalized).
-    pub fn new(clip: &tcb_core::Clip) -> Self {
+    pub fn new(clip: &tcb_core::SourceClip) -> Self {
         let mut splines = Vec::new();
         let mut quats = Vec::new();
         let mut inner = (f64::NEG_INFINITY, f64::INFINITY);
@@ -117,7 +117,7 @@ impl SplinesPeer {
     /// Largest difference from `clip` (the reference) over `samples`
     /// times inside the inner keys, relative to max(1, |value|); rotations
     /// compared up to sign.
-    pub fn agreement(&self, clip: &tcb_core::Clip, samples: usize) -> f64 {
+    pub fn agreement(&self, clip: &tcb_core::SourceClip, samples: usize) -> f64 {
         let (a, b) = self.inner;
         let mut want = vec![0.0f32; clip.channel_count()];
         let mut got = vec![0.0f32; self.channel_count()];

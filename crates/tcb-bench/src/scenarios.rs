@@ -34,7 +34,7 @@ pub struct Scenario {
     /// Name in the report.
     pub name: String,
     /// The validated clip (the tcb-core reference).
-    pub source: tcb_core::Clip,
+    pub source: tcb_core::SourceClip,
     /// The runtime's compiled clip.
     pub clip: Arc<tcb_runtime::Clip>,
     /// The scalar baseline.
@@ -56,7 +56,7 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    fn new(name: impl Into<String>, source: tcb_core::Clip, times: Vec<f64>) -> Self {
+    fn new(name: impl Into<String>, source: tcb_core::SourceClip, times: Vec<f64>) -> Self {
         Scenario {
             name: name.into(),
             clip: Arc::new(tcb_runtime::Clip::compile(&source)),
@@ -230,7 +230,7 @@ fn frames(end: f64, fps: f64) -> Vec<f64> {
     (0..=n).map(|i| i as f64 / fps).collect()
 }
 
-fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::Clip, usize), tcb_io::Error> {
+fn cmu(bvh: &Path, rotation: RotationMode) -> Result<(tcb_core::SourceClip, usize), tcb_io::Error> {
     let options = tcb_io::ImportOptions::default().rotation(rotation);
     let loaded = tcb_io::load_with(bvh, &options)?;
     let joints = animated_joints(&loaded);
@@ -510,7 +510,7 @@ pub fn wide() -> Scenario {
             ..scalar_track(times.clone(), &mut rng)
         })
         .collect();
-    let clip = tcb_core::Clip::new("wide", tracks).expect("unique track names");
+    let clip = tcb_core::SourceClip::new("wide", tracks).expect("unique track names");
     let mut s = Scenario::new("wide", clip, frames(2.0, 60.0));
     s.peer = Some(SplinesPeer::new(&s.source));
     s.read_limit = true;
@@ -532,7 +532,7 @@ pub fn sparse_seek() -> Scenario {
     Scenario::new("sparse-seek", sparse_clip(), times)
 }
 
-fn sparse_clip() -> tcb_core::Clip {
+fn sparse_clip() -> tcb_core::SourceClip {
     let mut rng = Rng(0x5ba5e);
     let tracks = (0..500)
         .map(|i| {
@@ -543,7 +543,7 @@ fn sparse_clip() -> tcb_core::Clip {
             }
         })
         .collect();
-    tcb_core::Clip::new("sparse", tracks).expect("unique track names")
+    tcb_core::SourceClip::new("sparse", tracks).expect("unique track names")
 }
 
 /// 10 to 40 random key times in [0, 2] s, the first at 0 and the last at 2.
@@ -603,7 +603,7 @@ pub fn sparse_rotations() -> Scenario {
             }
         })
         .collect();
-    let clip = tcb_core::Clip::new("sparse-rotations", tracks).expect("unique track names");
+    let clip = tcb_core::SourceClip::new("sparse-rotations", tracks).expect("unique track names");
     Scenario::new("sparse-rotations", clip, frames(2.0, 60.0))
 }
 

@@ -4,7 +4,7 @@ use tcb_bench::Baseline;
 use tcb_bench::peer::SplinesPeer;
 use tcb_core::{RotationMode, TrackData};
 
-fn clips() -> Vec<(String, tcb_core::Clip)> {
+fn clips() -> Vec<(String, tcb_core::SourceClip)> {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
     let mut out = Vec::new();
     for dir in ["examples/clips", "tools/check/clips"] {

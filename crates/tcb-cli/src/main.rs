@@ -24,7 +24,7 @@ use clap::{Args, Parser, Subcommand};
 use std::io::{self, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use tcb_core::Clip;
+use tcb_core::SourceClip;
 use tcb_core::sample_times::{frame_count, frame_times, inbetweens};
 
 /// Most sample times one command will produce.
@@ -674,7 +674,7 @@ fn with_progress<T>(template: &str, work: impl FnOnce(&(dyn Fn(usize, usize) + S
 fn load_any(
     path: &std::path::Path,
     options: &tcb_io::ImportOptions,
-) -> Result<(tcb_core::Clip, Option<tcb_core::skeleton::Skeleton>), BoxError> {
+) -> Result<(tcb_core::SourceClip, Option<tcb_core::skeleton::Skeleton>), BoxError> {
     if extension(path) == "tcbc" {
         let (clip, runtime) = load_tcbc(path)?;
         let skeleton = runtime.packed().and_then(|p| p.skeleton.clone());
@@ -689,7 +689,7 @@ fn load_any(
 /// `--scalar` and the track list) and its runtime clip.
 fn load_tcbc(
     path: &std::path::Path,
-) -> Result<(tcb_core::Clip, std::sync::Arc<tcb_runtime::Clip>), BoxError> {
+) -> Result<(tcb_core::SourceClip, std::sync::Arc<tcb_runtime::Clip>), BoxError> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let in_file = |e: tcb_runtime::PackError| format!("{}: {e}", path.display());
     let packed = std::sync::Arc::new(tcb_runtime::Packed::from_bytes(&bytes).map_err(in_file)?);
@@ -745,7 +745,7 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
 /// frame (`tcb_fit::cost`), and, unless `ms` is 0, their ns per animated
 /// joint per frame at 60 fps timed in one run (alternating rounds, medians
 /// ± MAD, about `ms` milliseconds in all: a quick timing).
-fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
+fn report_speed(input: &tcb_core::SourceClip, reduced: &tcb_fit::Reduced, ms: u64) {
     let (c0, c1) = (reduced.before_cost, reduced.after_cost);
     eprintln!(
         "tcb: estimated runtime cost: input {c0:.0}, output {c1:.0} instructions per frame ({:.2}x){}",
@@ -789,13 +789,13 @@ fn report_speed(input: &tcb_core::Clip, reduced: &tcb_fit::Reduced, ms: u64) {
 /// Seconds per frame of `a` and `b` compiled, played forward at 60 fps over
 /// `a`'s keys: medians of rounds timed alternately, in about `budget`, and
 /// the rounds' MAD (median absolute deviation).
-fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> [(f64, f64); 2] {
+fn quick_timing(a: &SourceClip, b: &SourceClip, budget: std::time::Duration) -> [(f64, f64); 2] {
     use std::sync::Arc;
     let (start, end) = a.time_range().unwrap_or((0.0, 0.0));
     let frames: Vec<f64> = (0..=((end - start) * 60.0).floor() as usize)
         .map(|i| start + i as f64 / 60.0)
         .collect();
-    let pass = |clip: &Clip| {
+    let pass = |clip: &SourceClip| {
         let mut instance = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(clip)));
         let frames = &frames;
         Box::new(move || {
@@ -831,7 +831,7 @@ fn quick_timing(a: &Clip, b: &Clip, budget: std::time::Duration) -> [(f64, f64);
 }
 
 /// The distinct `<joint>` of a clip's `<joint>.<part>` track names.
-fn animated_joints(clip: &Clip) -> usize {
+fn animated_joints(clip: &SourceClip) -> usize {
     let mut names: Vec<&str> = clip
         .tracks()
         .iter()
@@ -957,7 +957,7 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
 /// pre/post and, with `quantize`, each track's quantization error.
 fn write_tracks(
     out: &mut String,
-    clip: &Clip,
+    clip: &SourceClip,
     runtime: &tcb_runtime::Clip,
     quantize: bool,
 ) -> Result<(), BoxError> {
@@ -1319,7 +1319,7 @@ fn sample(args: &SampleArgs) -> Result<(), BoxError> {
     Ok(())
 }
 
-fn sample_times(args: &SampleArgs, clip: &Clip) -> Result<Vec<f64>, BoxError> {
+fn sample_times(args: &SampleArgs, clip: &SourceClip) -> Result<Vec<f64>, BoxError> {
     if args.fps.is_none() && (args.from.is_some() || args.to.is_some()) {
         return Err("--from and --to go with --fps".into());
     }
@@ -1378,7 +1378,7 @@ fn sample_times(args: &SampleArgs, clip: &Clip) -> Result<Vec<f64>, BoxError> {
 /// Write the CSV, sampling each time with `sample(time, values, velocities)`.
 fn write_csv(
     out: &mut impl Write,
-    clip: &Clip,
+    clip: &SourceClip,
     times: &[f64],
     velocity: bool,
     mut sample: impl FnMut(f64, &mut [f32], Option<&mut [f32]>),

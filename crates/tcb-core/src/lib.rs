@@ -15,7 +15,7 @@
 //! | [`ease`] | 3ds Max ease to / ease from |
 //! | [`track`] | [`Track`], the reference spline for `f32`, `Vec2`, `Vec3`, `Vec4` |
 //! | [`rotation`] | [`RotationTrack`]: `squad` and `hermite` on quaternions |
-//! | `clip` | [`Clip`]: named tracks sampled together |
+//! | `source_clip` | [`SourceClip`]: named tracks sampled together |
 //! | [`sample_times`] | the paper's inbetweens, frame grids |
 //! | [`simd`] | the formulas over lane types the runtime's kernels share (not a stable API) |
 //!
@@ -45,7 +45,6 @@
 
 #![forbid(unsafe_code)]
 
-mod clip;
 pub mod ease;
 mod error;
 pub mod params;
@@ -54,16 +53,17 @@ pub mod rotation;
 pub mod sample_times;
 pub mod simd;
 pub mod skeleton;
+mod source_clip;
 pub mod tangent;
 pub mod track;
 pub mod vector;
 
-pub use clip::{Clip, DuplicateTrack, NamedTrack, TrackData, TrackKind};
 pub use error::TrackError;
 pub use params::{
     Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, RotationMode, TangentRule, Tcb,
     TrackSettings,
 };
 pub use rotation::RotationTrack;
+pub use source_clip::{DuplicateTrack, NamedTrack, SourceClip, TrackData, TrackKind};
 pub use track::Track;
 pub use vector::{Value, Vector};

@@ -7,8 +7,8 @@ use glam::{Affine3A, DAffine3, Quat, Vec3};
 use tcb_core::ease::SegmentEase;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 use tcb_core::{
-    Clip, Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
-    RotationTrack, TangentRule, Tcb, Track, TrackData, TrackSettings,
+    Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
+    RotationTrack, SourceClip, TangentRule, Tcb, Track, TrackData, TrackSettings,
 };
 
 const TIMES: [f64; 4] = [f64::NAN, f64::INFINITY, -1e300, 1e300];
@@ -165,7 +165,7 @@ fn tracks_refuse_or_sample() {
     }
 }
 
-/// `tcb_core::Clip` (once public fields): `Clip::new` refuses a repeated
+/// `tcb_core::SourceClip` (once public fields): `SourceClip::new` refuses a repeated
 /// track name, the one invariant its fields skipped.
 #[test]
 fn clips_refuse_repeated_names() {
@@ -181,9 +181,9 @@ fn clips_refuse_repeated_names() {
             .expect("valid"),
         ),
     };
-    let e = Clip::new("c", vec![t(), t()]).unwrap_err();
+    let e = SourceClip::new("c", vec![t(), t()]).unwrap_err();
     assert_eq!(e.0, "x");
-    let clip = Clip::new("c", vec![t()]).expect("one track");
+    let clip = SourceClip::new("c", vec![t()]).expect("one track");
     let mut row = [0.0f32; 1];
     for time in TIMES {
         clip.sample_into(time, &mut row, None);

@@ -56,7 +56,11 @@ fn packed(bytes: &[u8], origin: &str) -> Result<TcbClip> {
     })
 }
 
-fn compiled(clip: &tcb_core::Clip, skeleton: Option<Skeleton>, flags: u32) -> Result<TcbClip> {
+fn compiled(
+    clip: &tcb_core::SourceClip,
+    skeleton: Option<Skeleton>,
+    flags: u32,
+) -> Result<TcbClip> {
     let options = compile_options(flags)?;
     Ok(TcbClip {
         clip: Arc::new(Clip::compile_with(clip, &options)),

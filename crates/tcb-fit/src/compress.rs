@@ -24,7 +24,7 @@ use crate::reduce::{
 };
 use std::sync::Arc;
 use tcb_core::skeleton::Skeleton;
-use tcb_core::{Clip, TrackKind};
+use tcb_core::{SourceClip, TrackKind};
 use tcb_runtime::{KeyValues, Packed};
 
 /// Options of [`compress`]; `None` takes the contract's default.
@@ -146,7 +146,7 @@ impl Compressed {
 /// Compress `clip` (with its `skeleton` for the shell metric). `progress`
 /// is called with (clips measured, of about how many).
 pub fn compress(
-    clip: &Clip,
+    clip: &SourceClip,
     skeleton: Option<&Skeleton>,
     options: &CompressOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
@@ -325,7 +325,7 @@ struct Budget {
 }
 
 impl Budget {
-    fn new(clip: &Clip, skeleton: Option<&Skeleton>, s: &Settings, largest: &[f64]) -> Self {
+    fn new(clip: &SourceClip, skeleton: Option<&Skeleton>, s: &Settings, largest: &[f64]) -> Self {
         let finest: Vec<f64> = largest.iter().map(|m| m / f64::from(1u32 << 22)).collect();
         let sqrt3 = 3f64.sqrt();
         let tracks = clip.tracks();

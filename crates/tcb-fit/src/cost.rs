@@ -31,7 +31,7 @@
 //! reduce` also times both clips.
 
 use std::collections::HashMap;
-use tcb_core::{Clip, Extrapolation, TrackKind};
+use tcb_core::{Extrapolation, SourceClip, TrackKind};
 
 /// Per frame, whatever the clip: the instance's own work.
 const BASE: f64 = 105.0;
@@ -65,7 +65,7 @@ const FPS: f64 = 60.0;
 /// assert!(tcb_fit::cost::frame_cost(&compiled, &source) > 400.0);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn frame_cost(compiled: &tcb_runtime::Clip, source: &Clip) -> f64 {
+pub fn frame_cost(compiled: &tcb_runtime::Clip, source: &SourceClip) -> f64 {
     let stats = compiled.stats();
     let blocks = |n: usize| n.div_ceil(8) as f64;
     let groups: f64 = stats
@@ -97,7 +97,7 @@ pub fn frame_cost(compiled: &tcb_runtime::Clip, source: &Clip) -> f64 {
 /// `tcb_runtime`'s `choose_loose`; eases and steps, which also part grids
 /// there, are not looked at, so tracks that differ only in them count as
 /// sharing one).
-fn loose_keys(source: &Clip) -> usize {
+fn loose_keys(source: &SourceClip) -> usize {
     type Key = (Vec<u64>, Extrapolation, Extrapolation);
     // Per grid: vector channels, rotations, keys of its tracks.
     let mut grids: HashMap<Key, (usize, usize, usize)> = HashMap::new();
@@ -123,7 +123,7 @@ fn loose_keys(source: &Clip) -> usize {
 mod tests {
     use super::*;
 
-    fn clip(tracks: &[String]) -> Clip {
+    fn clip(tracks: &[String]) -> SourceClip {
         let text = format!(
             r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
             tracks.join(",")

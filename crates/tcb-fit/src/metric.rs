@@ -12,17 +12,17 @@ use glam::DAffine3;
 use std::sync::Arc;
 use tcb_core::sample_times::inbetweens;
 use tcb_core::skeleton::{Skeleton, Transform};
-use tcb_core::{Clip, TrackKind};
+use tcb_core::{SourceClip, TrackKind};
 use tcb_runtime::{Instance, SkeletonBinding};
 
 /// The check times of a clip: every key time (the sorted union of its
 /// tracks' key times) and 3 evenly spaced times inside each interval.
-pub fn check_times(clip: &Clip) -> Vec<f64> {
+pub fn check_times(clip: &SourceClip) -> Vec<f64> {
     inbetweens(&clip.key_times(), 3)
 }
 
 /// A compiled clip played by the runtime (as `tcb sample` plays it) at
-/// `times`: one row of [`Clip::channel_count`] values per time, concatenated.
+/// `times`: one row of [`SourceClip::channel_count`] values per time, concatenated.
 pub fn play(clip: &Arc<tcb_runtime::Clip>, times: &[f64]) -> Vec<f32> {
     let channels = clip.channel_count();
     let mut instance = Instance::new(clip.clone());
@@ -155,7 +155,7 @@ pub fn point_error(a: &DAffine3, b: &DAffine3, radius: f64) -> f64 {
 /// (per component), rotations against `rotation_degrees`. The worst is the
 /// largest ratio.
 pub fn value_error(
-    reference: &Clip,
+    reference: &SourceClip,
     reference_rows: &[f32],
     reduced: &Arc<tcb_runtime::Clip>,
     times: &[f64],

@@ -52,7 +52,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{
-    Clip, Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, TrackKind, TrackSettings,
+    Ends, Extrapolation, Hemisphere, RotationMode, SourceClip, TangentRule, TrackKind,
+    TrackSettings,
 };
 use tcb_io::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 
@@ -227,7 +228,7 @@ pub struct Input<'a> {
     /// The input as a document (its tracks' settings are kept).
     pub doc: &'a ClipDoc,
     /// The input, built.
-    pub clip: &'a Clip,
+    pub clip: &'a SourceClip,
     /// Its rig (BVH End Sites are leaf joints in it, as `tcb_io::load` gives them).
     pub skeleton: Option<&'a Skeleton>,
 }
@@ -283,7 +284,7 @@ pub struct Reduced {
     /// The clip to write.
     pub doc: ClipDoc,
     /// It, built (what was verified).
-    pub clip: Clip,
+    pub clip: SourceClip,
     /// The values used.
     pub settings: Settings,
     /// The input's counts.
@@ -527,7 +528,7 @@ pub fn reduce(
 /// A written clip, built, compiled and measured.
 struct Candidate {
     doc: ClipDoc,
-    clip: Clip,
+    clip: SourceClip,
     compiled: Arc<tcb_runtime::Clip>,
     worst: Worst,
     /// Per track: kept as it was.
@@ -538,7 +539,7 @@ struct Candidate {
 /// played at the check times.
 pub(crate) struct Reference<'a> {
     /// The input.
-    pub(crate) source: &'a Clip,
+    pub(crate) source: &'a SourceClip,
     /// Its rig (`shell`).
     pub(crate) skeleton: Option<&'a Skeleton>,
     /// The check times ([`metric::check_times`]).
@@ -551,7 +552,11 @@ pub(crate) struct Reference<'a> {
 
 impl<'a> Reference<'a> {
     /// `source` compiled and played at `times`.
-    pub(crate) fn new(source: &'a Clip, skeleton: Option<&'a Skeleton>, times: &'a [f64]) -> Self {
+    pub(crate) fn new(
+        source: &'a SourceClip,
+        skeleton: Option<&'a Skeleton>,
+        times: &'a [f64],
+    ) -> Self {
         let compiled = Arc::new(tcb_runtime::Clip::compile(source));
         let rows = metric::play(&compiled, times);
         Reference {
@@ -591,7 +596,7 @@ impl<'a> Reference<'a> {
 }
 
 /// `doc` built and compiled.
-fn build(doc: &ClipDoc) -> Result<(Clip, Arc<tcb_runtime::Clip>), ReduceError> {
+fn build(doc: &ClipDoc) -> Result<(SourceClip, Arc<tcb_runtime::Clip>), ReduceError> {
     let clip = doc.build().map_err(|e| ReduceError::Build(e.to_string()))?;
     let compiled = Arc::new(tcb_runtime::Clip::compile(&clip));
     Ok((clip, compiled))
@@ -783,7 +788,7 @@ fn put_back_for_speed(
         s.dedup();
         s
     };
-    type Built = (ClipDoc, Vec<bool>, Clip, Arc<tcb_runtime::Clip>);
+    type Built = (ClipDoc, Vec<bool>, SourceClip, Arc<tcb_runtime::Clip>);
     let build_at = |size: usize| -> Result<Built, ReduceError> {
         let (doc, kept) = plan.write_fits(cache, &revert(size));
         let (clip, compiled) = build(&doc)?;
@@ -1195,7 +1200,7 @@ fn prepare(
 
 /// The fitted tracks in groups that share key times: by `knots` (the
 /// track, its joint, or the whole clip) and the same span of check times.
-fn knot_groups(clip: &Clip, knots: Knots, tracks: &[Option<Prepared>]) -> Vec<Vec<usize>> {
+fn knot_groups(clip: &SourceClip, knots: Knots, tracks: &[Option<Prepared>]) -> Vec<Vec<usize>> {
     let mut groups: Vec<(String, usize, usize, Vec<usize>)> = Vec::new();
     for (i, p) in tracks.iter().enumerate() {
         let Some(p) = p else { continue };
@@ -1293,7 +1298,7 @@ fn continuous_rotations(samples: &mut [[f64; 4]]) {
 fn chains(
     skeleton: &Skeleton,
     tracks: &[Option<Prepared>],
-    clip: &Clip,
+    clip: &SourceClip,
     rows: &[f32],
     channels: usize,
     radius: f64,

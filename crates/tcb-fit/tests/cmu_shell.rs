@@ -95,7 +95,7 @@ fn locals(rig: &Rig, columns: &[String], row: &[f32]) -> Vec<(DVec3, DQuat)> {
         .collect()
 }
 
-fn play(clip: &tcb_core::Clip, times: &[f64]) -> Vec<Vec<f32>> {
+fn play(clip: &tcb_core::SourceClip, times: &[f64]) -> Vec<Vec<f32>> {
     let mut instance = tcb_runtime::Instance::new(Arc::new(tcb_runtime::Clip::compile(clip)));
     times
         .iter()
@@ -108,7 +108,12 @@ fn play(clip: &tcb_core::Clip, times: &[f64]) -> Vec<Vec<f32>> {
 }
 
 /// The shell error by the contract, computed here.
-fn shell_error(rig: &Rig, input: &tcb_core::Clip, output: &tcb_core::Clip, radius: f64) -> f64 {
+fn shell_error(
+    rig: &Rig,
+    input: &tcb_core::SourceClip,
+    output: &tcb_core::SourceClip,
+    radius: f64,
+) -> f64 {
     // Check times: every frame and 3 inbetweens between frames.
     let mut times = Vec::new();
     for f in 0..rig.frames {

@@ -29,7 +29,7 @@ fn a_track_no_joint_uses_is_kept_finely() {
         name: "camera.fov".into(),
         data: TrackData::Scalar(fov),
     });
-    let clip = tcb_core::Clip::new("cmu+fov", tracks).unwrap();
+    let clip = tcb_core::SourceClip::new("cmu+fov", tracks).unwrap();
     let c = tcb_fit::compress(
         &clip,
         loaded.skeleton.as_ref(),

@@ -19,7 +19,7 @@ fn scalar(name: &str, keys: impl Iterator<Item = (f64, f64)>) -> String {
     )
 }
 
-fn reduce(doc: &tcb_io::ClipDoc, clip: &tcb_core::Clip) -> tcb_fit::Reduced {
+fn reduce(doc: &tcb_io::ClipDoc, clip: &tcb_core::SourceClip) -> tcb_fit::Reduced {
     let input = tcb_fit::reduce::Input {
         doc,
         clip,
@@ -29,7 +29,7 @@ fn reduce(doc: &tcb_io::ClipDoc, clip: &tcb_core::Clip) -> tcb_fit::Reduced {
     tcb_fit::reduce(input, &options, &|_, _| {}).unwrap()
 }
 
-fn cost_of(clip: &tcb_core::Clip) -> f64 {
+fn cost_of(clip: &tcb_core::SourceClip) -> f64 {
     cost::frame_cost(&tcb_runtime::Clip::compile(clip), clip)
 }
 

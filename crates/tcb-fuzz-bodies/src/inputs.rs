@@ -167,7 +167,7 @@ pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
 /// its tracks animate, and arbitrary options.
 pub(crate) type ReduceInput = (
     ClipDoc,
-    tcb_core::Clip,
+    tcb_core::SourceClip,
     Option<tcb_core::skeleton::Skeleton>,
     tcb_fit::ReduceOptions,
 );

@@ -25,7 +25,7 @@ mod reduce_readback;
 mod roundtrip;
 
 pub use edges::{edge_time, edge_times, f32_ulps, ulps};
-pub use export::export;
+pub use export::{export, export_and_read_back, read_back_misses};
 use inputs::*;
 pub use inputs::{arbitrary_doc, arbitrary_time};
 pub use playback::{clip_time, playback};
@@ -293,7 +293,7 @@ pub fn pack(data: &[u8]) {
 
 /// Play a clip that built at its key times, between them, beyond them and
 /// at the awkward times, against the reference.
-fn play(clip: &tcb_core::Clip) {
+fn play(clip: &tcb_core::SourceClip) {
     let mut times = clip.key_times();
     times.truncate(200);
     if let Some((a, b)) = clip.time_range() {
@@ -307,7 +307,7 @@ fn play(clip: &tcb_core::Clip) {
 
 /// The runtime against the reference at `times`, played forward as given
 /// and by a fresh instance per time (a seek), which must agree bit for bit.
-fn check(clip: &tcb_core::Clip, times: &[f64], options: &tcb_runtime::CompileOptions) {
+fn check(clip: &tcb_core::SourceClip, times: &[f64], options: &tcb_runtime::CompileOptions) {
     let compiled = Arc::new(tcb_runtime::Clip::compile_with(clip, options));
     let n = clip.channel_count();
     let mut playing = Instance::new(compiled.clone()).with_velocities();
@@ -583,7 +583,7 @@ fn play_anything(clip: tcb_runtime::Clip, u: &mut Unstructured) {
     }
 }
 
-fn play_packed(clip: tcb_runtime::Clip, reference: &tcb_core::Clip, u: &mut Unstructured) {
+fn play_packed(clip: tcb_runtime::Clip, reference: &tcb_core::SourceClip, u: &mut Unstructured) {
     let head = clip.packed().expect("compiled from a packed clip").head();
     let (start, interval, keys) = (head.start, head.interval, head.keys);
     let at = |k: f64| start + k * interval;

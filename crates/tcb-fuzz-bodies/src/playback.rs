@@ -144,7 +144,7 @@ fn choose_speed(u: &mut Unstructured) -> f64 {
 
 /// Edge times in clip time, then half of them again divided by the speed:
 /// instance times whose clip times land near the keys.
-fn instance_times(u: &mut Unstructured, clip: &tcb_core::Clip, speed: f64) -> Vec<f64> {
+fn instance_times(u: &mut Unstructured, clip: &tcb_core::SourceClip, speed: f64) -> Vec<f64> {
     let keys: Vec<f64> = clip.key_times().into_iter().take(200).collect();
     let mut times = edge_times(u, &keys, 48);
     if speed != 0.0 && speed.is_finite() {
@@ -159,7 +159,7 @@ fn instance_times(u: &mut Unstructured, clip: &tcb_core::Clip, speed: f64) -> Ve
 
 /// A rig of the clip's tracks reversed, then one the clip lacks
 /// (`fuzz.extra`, a vec4 at `rest`, made finite).
-fn reversed_rig(clip: &tcb_core::Clip, rest: [f32; 4]) -> Arc<Rig> {
+fn reversed_rig(clip: &tcb_core::SourceClip, rest: [f32; 4]) -> Arc<Rig> {
     let mut tracks: Vec<RigTrack> = clip
         .tracks()
         .iter()
@@ -222,7 +222,7 @@ impl Player {
     /// The clip time and velocity factor of `t` ([`clip_time`]), checked
     /// to be within the keys in `Loop`, `Clamp` and `PingPong` when `t` is
     /// finite.
-    fn check_clip_time(&self, clip: &tcb_core::Clip, t: f64) -> (f64, f32) {
+    fn check_clip_time(&self, clip: &tcb_core::SourceClip, t: f64) -> (f64, f32) {
         let (mode, speed) = (self.mode, self.speed);
         let range = clip.time_range();
         let (c, rate) = clip_time(mode, speed, t, range);
@@ -254,7 +254,7 @@ impl Player {
     /// track holds its rest value with velocity 0.
     fn check_rig(
         &self,
-        clip: &tcb_core::Clip,
+        clip: &tcb_core::SourceClip,
         rig: &Arc<Rig>,
         inst: &mut Instance,
         got: &(Vec<f32>, Vec<f32>),
@@ -300,14 +300,14 @@ impl Player {
 
 /// The scalar reference and the rows it samples into.
 struct Reference<'a> {
-    clip: &'a tcb_core::Clip,
+    clip: &'a tcb_core::SourceClip,
     want: Vec<f32>,
     want_v: Vec<f32>,
 }
 
 impl<'a> Reference<'a> {
     /// Rows for `clip`'s channels.
-    fn new(clip: &'a tcb_core::Clip) -> Self {
+    fn new(clip: &'a tcb_core::SourceClip) -> Self {
         let n = clip.channel_count();
         Self {
             clip,

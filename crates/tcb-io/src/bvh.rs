@@ -13,7 +13,7 @@
 //! # Ok::<(), tcb_io::Error>(())
 //! ```
 
-use crate::clip::{ClipDoc, SettingsDoc, TrackDoc};
+use crate::clip_json::{ClipDoc, SettingsDoc, TrackDoc};
 use crate::error::Error;
 use glam::{DQuat, DVec3, Vec3};
 use tcb_core::skeleton::{Joint, Skeleton, Transform};

@@ -506,7 +506,10 @@ struct NodeOut {
 
 /// The track names after `renames`, checked: every `from` names a track,
 /// and no two tracks end up with one name.
-fn renamed(clip: &tcb_core::Clip, renames: &[(String, String)]) -> Result<Vec<String>, Error> {
+fn renamed(
+    clip: &tcb_core::SourceClip,
+    renames: &[(String, String)],
+) -> Result<Vec<String>, Error> {
     let mut names: Vec<String> = clip.tracks().iter().map(|t| t.name.clone()).collect();
     for (from, to) in renames {
         let i = clip
@@ -554,7 +557,7 @@ impl Container {
 /// joints are the node hierarchy (children and rest transforms); tracks
 /// animate the node of their name. Returns the file bytes and the report.
 pub fn export(
-    clip: &tcb_core::Clip,
+    clip: &tcb_core::SourceClip,
     skeleton: Option<&Skeleton>,
     container: Container,
     options: &ExportOptions,
@@ -658,7 +661,7 @@ impl Scene {
     /// one channel of a mesh with that many morph targets.
     fn add_weights(
         &mut self,
-        clip: &tcb_core::Clip,
+        clip: &tcb_core::SourceClip,
         ni: usize,
         mut list: Vec<(usize, usize)>,
         max_error: f64,
@@ -882,7 +885,7 @@ fn read_back(kind: TrackKind, sampler: &Sampler) -> Result<TrackData, tcb_core::
         v
     };
     crate::gltf_import::sampler_track(String::new(), kind, times, sampler.interpolation, value)
-        .build(&crate::clip::SettingsDoc::default())
+        .build(&crate::clip_json::SettingsDoc::default())
 }
 
 /// How much more than its largest value at 9 evenly spaced points a cubic
@@ -1466,7 +1469,7 @@ impl Builder {
 
 /// Export to `path` (`.glb` binary, else `.gltf`), written atomically.
 pub fn export_file(
-    clip: &tcb_core::Clip,
+    clip: &tcb_core::SourceClip,
     skeleton: Option<&Skeleton>,
     path: impl AsRef<Path>,
     options: &ExportOptions,

@@ -6,7 +6,7 @@
 //! allocated, so a file claiming more than it holds is an error, not a panic
 //! or a huge allocation.
 
-use crate::clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
+use crate::clip_json::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc};
 use crate::error::Error;
 use glam::{Quat, Vec3};
 use gltf::Document;

@@ -2,7 +2,7 @@
 //!
 //! The clip file (`tcb-clip/1` JSON, the project's `docs/clip-format.md`):
 //! parsing with errors that name the file, the track and the key, building
-//! validated [`tcb_core::Clip`]s, and writing clips without leaving
+//! validated [`tcb_core::SourceClip`]s, and writing clips without leaving
 //! half-written files; BVH and glTF import, glTF export.
 //!
 //! Most programs start with [`load`]: a clip file, BVH or glTF by its
@@ -40,7 +40,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bvh;
-pub mod clip;
+pub mod clip_json;
 pub mod error;
 mod files;
 pub mod gltf_export;
@@ -48,7 +48,9 @@ pub mod gltf_import;
 mod json;
 mod skeleton_json;
 
-pub use clip::{ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc, write_clip_doc};
+pub use clip_json::{
+    ClipDoc, KeyDoc, SettingsDoc, TrackDoc, load_clip, read_clip_doc, write_clip_doc,
+};
 pub use error::{Error, ErrorKind, Location};
 pub use files::{DEFAULT_MAX_FILE_BYTES, ImportOptions, write_atomically};
 
@@ -61,8 +63,9 @@ use tcb_core::skeleton::Skeleton;
 pub struct Loaded {
     /// The clip as a document (what `tcb import` writes).
     pub doc: ClipDoc,
-    /// The clip, built and validated.
-    pub clip: tcb_core::Clip,
+    /// The source clip, built and validated (`tcb_runtime::Clip::compile`
+    /// makes the compiled clip a game plays).
+    pub clip: tcb_core::SourceClip,
     /// The joint hierarchy: the clip's `skeleton` (BVH and glTF imports
     /// fill it; BVH End Sites are leaf joints `<parent>_end` after the
     /// joints, [`bvh::Bvh::skeleton_with_end_sites`]).

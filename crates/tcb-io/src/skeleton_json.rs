@@ -168,7 +168,7 @@ impl<'a> SkeletonOut<'a> {
 
 #[cfg(test)]
 mod tests {
-    use crate::clip::ClipDoc;
+    use crate::clip_json::ClipDoc;
 
     fn clip(skeleton: &str) -> String {
         format!(

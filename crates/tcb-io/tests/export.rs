@@ -16,10 +16,10 @@ const CLIP: &str = r#"{"format": "tcb-clip/1", "name": "rt",
  ]}"#;
 
 fn round_trip(
-    clip: &tcb_core::Clip,
+    clip: &tcb_core::SourceClip,
     container: Container,
     max_error: f64,
-) -> (tcb_core::Clip, tcb_io::gltf_export::ExportReport) {
+) -> (tcb_core::SourceClip, tcb_io::gltf_export::ExportReport) {
     let options = tcb_io::gltf_export::ExportOptions::default().max_error(max_error);
     let (bytes, report) = export(clip, None, container, &options).unwrap();
     let back = import(&bytes, None, None, "rt").unwrap();
@@ -27,7 +27,11 @@ fn round_trip(
 }
 
 /// Largest difference per track (relative to max(1, |value|); rotations up to sign).
-fn compare(a: &tcb_core::Clip, b: &tcb_core::Clip, times: impl Iterator<Item = f64>) -> Vec<f64> {
+fn compare(
+    a: &tcb_core::SourceClip,
+    b: &tcb_core::SourceClip,
+    times: impl Iterator<Item = f64>,
+) -> Vec<f64> {
     let mut worst = vec![0.0f64; a.tracks().len()];
     let (mut va, mut vb) = (
         vec![0.0f32; a.channel_count()],
@@ -305,7 +309,7 @@ fn unused_tangents_are_zero() {
 
 /// A clip of one `a.translation` track at `times`, a wave of values with
 /// the default (curve) keys, so that its keys are exported as they are.
-fn at_times(times: &[f64]) -> tcb_core::Clip {
+fn at_times(times: &[f64]) -> tcb_core::SourceClip {
     let times: Vec<String> = times.iter().map(|t| format!("{t:?}")).collect();
     let values: Vec<String> = (0..times.len())
         .map(|k| format!("[{}, {}, 0]", (k % 3) as f32, (k % 2) as f32 * 2.0))
@@ -350,7 +354,7 @@ fn key_times_gltf_cannot_hold_are_refused() {
 /// `tcb import`, at the clip's keys, the f32 times glTF stores and 7
 /// points between each two of those, clamped into the clip's keys (glTF
 /// holds the end values).
-fn read_back_error(clip: &tcb_core::Clip, container: Container) -> (f64, ExportReport) {
+fn read_back_error(clip: &tcb_core::SourceClip, container: Container) -> (f64, ExportReport) {
     let (bytes, report) = export(clip, None, container, &Default::default()).unwrap();
     let back = import(&bytes, None, None, "rt")
         .unwrap()

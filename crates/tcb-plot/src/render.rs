@@ -5,17 +5,17 @@ use crate::plot::{Mode, Plot, PlotError, Rendered, draw, err};
 use crate::select::{self, Panel, Selection};
 use crate::{chart, legend, panel};
 use plotters::prelude::*;
-use tcb_core::Clip;
+use tcb_core::SourceClip;
 
 /// Draw `plot` of `clip` as an SVG document ([`render_with_notes`] without
 /// the notes).
-pub fn render(clip: &Clip, plot: &Plot) -> Result<String, PlotError> {
+pub fn render(clip: &SourceClip, plot: &Plot) -> Result<String, PlotError> {
     render_with_notes(clip, plot).map(|r| r.svg)
 }
 
 /// Draw `plot` of `clip`: choose the tracks and their panels, fix the time
 /// range, draw each panel.
-pub fn render_with_notes(clip: &Clip, plot: &Plot) -> Result<Rendered, PlotError> {
+pub fn render_with_notes(clip: &SourceClip, plot: &Plot) -> Result<Rendered, PlotError> {
     let Selection { panels, notes } = select::select(clip, plot)?;
     let range = time_range(&panels, plot)?;
     let svg = figure(&panels, plot, range)?;

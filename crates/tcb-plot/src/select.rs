@@ -3,7 +3,7 @@
 //! grouped by kind (vectors, rotations, scalars: one panel each).
 
 use crate::plot::{Mode, NAMES, Plot, PlotError};
-use tcb_core::{Clip, NamedTrack, TrackKind};
+use tcb_core::{NamedTrack, SourceClip, TrackKind};
 
 /// The kinds that share a panel: their values share units and a drawing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -57,7 +57,7 @@ pub(crate) struct Selection<'a> {
 const DEFAULT_CHANNELS: usize = 16;
 
 /// The tracks `plot` draws from `clip`, grouped into panels.
-pub(crate) fn select<'a>(clip: &'a Clip, plot: &Plot) -> Result<Selection<'a>, PlotError> {
+pub(crate) fn select<'a>(clip: &'a SourceClip, plot: &Plot) -> Result<Selection<'a>, PlotError> {
     if clip.tracks().is_empty() {
         return Err(PlotError("the clip has no tracks".into()));
     }
@@ -98,7 +98,7 @@ pub(crate) fn select<'a>(clip: &'a Clip, plot: &Plot) -> Result<Selection<'a>, P
 }
 
 /// The track called `name`, or an error listing what the clip has.
-fn named<'a>(clip: &'a Clip, name: &str) -> Result<&'a NamedTrack, PlotError> {
+fn named<'a>(clip: &'a SourceClip, name: &str) -> Result<&'a NamedTrack, PlotError> {
     clip.tracks()
         .iter()
         .find(|t| t.name == name)

@@ -95,7 +95,7 @@ fn bad_requests_are_one_clear_line() {
 fn dense_capture_is_drawn_as_a_line_without_marks() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let cmu = tcb_io::load(root.join("data/cmu-01_01.bvh")).unwrap();
-    let path = |clip: &tcb_core::Clip, track: &str| {
+    let path = |clip: &tcb_core::SourceClip, track: &str| {
         let plot = tcb_plot::Plot {
             tracks: vec![track.into()],
             mode: tcb_plot::Mode::Path { components: [0, 2] },

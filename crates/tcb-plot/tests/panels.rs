@@ -6,7 +6,7 @@ use std::path::Path;
 use tcb_core::skeleton::{Joint, Skeleton, Transform};
 use tcb_plot::{Mode, Plot, render_with_notes};
 
-fn load(clip: &str) -> tcb_core::Clip {
+fn load(clip: &str) -> tcb_core::SourceClip {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     tcb_io::load(root.join(clip)).unwrap().clip
 }

@@ -24,7 +24,7 @@ fn times(n: usize, seed: u64) -> Vec<f64> {
     t
 }
 
-fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::Clip {
+fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::SourceClip {
     let s = TrackSettings::default();
     let tracks = (0..count)
         .map(|i| {
@@ -36,11 +36,11 @@ fn scalar_tracks(count: usize, keys: usize, shared: bool) -> tcb_core::Clip {
             }
         })
         .collect();
-    tcb_core::Clip::new("synthetic", tracks).expect("unique track names")
+    tcb_core::SourceClip::new("synthetic", tracks).expect("unique track names")
 }
 
 /// `count` rotations, each on key times of its own.
-fn sparse_rotations(count: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
+fn sparse_rotations(count: usize, keys: usize, mode: RotationMode) -> tcb_core::SourceClip {
     let s = TrackSettings {
         rotation: mode,
         ..Default::default()
@@ -64,16 +64,21 @@ fn sparse_rotations(count: usize, keys: usize, mode: RotationMode) -> tcb_core::
             }
         })
         .collect();
-    tcb_core::Clip::new("sparse-rotations", tracks).expect("unique track names")
+    tcb_core::SourceClip::new("sparse-rotations", tracks).expect("unique track names")
 }
 
-fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::Clip {
+fn skeleton(joints: usize, keys: usize, mode: RotationMode) -> tcb_core::SourceClip {
     skeleton_turning(joints, keys, mode, 1.0)
 }
 
 /// As `skeleton`, the rotation between keys `turn` times larger (large
 /// turns put squad segments on the exact f64 path).
-fn skeleton_turning(joints: usize, keys: usize, mode: RotationMode, turn: f32) -> tcb_core::Clip {
+fn skeleton_turning(
+    joints: usize,
+    keys: usize,
+    mode: RotationMode,
+    turn: f32,
+) -> tcb_core::SourceClip {
     let s = TrackSettings {
         rotation: mode,
         ..Default::default()
@@ -109,17 +114,17 @@ fn skeleton_turning(joints: usize, keys: usize, mode: RotationMode, turn: f32) -
             data: TrackData::Quat(RotationTrack::new(t.clone(), q, vec![], &s).unwrap()),
         });
     }
-    tcb_core::Clip::new("skeleton", tracks).expect("unique track names")
+    tcb_core::SourceClip::new("skeleton", tracks).expect("unique track names")
 }
 
-fn play(c: &mut Criterion, group: &str, clip: &tcb_core::Clip, channels: u64) {
+fn play(c: &mut Criterion, group: &str, clip: &tcb_core::SourceClip, channels: u64) {
     play_with(c, group, clip, channels, &CompileOptions::default());
 }
 
 fn play_with(
     c: &mut Criterion,
     group: &str,
-    clip: &tcb_core::Clip,
+    clip: &tcb_core::SourceClip,
     channels: u64,
     options: &CompileOptions,
 ) {

@@ -154,7 +154,7 @@ impl Clip {
         self.time_range
     }
 
-    /// Values per sample, as [`tcb_core::Clip::channel_count`] (a rotation counts 4).
+    /// Values per sample, as [`tcb_core::SourceClip::channel_count`] (a rotation counts 4).
     pub fn channel_count(&self) -> usize {
         self.layout.slots.iter().map(|s| s.kind.dim()).sum()
     }

@@ -200,7 +200,7 @@ impl Rig {
 
     /// The tracks of `clip`, in file order, resting at zero (rotations at
     /// the identity). Fails when two tracks share a name (a hand-built
-    /// `tcb_core::Clip`; the clip file and the importers refuse that).
+    /// `tcb_core::SourceClip`; the clip file and the importers refuse that).
     pub fn from_clip(clip: &Clip) -> Result<Self, RigError> {
         let tracks = clip
             .tracks()
@@ -334,7 +334,7 @@ mod tests {
     }
 
     /// A hand-built clip with two tracks of one name: `from_clip` used to
-    /// panic on it. Such a clip can no longer be made: `tcb_core::Clip::new`
+    /// panic on it. Such a clip can no longer be made: `tcb_core::SourceClip::new`
     /// refuses it (its fields are private).
     #[test]
     fn a_clip_with_a_repeated_name_is_refused() {
@@ -350,9 +350,9 @@ mod tests {
                 .unwrap(),
             ),
         };
-        let twice = tcb_core::Clip::new("twice", vec![track(1.0), track(2.0)]);
+        let twice = tcb_core::SourceClip::new("twice", vec![track(1.0), track(2.0)]);
         assert_eq!(twice, Err(tcb_core::DuplicateTrack("x".into())));
-        let once = Clip::compile(&tcb_core::Clip::new("once", vec![track(1.0)]).unwrap());
+        let once = Clip::compile(&tcb_core::SourceClip::new("once", vec![track(1.0)]).unwrap());
         assert_eq!(Rig::from_clip(&once).unwrap().tracks().len(), 1);
     }
 

@@ -45,7 +45,7 @@ fn clip(names: &[&str]) -> Arc<Clip> {
         })
         .collect();
     Arc::new(Clip::compile(
-        &tcb_core::Clip::new("c", tracks).expect("unique names"),
+        &tcb_core::SourceClip::new("c", tracks).expect("unique names"),
     ))
 }
 
@@ -207,7 +207,7 @@ fn quantizing_extreme_ranges() {
         &TrackSettings::default(),
     )
     .expect("finite values");
-    let src = tcb_core::Clip::new(
+    let src = tcb_core::SourceClip::new(
         "q",
         vec![NamedTrack {
             name: "v".into(),
@@ -268,7 +268,7 @@ fn quantizing_ranges_beyond_f32() {
         // One track alone is a loose lane; with 3 more (12 channels) a group.
         let mut tracks = vec![track("v".into(), extreme)];
         tracks.extend((0..others).map(|i| track(format!("o{i}"), [0.0, 1.0, 2.0, 1.0])));
-        let src = tcb_core::Clip::new("q", tracks).expect("unique names");
+        let src = tcb_core::SourceClip::new("q", tracks).expect("unique names");
         let q = Arc::new(Clip::compile_with(
             &src,
             &CompileOptions::default().quantize(true),

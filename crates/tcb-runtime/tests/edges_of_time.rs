@@ -20,7 +20,7 @@ fn ulps(x: f64, n: i32) -> f64 {
     x
 }
 
-fn clip(text: &str) -> tcb_core::Clip {
+fn clip(text: &str) -> tcb_core::SourceClip {
     tcb_io::ClipDoc::parse(text)
         .expect("the test's clip parses")
         .build()
@@ -29,7 +29,7 @@ fn clip(text: &str) -> tcb_core::Clip {
 
 /// Where the runtime (forward playback over `times`, and a fresh instance
 /// per time, with velocities) and the reference disagree.
-fn mismatches(clip: &tcb_core::Clip, times: &[f64]) -> Vec<String> {
+fn mismatches(clip: &tcb_core::SourceClip, times: &[f64]) -> Vec<String> {
     let compiled = Arc::new(Clip::compile(clip));
     let n = clip.channel_count();
     let (mut got, mut want) = (vec![0.0f32; n], vec![0.0f32; n]);

@@ -177,7 +177,7 @@ fn rotation_track_with(
 
 /// A clip with `channels` scalar channels on one grid (in tracks of mixed
 /// kinds) plus rotations and a few tracks on grids of their own.
-fn random_clip(seed: u64, channels: usize) -> tcb_core::Clip {
+fn random_clip(seed: u64, channels: usize) -> tcb_core::SourceClip {
     let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
     let n = 3 + rng.below(6);
     let shared = times(&mut rng, n);
@@ -222,7 +222,7 @@ fn random_clip(seed: u64, channels: usize) -> tcb_core::Clip {
         }
         tracks.push(TrackData::Quat(rotation_track(&mut rng, &own, &rs)));
     }
-    tcb_core::Clip::new(
+    tcb_core::SourceClip::new(
         format!("random-{seed}"),
         tracks
             .into_iter()
@@ -250,7 +250,7 @@ impl RotationSafe for Extrapolation {
     }
 }
 
-fn sample_times(rng: &mut Rng, clip: &tcb_core::Clip) -> Vec<f64> {
+fn sample_times(rng: &mut Rng, clip: &tcb_core::SourceClip) -> Vec<f64> {
     let (a, b) = clip.time_range().unwrap();
     let mut t: Vec<f64> = clip.key_times();
     for _ in 0..40 {
@@ -271,7 +271,7 @@ fn sample_times(rng: &mut Rng, clip: &tcb_core::Clip) -> Vec<f64> {
 /// up to sign to 1e-6 relative (absolute below 1), their velocities to 1e-4
 /// of the rotation's speed ([`velocity_tolerance`]).
 fn assert_rows_match(
-    clip: &tcb_core::Clip,
+    clip: &tcb_core::SourceClip,
     time: f64,
     got: (&[f32], &[f32]),
     want: (&[f32], &[f32]),
@@ -360,7 +360,7 @@ fn describe(data: &TrackData, time: f64) -> String {
     }
 }
 
-fn check_clip(clip: &tcb_core::Clip, seed: u64) {
+fn check_clip(clip: &tcb_core::SourceClip, seed: u64) {
     let compiled = Arc::new(Clip::compile(clip));
     let mut inst = Instance::new(compiled.clone()).with_velocities();
     // Without velocities the runtime may take other paths (segments whose
@@ -418,7 +418,7 @@ fn wild_rotations_stay_within_1e_6() {
             ..s
         };
         let track = rotation_track_with(&mut rng, &t, &s, std::f64::consts::PI);
-        let clip = tcb_core::Clip::new(
+        let clip = tcb_core::SourceClip::new(
             "wild",
             vec![NamedTrack {
                 name: "q".into(),
@@ -496,7 +496,7 @@ fn dense_squad_without_velocities() {
                 data: TrackData::Quat(rotation_track_with(&mut rng, &t, &s, 0.05)),
             })
             .collect();
-        let clip = tcb_core::Clip::new("capture", tracks).expect("unique track names");
+        let clip = tcb_core::SourceClip::new("capture", tracks).expect("unique track names");
         velocity_only += Clip::compile(&clip).stats().exact_for_velocity_only;
         check_clip(&clip, seed);
     }
@@ -537,7 +537,7 @@ fn rotations_on_their_own_grids() {
                 data: TrackData::Quat(rotation_track(&mut rng, &t, &s)),
             });
         }
-        let clip = tcb_core::Clip::new("own rotations", tracks).expect("unique track names");
+        let clip = tcb_core::SourceClip::new("own rotations", tracks).expect("unique track names");
         loose += Clip::compile(&clip).loose_track_count();
         check_clip(&clip, seed);
     }
@@ -574,7 +574,7 @@ fn a_segment_no_split_holds_leaves_the_others_split() {
     let n = t.len();
     let track = RotationTrack::new(t, values, vec![KeyParams::default(); n], &s)
         .expect("valid rotation keys");
-    let clip = tcb_core::Clip::new(
+    let clip = tcb_core::SourceClip::new(
         "short segment",
         vec![NamedTrack {
             name: "r".into(),
@@ -619,7 +619,7 @@ fn tracks_on_their_own_grids() {
                 data,
             });
         }
-        let clip = tcb_core::Clip::new("own", tracks).expect("unique track names");
+        let clip = tcb_core::SourceClip::new("own", tracks).expect("unique track names");
         let compiled = Clip::compile(&clip);
         assert_eq!(compiled.loose_track_count(), clip.tracks().len());
         assert_eq!(compiled.group_count(), 0);
@@ -733,7 +733,7 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
             ..TrackSettings::default()
         };
         let track = RotationTrack::new(t, q.to_vec(), vec![key; 4], &s).expect("finite parameters");
-        let clip = tcb_core::Clip::new(
+        let clip = tcb_core::SourceClip::new(
             "overflow",
             vec![NamedTrack {
                 name: "r".into(),
@@ -762,7 +762,7 @@ fn rotations_with_overflowing_tangents_hold_their_keys() {
             },
         )
         .expect("finite parameters");
-        let vclip = tcb_core::Clip::new(
+        let vclip = tcb_core::SourceClip::new(
             "overflow",
             vec![NamedTrack {
                 name: "v".into(),
@@ -855,7 +855,7 @@ fn step_segments_hold_their_keys_past_overflowing_tangents() {
             ),
         },
     ];
-    let clip = tcb_core::Clip::new("step", tracks).expect("unique track names");
+    let clip = tcb_core::SourceClip::new("step", tracks).expect("unique track names");
     let compiled = Arc::new(Clip::compile(&clip));
     let mut inst = Instance::new(compiled.clone()).with_velocities();
     let n = clip.channel_count();
@@ -915,7 +915,7 @@ fn rotations_with_huge_tangents_stay_unit() {
                 }
             })
             .collect();
-        let clip = tcb_core::Clip::new("huge", named).expect("unique track names");
+        let clip = tcb_core::SourceClip::new("huge", named).expect("unique track names");
         let compiled = Arc::new(Clip::compile(&clip));
         assert_eq!(compiled.group_count(), usize::from(tracks > 1));
         for velocities in [false, true] {
@@ -971,7 +971,7 @@ fn mapped_times_rounded_below_the_first_key() {
         ..KeyParams::default()
     };
     let track = Track::new(times, values, vec![key; n], &settings).expect("valid");
-    let clip = tcb_core::Clip::new(
+    let clip = tcb_core::SourceClip::new(
         "oscillate",
         vec![NamedTrack {
             name: "v".into(),
@@ -1054,7 +1054,7 @@ fn dense_own_keys_played_at_a_lower_rate() {
                 }
             })
             .collect();
-        let clip = tcb_core::Clip::new("dense", tracks).expect("unique track names");
+        let clip = tcb_core::SourceClip::new("dense", tracks).expect("unique track names");
         let compiled = Arc::new(Clip::compile(&clip));
         assert!(compiled.loose_track_count() > 0, "seed {seed}");
         let (a, b) = clip.time_range().unwrap();

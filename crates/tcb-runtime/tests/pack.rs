@@ -7,7 +7,7 @@ use tcb_runtime::{Clip, Instance, PackSource, Packed};
 
 /// The bundled CMU capture (hermite), quantized with steps of 2^-14
 /// (rotations) and 2^-8 (the root translation, in the clip's units).
-fn cmu() -> (tcb_core::Clip, PackSource) {
+fn cmu() -> (tcb_core::SourceClip, PackSource) {
     let bvh = include_str!("../../../data/cmu-01_01.bvh");
     let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
     let clip = bvh

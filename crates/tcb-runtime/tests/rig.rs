@@ -14,8 +14,8 @@ const MISSING: &str = "LeftArm.rotation";
 
 struct Setup {
     rig: Arc<Rig>,
-    a: tcb_core::Clip,
-    b: tcb_core::Clip,
+    a: tcb_core::SourceClip,
+    b: tcb_core::SourceClip,
     ca: Arc<Clip>,
     cb: Arc<Clip>,
 }
@@ -55,7 +55,7 @@ fn setup() -> Setup {
 }
 
 /// The reference value of rig track `name` in `clip` at `time`, or its rest.
-fn reference(rig: &Rig, clip: &tcb_core::Clip, name: &str, time: f64) -> [f64; 4] {
+fn reference(rig: &Rig, clip: &tcb_core::SourceClip, name: &str, time: f64) -> [f64; 4] {
     let mut v = [0.0f32; 4];
     match clip.tracks().iter().find(|t| t.name == name) {
         Some(t) => t.data.sample_into(time, &mut v, None),

@@ -63,7 +63,7 @@ fn a_pose_of_another_layout_or_a_short_slice_is_an_error() {
     // A clip of the same joints but one track fewer: another layout.
     let tracks = source.clone().into_tracks();
     let fewer = tracks.into_iter().filter(|t| t.name != "Head.rotation");
-    let fewer = tcb_core::Clip::new("fewer", fewer.collect()).unwrap();
+    let fewer = tcb_core::SourceClip::new("fewer", fewer.collect()).unwrap();
     let mut other = Instance::new(Arc::new(Clip::compile(&fewer)));
     let err = binding
         .model_transforms(other.sample(1.0), &mut local, &mut model)

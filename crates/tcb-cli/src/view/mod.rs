@@ -21,7 +21,7 @@ mod poses;
 
 use serde::Serialize;
 use std::sync::Arc;
-use tcb_core::Clip;
+use tcb_core::SourceClip;
 use tcb_core::skeleton::Skeleton;
 
 const TEMPLATE: &str = include_str!("page.html");
@@ -66,7 +66,7 @@ struct Data<'a> {
 /// The page of `clip` played by `runtime` (`clip` compiled, or the packed
 /// stream whose reference it is) on `skeleton` (none: its curves alone).
 pub(crate) fn page(
-    clip: &Clip,
+    clip: &SourceClip,
     skeleton: Option<&Skeleton>,
     runtime: Arc<tcb_runtime::Clip>,
     options: &Options,

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 use serde::Serialize;
-use tcb_core::Clip;
+use tcb_core::SourceClip;
 use tcb_core::skeleton::Skeleton;
 
 /// Most plots one page holds (a group past these is left out, and named
@@ -30,7 +30,7 @@ pub(crate) struct Group {
 /// The groups of `clip`'s tracks, in the order of their first track: a
 /// joint of `skeleton` for `<joint>.translation|rotation|scale`, else the
 /// name up to its last dot (the whole name without one).
-pub(crate) fn groups(clip: &Clip, skeleton: Option<&Skeleton>) -> Vec<(String, Vec<String>)> {
+pub(crate) fn groups(clip: &SourceClip, skeleton: Option<&Skeleton>) -> Vec<(String, Vec<String>)> {
     let mut groups: Vec<(String, Vec<String>)> = Vec::new();
     for t in clip.tracks() {
         let split = t.name.rsplit_once('.');
@@ -52,7 +52,7 @@ pub(crate) fn groups(clip: &Clip, skeleton: Option<&Skeleton>) -> Vec<(String, V
 /// The time range every plot shares: `tcb plot`'s default for the whole
 /// clip (the keys' range, 15% wider each side; a second each side of a
 /// single key time).
-pub(crate) fn time_range(clip: &Clip) -> Option<(f64, f64)> {
+pub(crate) fn time_range(clip: &SourceClip) -> Option<(f64, f64)> {
     let (first, last) = clip.time_range()?;
     let margin = if last > first {
         0.15 * (last - first)
@@ -66,7 +66,7 @@ pub(crate) fn time_range(clip: &Clip) -> Option<(f64, f64)> {
 /// (at most [`MAX_PLOTS`]), and the notes for the user: tcb-plot's, and the
 /// groups left out.
 pub(crate) fn plots(
-    clip: &Clip,
+    clip: &SourceClip,
     groups: Vec<(String, Vec<String>)>,
     title: &str,
 ) -> Result<(Vec<Group>, Vec<String>), tcb_plot::PlotError> {

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 use std::sync::Arc;
-use tcb_core::Clip;
+use tcb_core::SourceClip;
 use tcb_core::sample_times::{frame_count, frame_times};
 use tcb_core::skeleton::Skeleton;
 
@@ -32,7 +32,7 @@ pub(crate) struct Frames {
 /// The frames of `clip` at `fps`, or by default at the clip's own rate:
 /// its key times when they are one even grid (motion capture, baked
 /// animation), else [`DEFAULT_FPS`] over its keys' range.
-pub(crate) fn frames(clip: &Clip, fps: Option<f64>) -> Result<Frames, String> {
+pub(crate) fn frames(clip: &SourceClip, fps: Option<f64>) -> Result<Frames, String> {
     let (first, last) = clip.time_range().ok_or("the clip has no tracks to view")?;
     if let Some(fps) = fps
         && !(fps > 0.0 && fps.is_finite())
@@ -108,7 +108,7 @@ pub(crate) struct Figure {
 /// compiled, or the packed stream whose reference it is) sampled by an
 /// instance and bound to `skeleton` ([`tcb_runtime::SkeletonBinding`]).
 pub(crate) fn figure(
-    clip: &Clip,
+    clip: &SourceClip,
     runtime: Arc<tcb_runtime::Clip>,
     skeleton: &Skeleton,
     times: &[f64],
@@ -181,7 +181,7 @@ pub(crate) fn figure(
 mod tests {
     use super::*;
 
-    fn clip(tracks: &str) -> Clip {
+    fn clip(tracks: &str) -> SourceClip {
         let text = format!(r#"{{"format": "tcb-clip/1", "tracks": [{tracks}]}}"#);
         tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()
     }

@@ -7,7 +7,7 @@
 //! reference's own formulas on 8 lanes; their signatures follow the
 //! runtime's needs and the `wide` version in use, and may change in any
 //! release. What a user needs is public elsewhere: [`crate::Track`],
-//! [`crate::RotationTrack`] and [`crate::Clip`] sample, and
+//! [`crate::RotationTrack`] and [`crate::SourceClip`] sample, and
 //! [`crate::rotation`] has slerp, squad and quaternion log and exp on
 //! `glam` types.
 //!

@@ -1,4 +1,4 @@
-//! Compiling a validated [`tcb_core::Clip`] into the runtime's layout
+//! Compiling a validated [`tcb_core::SourceClip`] into the runtime's layout
 //! ([`crate::clip`]), offline, in named steps:
 //!
 //! 1. [`group_tracks`]: tracks by identical time grid, each as per-channel
@@ -139,7 +139,7 @@ impl Clip {
     /// let clip = tcb_runtime::Clip::compile(&clip);
     /// assert_eq!(clip.track("x").map(|t| t.index()), Some(0));
     /// ```
-    pub fn compile(source: &tcb_core::Clip) -> Self {
+    pub fn compile(source: &tcb_core::SourceClip) -> Self {
         Clip::compile_with(source, &CompileOptions::default())
     }
 
@@ -158,7 +158,7 @@ impl Clip {
     /// let hips = small.track("Hips.translation").unwrap();
     /// assert!(small.quantization_error(hips).unwrap() < 1e-3); // in the clip's units
     /// ```
-    pub fn compile_with(source: &tcb_core::Clip, options: &CompileOptions) -> Self {
+    pub fn compile_with(source: &tcb_core::SourceClip, options: &CompileOptions) -> Self {
         compile_impl(source, options, false)
     }
 }
@@ -166,7 +166,7 @@ impl Clip {
 /// [`Clip::compile_with`]; with `groups_only`, small groups stay groups
 /// rather than loose lanes (a packed clip's one group).
 pub(crate) fn compile_impl(
-    source: &tcb_core::Clip,
+    source: &tcb_core::SourceClip,
     options: &CompileOptions,
     groups_only: bool,
 ) -> Clip {
@@ -234,7 +234,7 @@ pub(crate) fn compile_impl(
 
 /// Step 1: tracks grouped by identical grid (times, eases, steps, `pre`
 /// and `post`), each as its channels' controls.
-fn group_tracks(source: &tcb_core::Clip, options: &CompileOptions) -> Grouping {
+fn group_tracks(source: &tcb_core::SourceClip, options: &CompileOptions) -> Grouping {
     let mut group_of: HashMap<GridKey, usize> = HashMap::new();
     let mut out = Grouping {
         grids: Vec::new(),

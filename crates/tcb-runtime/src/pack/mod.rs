@@ -22,7 +22,7 @@
 //!
 //! [`PackSource`] is the description in integers (what the encoder in
 //! `tcb-fit` searches over); [`PackSource::to_clip`] is its reference, an
-//! ordinary `tcb_core::Clip` whose values are the dequantized integers;
+//! ordinary `tcb_core::SourceClip` whose values are the dequantized integers;
 //! [`Packed`] is the encoded form and the file. [`crate::Clip::from_packed`]
 //! compiles it: the runtime's controls come from decoding keys as playback
 //! reaches them, checked at compile time to equal, bit for bit, the controls
@@ -32,8 +32,7 @@ use std::fmt;
 use std::ops::Range;
 use tcb_core::params::{Hemisphere, RotationMode, TangentRule, Tcb};
 use tcb_core::{
-    Clip as SourceClip, KeyParams, NamedTrack, RotationTrack, Track, TrackData, TrackKind,
-    TrackSettings,
+    KeyParams, NamedTrack, RotationTrack, SourceClip, Track, TrackData, TrackKind, TrackSettings,
 };
 
 /// Keys per block by default: a block starts from absolute values (a seek

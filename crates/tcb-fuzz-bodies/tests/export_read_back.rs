@@ -2,88 +2,44 @@
 //! export either reads back within what it reports (relative to max(1,
 //! |value|), rotations up to sign, plus 1e-5) or is refused with a
 //! message. Each clip here is a fuzz finding, its tracks renamed for glTF
-//! as the target names them.
+//! as the target names them, checked by the target's own comparison
+//! (`export_and_read_back`, `read_back_misses`: one copy, this crate's).
 
+use tcb_core::NamedTrack;
+use tcb_fuzz_bodies::{export_and_read_back, read_back_misses};
 use tcb_io::gltf_export::{Container, ExportOptions, export};
-use tcb_io::gltf_import::import;
 
 /// Export `text`'s clip, import it, and return what is wrong: the import's
-/// error, or each track's largest difference beyond what was reported.
+/// error, or each track's largest difference beyond what was reported
+/// (the `export` target's own check, on denser times: below).
 fn read_back(text: &str, max_error: f64) -> Result<Vec<String>, String> {
     let clip = tcb_io::ClipDoc::parse(text).unwrap().build().unwrap();
     let options = ExportOptions::default().max_error(max_error);
-    let Ok((bytes, report)) = export(&clip, None, Container::Glb, &options) else {
+    let Some(read) = export_and_read_back(&clip, Container::Glb, &options) else {
         return Ok(Vec::new()); // refused: allowed
     };
-    let back = import(&bytes, None, None, "rt")
-        .map_err(|e| e.to_string())?
-        .doc
-        .build()
-        .map_err(|e| e.to_string())?;
-    let (mut va, mut vb) = (
-        vec![0.0f32; clip.channel_count()],
-        vec![0.0f32; back.channel_count()],
-    );
-    let mut bad = Vec::new();
-    for (i, track) in clip.tracks().iter().enumerate() {
+    let (back, report) = read?;
+    let mut near_keys = Vec::new();
+    for &k in clip.key_times().iter().chain(&back.key_times()) {
+        let (mut up, mut down) = (k as f32, k as f32);
+        for _ in 0..3 {
+            (up, down) = (up.next_up(), down.next_down());
+            near_keys.extend([f64::from(up), f64::from(down)]);
+        }
+    }
+    // 401 even points over each track's keys, and 1 to 3 f32 steps either
+    // side of each key of both clips (where the `export` target's edge
+    // times fall).
+    let times = |track: &NamedTrack| {
         let keys = track.data.times();
         let (t0, t1) = (keys[0], keys[keys.len() - 1]);
-        let bt: usize = back
-            .tracks()
-            .iter()
-            .take_while(|o| o.name != track.name)
-            .map(|o| o.data.kind().dim())
-            .sum();
-        let at: usize = clip.tracks()[..i].iter().map(|o| o.data.kind().dim()).sum();
-        let dim = track.data.kind().dim();
-        let stated = report
-            .tracks
-            .iter()
-            .find(|r| r.name == track.name)
-            .expect("every track reported")
-            .error();
-        let mut worst = (0.0f64, 0.0);
-        // 401 even points, and 1 to 3 f32 steps either side of each key of
-        // both clips (where the `export` target's edge times fall).
         let mut times: Vec<f64> = (0..=400)
             .map(|j| t0 + (t1 - t0) * f64::from(j) / 400.0)
             .collect();
-        for &k in clip.key_times().iter().chain(&back.key_times()) {
-            let (mut up, mut down) = (k as f32, k as f32);
-            for _ in 0..3 {
-                (up, down) = (up.next_up(), down.next_down());
-                times.extend([f64::from(up), f64::from(down)]);
-            }
-        }
-        times.retain(|t| (t0..=t1).contains(t));
-        for t in times {
-            clip.sample_into(t, &mut va, None);
-            back.sample_into(t, &mut vb, None);
-            let d = |s: f32| {
-                (0..dim)
-                    .map(|c| {
-                        let (a, b) = (va[at + c], vb[bt + c]);
-                        f64::from((a - s * b).abs() / a.abs().max(1.0))
-                    })
-                    .fold(0.0, |m: f64, x| if x.is_nan() || x > m { x } else { m })
-            };
-            let e = if dim == 4 && track.data.kind() == tcb_core::TrackKind::Quat {
-                d(1.0).min(d(-1.0))
-            } else {
-                d(1.0)
-            };
-            if e.is_nan() || e > worst.0 {
-                worst = (e, t);
-            }
-        }
-        if worst.0.is_nan() || worst.0 > stated.unwrap_or(0.0) + 1e-5 {
-            bad.push(format!(
-                "{}: off by {:e} at {}, reported {stated:?}",
-                track.name, worst.0, worst.1
-            ));
-        }
-    }
-    Ok(bad)
+        times.extend(&near_keys);
+        times
+    };
+    Ok(read_back_misses(&clip, &back, &report, times))
 }
 
 /// A default tension of -9e305 makes the tangents overflow f32: the

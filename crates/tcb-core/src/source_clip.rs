@@ -1,5 +1,7 @@
-//! A clip: named tracks of any kind, sampled together into flat rows of
-//! `f32` channels (the columns of `tcb sample`).
+//! The source clip: named tracks of any kind, as a clip file, BVH or glTF
+//! describes them, sampled together into flat rows of `f32` channels (the
+//! columns of `tcb sample`). What a game plays is the compiled clip,
+//! `tcb_runtime::Clip`, built from one.
 
 use crate::params::TrackSettings;
 use crate::rotation::RotationTrack;
@@ -150,27 +152,30 @@ pub struct NamedTrack {
     pub data: TrackData,
 }
 
-/// Named tracks sampled together.
+/// The source clip: named, validated tracks sampled together by the scalar
+/// reference. `tcb_io::load(path)?.clip` is one; `tcb_runtime::Clip::compile`
+/// turns one into the compiled clip that instances play (ozz's raw
+/// animation and animation).
 ///
 /// ```
-/// use tcb_core::{Clip, NamedTrack, Track, TrackData, TrackSettings};
+/// use tcb_core::{SourceClip, NamedTrack, Track, TrackData, TrackSettings};
 /// let squash = Track::new(vec![0.0, 1.25], vec![1.0f32, 0.6], vec![], &TrackSettings::default()).unwrap();
 /// let squash = NamedTrack { name: "ball.squash".into(), data: TrackData::Scalar(squash) };
-/// let clip = Clip::new("bounce", vec![squash.clone()]).unwrap();
+/// let clip = SourceClip::new("bounce", vec![squash.clone()]).unwrap();
 /// // Track names are unique in a clip.
-/// assert!(Clip::new("bounce", vec![squash.clone(), squash]).is_err());
+/// assert!(SourceClip::new("bounce", vec![squash.clone(), squash]).is_err());
 /// assert_eq!(clip.column_names(), ["ball.squash"]);
 /// let mut row = vec![0.0; clip.channel_count()];
 /// clip.sample_into(1.25, &mut row, None);
 /// assert_eq!(row, [0.6]);
 /// ```
 #[derive(Clone, Debug, PartialEq, Default)]
-pub struct Clip {
+pub struct SourceClip {
     name: String,
     tracks: Vec<NamedTrack>,
 }
 
-/// A clip [`Clip::new`] refuses: two tracks have this name.
+/// A clip [`SourceClip::new`] refuses: two tracks have this name.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct DuplicateTrack(pub String);
 
@@ -182,14 +187,14 @@ impl std::fmt::Display for DuplicateTrack {
 
 impl std::error::Error for DuplicateTrack {}
 
-impl Clip {
+impl SourceClip {
     /// A clip of `tracks` (file order), whose names must be unique.
     pub fn new(name: impl Into<String>, tracks: Vec<NamedTrack>) -> Result<Self, DuplicateTrack> {
         let mut seen = std::collections::HashSet::new();
         if let Some(t) = tracks.iter().find(|t| !seen.insert(t.name.as_str())) {
             return Err(DuplicateTrack(t.name.clone()));
         }
-        Ok(Clip {
+        Ok(SourceClip {
             name: name.into(),
             tracks,
         })
@@ -232,7 +237,7 @@ impl Clip {
     }
 
     /// Sample every track at `time` into `values` (and `velocities`), each
-    /// [`Clip::channel_count`] long (shorter slices get the channels that
+    /// [`SourceClip::channel_count`] long (shorter slices get the channels that
     /// fit; longer ones keep the rest).
     pub fn sample_into(&self, time: f64, values: &mut [f32], mut velocities: Option<&mut [f32]>) {
         let mut at = 0;

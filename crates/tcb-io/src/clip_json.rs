@@ -2,7 +2,7 @@
 //!
 //! [`ClipDoc`] is the file as written: every optional field stays optional,
 //! so a clip read and written again says no more than it said. [`ClipDoc::build`]
-//! resolves defaults and builds the validated [`tcb_core::Clip`].
+//! resolves defaults and builds the validated [`tcb_core::SourceClip`].
 //!
 //! Reading and writing go through serde. Parsing is strict: unknown fields
 //! are errors (a misspelt `tangent_rule` would otherwise silently give
@@ -26,8 +26,8 @@ use std::collections::HashMap;
 use std::path::Path;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{
-    Clip, Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
-    RotationTrack, TangentRule, Tcb, Track, TrackData, TrackKind, TrackSettings, Value,
+    Ease, Ends, Extrapolation, Hemisphere, Interp, KeyParams, NamedTrack, RotationMode,
+    RotationTrack, SourceClip, TangentRule, Tcb, Track, TrackData, TrackKind, TrackSettings, Value,
 };
 
 /// The format string a clip file carries.
@@ -194,7 +194,7 @@ pub struct ClipDoc {
 /// println!("{} channels", clip.channel_count());
 /// # Ok::<(), tcb_io::Error>(())
 /// ```
-pub fn load_clip(path: impl AsRef<Path>) -> Result<Clip, Error> {
+pub fn load_clip(path: impl AsRef<Path>) -> Result<SourceClip, Error> {
     let path = path.as_ref();
     let doc = read_clip_doc(path)?;
     doc.build().map_err(|e| e.in_file(path))
@@ -258,7 +258,7 @@ impl ClipDoc {
     }
 
     /// Resolve defaults and build every track. Errors name the track and key.
-    pub fn build(&self) -> Result<Clip, Error> {
+    pub fn build(&self) -> Result<SourceClip, Error> {
         // A default tcb is checked even where every key states its own: a
         // clip that builds must write as it is, and JSON has no NaN.
         let tcb_error = |s: &SettingsDoc| {
@@ -302,7 +302,7 @@ impl ClipDoc {
             });
         }
         // Names were checked above, with the track that repeats one.
-        Clip::new(self.name.clone(), tracks).map_err(|e| {
+        SourceClip::new(self.name.clone(), tracks).map_err(|e| {
             Error::invalid(
                 Location {
                     track: Some(quote(&e.0)),
