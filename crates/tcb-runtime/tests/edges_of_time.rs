@@ -304,10 +304,10 @@ fn squad_on_a_segment_a_few_ulps_long() {
 /// the `playback` target's 20-minute run of 2026-12-05): the runtime holds
 /// the step's key (math.md: it "stays P_k"), the reference gives the last
 /// key [2.63, 0.094, 6.41] a hair early: `tcb_core::Track::evaluate`
-/// snaps to the last key where the segment parameter `u` is 1, and here
-/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1.
+/// snapped to the last key where the segment parameter `u` is 1, and here
+/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1. The reference now gives the
+/// last key where the time reaches the last key's, as the runtime does.
 #[test]
-#[ignore = "issue 29 class 2: one ulp before a final step key the reference gives the last key (its u rounds to 1), the runtime holds the step's"]
 fn a_final_step_one_ulp_before_its_last_key() {
     let clip = clip(
         r#"{"format": "tcb-clip/1", "defaults": {"tangent_rule": "uniform", "continuity_fade": false, "post": "linear"},
