@@ -438,6 +438,11 @@ impl<V: Value> Track<V> {
             // the last but one, `u` rounds to 1, and a final `step` still
             // holds its key there (issue 29 class 2).
             self.values[k + 1]
+        } else if s == 1.0 {
+            // At the segment's end (basis [0, 1, 0, 0]) the value is its
+            // key, also beside a tangent that overflowed f32, where the sum
+            // would be 0 x inf = NaN; the runtime copies the key there too.
+            seg.p1
         } else {
             V::from_array(value)
         };
