@@ -309,7 +309,9 @@ impl RotationTrack {
 
     fn evaluate(&self, time: f64) -> (DQuat, DVec4) {
         let (k, u) = locate(&self.times, time);
-        if u >= 1.0 && k == self.times.len() - 2 && self.interps[k] == Interp::Step {
+        // The last key itself: the time decides, not `u`, which rounds to
+        // 1 one ulp before a key far from the one before it.
+        if time >= self.times[k + 1] && self.interps[k] == Interp::Step {
             return (self.keys[k + 1], DVec4::ZERO);
         }
         let (s, ds_du) = self.eases[k].apply(u);
@@ -549,6 +551,32 @@ mod tests {
             got.abs_diff_eq(last, 1e-6) || got.abs_diff_eq(-last, 1e-6),
             "{got:?} against {last:?}"
         );
+    }
+
+    /// As `Track`'s: a final `step` segment holds its key until the last
+    /// key's time, also where `u` rounds to 1 one ulp before it.
+    #[test]
+    fn a_final_step_holds_its_key_until_the_last_keys_time() {
+        let times = vec![-6.75, -4.1640625, -1.046875];
+        let q = [
+            Quat::IDENTITY,
+            Quat::from_rotation_y(1.0),
+            Quat::from_rotation_x(2.0),
+        ];
+        let mut keys = vec![KeyParams::default(); 3];
+        keys[1].interp = Interp::Step;
+        for rotation in [RotationMode::Squad, RotationMode::Hermite] {
+            let settings = TrackSettings {
+                rotation,
+                ..TrackSettings::default()
+            };
+            let track =
+                RotationTrack::new(times.clone(), q.to_vec(), keys.clone(), &settings).unwrap();
+            let before = f64::next_down(-1.046875);
+            assert_eq!(locate(&times, before).1, 1.0, "u rounds to 1 there");
+            assert!(close_f32(track.sample(before), q[1]), "{rotation:?}");
+            assert!(close_f32(track.sample(-1.046875), q[2]), "{rotation:?}");
+        }
     }
 
     fn close_f32(a: Quat, b: Quat) -> bool {

@@ -432,9 +432,17 @@ impl<V: Value> Track<V> {
             value[i] = hermite(&h, p0[i], p1[i], m0[i], m1[i]);
             velocity[i] = hermite(&dh, p0[i], p1[i], m0[i], m1[i]) * rate;
         }
-        let value = if u >= 1.0 && k == self.segments.len() - 1 {
+        let value = if time >= self.times[k + 1] {
             // The last key itself (a `step` segment would still hold P_{n-2}).
+            // The time decides, not `u`: one ulp before a key 3.1 s after
+            // the last but one, `u` rounds to 1, and a final `step` still
+            // holds its key there (issue 29 class 2).
             self.values[k + 1]
+        } else if s == 1.0 {
+            // At the segment's end (basis [0, 1, 0, 0]) the value is its
+            // key, also beside a tangent that overflowed f32, where the sum
+            // would be 0 x inf = NaN; the runtime copies the key there too.
+            seg.p1
         } else {
             V::from_array(value)
         };
@@ -493,6 +501,22 @@ mod tests {
             let (v, d) = t.sample_with_velocity(f64::from(i) / 1000.0);
             assert_eq!((v, d), (0.1, 0.0), "at {}", f64::from(i) / 1000.0);
         }
+    }
+
+    /// A final `step` segment holds its key until the last key's time:
+    /// one ulp before a last key 3.1 s after the one before, `u` rounds to
+    /// 1, and the value was the last key already (the `playback` fuzz
+    /// target, issue 29 class 2; the runtime held the step's key).
+    #[test]
+    fn a_final_step_holds_its_key_until_the_last_keys_time() {
+        let mut keys = vec![KeyParams::default(); 3];
+        keys[1].interp = Interp::Step;
+        let times = [-6.75, -4.1640625, -1.046875];
+        let t = scalar(&times, &[0.5, 2.0, 7.0], keys, TrackSettings::default());
+        let before = f64::next_down(-1.046875);
+        assert_eq!(locate(&times, before), (1, 1.0), "u rounds to 1 there");
+        assert_eq!(t.sample_with_velocity(before), (2.0, 0.0));
+        assert_eq!(t.sample(-1.046875), 7.0);
     }
 
     #[test]

@@ -138,6 +138,10 @@ fn hermite_quat_block(
 
 /// [`hermite_quats`] again for the blocks with a lane out of range, each
 /// lane first divided by its largest component ([`renormalize_scaled`]).
+/// At a segment's end (basis `[0, 1, 0, 0]`) such a block's value is its
+/// key: the cubic there is `0 x inf` (NaN) where a tangent overflowed f32,
+/// and the key is what the reference gives (the vector channels' copy of
+/// `P1` in `crate::group`, free here on the cold path).
 #[cold]
 #[inline(never)]
 fn rescale_quats(
@@ -148,10 +152,12 @@ fn rescale_quats(
     out: &mut [f32x8],
     mut vel: Option<&mut [f32x8]>,
 ) {
+    let at_end = h == [0.0, 1.0, 0.0, 0.0];
     let (h, dh, rate) = (&splat4(h), &splat4(dh), f32x8::splat(rate));
     for (b, k) in quat_keys(c).enumerate() {
         let (p, dp) = quat_curve(k, h, vel.is_some().then_some((dh, rate)));
         if in_range(&p).to_bitmask() != 0xff {
+            let p = if at_end { *k.0.0.1 } else { p };
             let planes = 4 * b..4 * b + 4;
             let v = vel.as_deref_mut().map(|v| &mut v[planes.clone()]);
             renormalize_scaled(&p, dp.as_ref(), &mut out[planes], v);

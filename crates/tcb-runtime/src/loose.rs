@@ -654,6 +654,8 @@ impl LooseState {
 
 /// Rows of one block, per lane.
 struct Rows {
+    /// Lanes at a real segment's end (`s = 1`, basis `[0, 1, 0, 0]`).
+    end: f32x8,
     h: [f32x8; 4],
     dh: [f32x8; 4],
     rate: f32x8,
@@ -810,6 +812,8 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
         velocity,
     );
     Rows {
+        // Lanes not in a real segment have `s = 0`.
+        end: s32.simd_eq(f32x8::ONE),
         h,
         dh,
         rate,
@@ -892,6 +896,10 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool>(
         let ctl = &st.ctl[info.ctl.clone()];
         for (c, k) in ctl.chunks_exact(4).enumerate() {
             let mut v = hermite(&rows.h, k[0], k[1], k[2], k[3]);
+            if UNBOUNDED && info.unbounded {
+                // As inside the keys: at a segment's end, the key.
+                v = Lane::select(rows.end, k[1], v);
+            }
             if rows.any_cycles {
                 v += loose.delta[4 * b + c] * rows.cycles;
             }

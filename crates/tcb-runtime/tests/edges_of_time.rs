@@ -304,10 +304,10 @@ fn squad_on_a_segment_a_few_ulps_long() {
 /// the `playback` target's 20-minute run of 2026-12-05): the runtime holds
 /// the step's key (math.md: it "stays P_k"), the reference gives the last
 /// key [2.63, 0.094, 6.41] a hair early: `tcb_core::Track::evaluate`
-/// snaps to the last key where the segment parameter `u` is 1, and here
-/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1.
+/// snapped to the last key where the segment parameter `u` is 1, and here
+/// `(t - t_k) / (t_k+1 - t_k)` rounds to 1. The reference now gives the
+/// last key where the time reaches the last key's, as the runtime does.
 #[test]
-#[ignore = "issue 29 class 2: one ulp before a final step key the reference gives the last key (its u rounds to 1), the runtime holds the step's"]
 fn a_final_step_one_ulp_before_its_last_key() {
     let clip = clip(
         r#"{"format": "tcb-clip/1", "defaults": {"tangent_rule": "uniform", "continuity_fade": false, "post": "linear"},
@@ -318,4 +318,89 @@ fn a_final_step_one_ulp_before_its_last_key() {
             "rotation": "squad", "hemisphere": "keep"}]}"#,
     );
     assert_none(&mismatches(&clip, &around(&[-6.75, -4.1640625, -1.046875])));
+}
+
+/// Where the reference and the runtime disagree at `times`, or where the
+/// reference is not finite: each of these times is at a segment's end
+/// (its `s` rounds to 1 in f32), where the value is the segment's key
+/// whatever its tangents, so the answer must be finite there.
+fn key_at_segment_end(clip: &tcb_core::Clip, times: &[f64]) -> Vec<String> {
+    let n = clip.channel_count();
+    let mut want = vec![0.0f32; n];
+    let mut bad = mismatches(clip, times);
+    for &t in times {
+        clip.sample_into(t, &mut want, None);
+        if want.iter().any(|x| !x.is_finite()) {
+            bad.push(format!("reference at {t:e}: {want:?}"));
+        }
+    }
+    bad
+}
+
+/// Tracks whose tangents overflow f32 (a bias of 8.1e270, a continuity of
+/// -7.6e135 with a bias of -8.4e187, a tension of 1.6e80), one ulp before
+/// a key, where `s` rounds to 1 and the value is the key: in a loose block
+/// whose lanes are not all inside their keys (another track's keys end
+/// before), directly and through `offset-repeat` from before the first
+/// key, as hermite rotations in a group and in such a block, and played at
+/// speed -f64::MAX. The `playback` fuzz target's run of 2026-12-05
+/// (`fuzz/open/playback-nan-an-ulp-from-a-key-*`,
+/// `playback-nan-at-speed-minus-max-*`): the runtime gave NaN (0 x inf)
+/// where the reference gave the key.
+#[test]
+fn an_overflowing_tangent_one_ulp_before_a_key_gives_the_key() {
+    let mut bad = Vec::new();
+    // A vec2 beside a scalar whose keys start after its last.
+    let beside = clip(
+        r#"{"format": "tcb-clip/1", "defaults": {"tcb": [-4.741725518223423e-182, 0.07, 8.109918638818106e270], "post": "repeat"},
+        "tracks": [{"name": "t0", "kind": "scalar", "times": [-0.125, -0.1171875, 3.875, 7.8671875], "values": [1.4405e-41, 0, -1.8198242, -1.8198242]},
+          {"name": "t1", "kind": "vec2", "times": [-3.75, -0.2109375], "values": [[-1.8198242, -1.8198242], [9.334581e-15, 9.334581e-15]]}]}"#,
+    );
+    bad.extend(key_at_segment_end(&beside, &[ulps(-0.2109375, -1)]));
+    // Alone, wrapped from before its first key by `offset-repeat`.
+    let wrapped = clip(
+        r#"{"format": "tcb-clip/1", "defaults": {"tangent_rule": "parabolic", "continuity_fade": false,
+          "tcb": [-0.78, 0, -1.7366082074772295e168], "pre": "offset-repeat"},
+        "tracks": [{"name": "t0", "kind": "scalar", "times": [-0.125, -0.124999999, 0.601562501, 1.734375001], "values": [1.0144043, 0, 5.231201, -6.211914]}]}"#,
+    );
+    bad.extend(key_at_segment_end(&wrapped, &[ulps(-0.125, -6)]));
+    // A scalar beside a vec2 whose keys end before, also played at speed
+    // -f64::MAX.
+    let fast = clip(
+        r#"{"format": "tcb-clip/1", "defaults": {"tcb": [-0.79, -7.634988870360329e135, -8.395468232477215e187]},
+        "tracks": [{"name": "t0", "kind": "scalar", "times": [-7.5, -6.1015625, -3.125, -2.2265625, -0.78125, -0.4609375, 0.125],
+            "values": [-2.1594238, 1.8127441, -5.255371, -6.211914, -6.211914, 1.1005859, -6.211914]},
+          {"name": "t1", "kind": "vec2", "times": [-12.5, -12.499999999, -10.398437499, -9.109374999],
+            "values": [[1.6987305, -3.8486328], [2.5273438, 5.4802246], [7.951172, 5.6835938], [-0.4284668, 2.5375977]], "pre": "linear"}]}"#,
+    );
+    let before = ulps(0.125, -1);
+    bad.extend(key_at_segment_end(&fast, &[before]));
+    let mut playing = Instance::new(Arc::new(Clip::compile(&fast)));
+    playing
+        .set_playback(tcb_runtime::Playback::Clip, -f64::MAX)
+        .expect("a finite speed");
+    let t = before / -f64::MAX;
+    assert_eq!(t * -f64::MAX, before, "the clip time of {t:e}");
+    let mut got = [0.0f32; 3];
+    playing.sample(t).write_row(&mut got, None);
+    if got[0] != -6.211914 {
+        bad.push(format!("at speed -f64::MAX, {t:e}: {got:?}"));
+    }
+    // Hermite rotations: in a group (beside a scalar on the same keys) and
+    // as a loose lane beside a rotation whose keys start after its last.
+    for other in [
+        r#"{"name": "s", "kind": "scalar", "times": [0, 1, 2], "values": [1, 2, 3]}"#,
+        r#"{"name": "q", "kind": "quat", "times": [5, 6], "values": [[0, 0, 0, 1], [0, 1, 0, 0]]}"#,
+    ] {
+        let text = format!(
+            r#"{{"format": "tcb-clip/1", "tracks": [{other},
+              {{"name": "r", "kind": "quat", "rotation": "hermite", "times": [0, 1, 2],
+               "values": [[0, 0, 0, 1], [0, 0.7071068, 0, 0.7071068], [1, 0, 0, 0]],
+               "keys": [{{}}, {{"tcb": [1.6e80, 0, 0]}}, {{}}]}}]}}"#
+        );
+        let rotations = clip(&text);
+        let times = [ulps(1.0, -1), ulps(2.0, -1), ulps(2.0, -64)];
+        bad.extend(key_at_segment_end(&rotations, &times));
+    }
+    assert_none(&bad);
 }
