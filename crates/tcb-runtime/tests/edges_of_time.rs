@@ -324,7 +324,7 @@ fn a_final_step_one_ulp_before_its_last_key() {
 /// reference is not finite: each of these times is at a segment's end
 /// (its `s` rounds to 1 in f32), where the value is the segment's key
 /// whatever its tangents, so the answer must be finite there.
-fn key_at_segment_end(clip: &tcb_core::Clip, times: &[f64]) -> Vec<String> {
+fn key_at_segment_end(clip: &tcb_core::SourceClip, times: &[f64]) -> Vec<String> {
     let n = clip.channel_count();
     let mut want = vec![0.0f32; n];
     let mut bad = mismatches(clip, times);
