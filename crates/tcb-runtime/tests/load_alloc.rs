@@ -11,10 +11,17 @@ use tcb_test_support::{CountingAllocator, count_allocations};
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
 
-/// The largest allocation `Clip::from_bytes` makes on `bytes`, and the clip.
-fn load(bytes: &[u8]) -> (Clip, usize) {
+/// `Clip::from_bytes` of `bytes`, checked to make no allocation larger
+/// than them.
+fn load(bytes: &[u8]) -> Clip {
     let (clip, counted) = count_allocations(|| Clip::from_bytes(bytes));
-    (clip.unwrap(), counted.largest)
+    assert!(
+        counted.largest <= bytes.len(),
+        "an allocation of {} bytes for a file of {}",
+        counted.largest,
+        bytes.len()
+    );
+    clip.unwrap()
 }
 
 #[test]
@@ -41,12 +48,7 @@ fn a_long_constant_clip_loads_in_less_than_its_file() {
         tracks: vec![track],
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();
-    let (clip, largest) = load(&bytes);
-    assert!(
-        largest <= bytes.len(),
-        "an allocation of {largest} bytes for a file of {}",
-        bytes.len()
-    );
+    let clip = load(&bytes);
     let level = clip.track("level").unwrap();
     let mut play = Instance::new(Arc::new(clip));
     for t in [0.0, 1.0 / 240.0, 9000.5, 34952.52] {
@@ -64,11 +66,6 @@ fn capture_loads_in_less_than_its_file() {
     let steps = vec![1.0 / 4096.0; cmu.tracks().len()];
     let source = PackSource::quantize(&cmu, &steps).unwrap();
     let bytes = Packed::encode(&source).unwrap().to_bytes();
-    let (clip, largest) = load(&bytes);
-    assert!(
-        largest <= bytes.len(),
-        "an allocation of {largest} bytes for a file of {}",
-        bytes.len()
-    );
+    let clip = load(&bytes);
     clip.verify_packed().unwrap();
 }
