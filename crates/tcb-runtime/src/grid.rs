@@ -53,15 +53,14 @@ impl KeyTimes {
         }
     }
 
-    /// Key `k`'s time. (`k as i64 as f64` is `k as f64` for every key
-    /// count a clip can have, in one instruction where `usize` takes ten.)
+    /// Key `k`'s time.
     #[inline(always)]
     pub fn at(&self, k: usize) -> f64 {
         match self {
             KeyTimes::Listed(t) => t[k],
             KeyTimes::Even {
                 start, interval, ..
-            } => start + k as i64 as f64 * interval,
+            } => even_time(*start, *interval, k),
         }
     }
 
@@ -137,6 +136,15 @@ impl KeyTimes {
         }
         lo
     }
+}
+
+/// Key `k`'s time on an even grid: `start + k interval` in f64, what
+/// `tcb compress` writes and the runtime plays (one formula for both).
+/// (`k as i64 as f64` is `k as f64` for every key count a clip can have,
+/// in one instruction where `usize` takes ten.)
+#[inline(always)]
+pub(crate) fn even_time(start: f64, interval: f64, k: usize) -> f64 {
+    start + k as i64 as f64 * interval
 }
 
 /// Key times, segment eases and extrapolation shared by a group of channels.

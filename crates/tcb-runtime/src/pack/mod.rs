@@ -155,10 +155,10 @@ impl PackSource {
         (0..self.keys).map(|k| self.time(k)).collect()
     }
 
-    /// Key `k`'s time: `start + k interval` in f64 (the runtime's
-    /// `KeyTimes::Even` computes it the same way).
+    /// Key `k`'s time: `start + k interval` in f64, by the runtime's own
+    /// formula for an even grid.
     pub fn time(&self, k: usize) -> f64 {
-        self.start + k as f64 * self.interval
+        crate::grid::even_time(self.start, self.interval, k)
     }
 
     /// Quantize `clip`'s keys: every track on one even grid (to 1e-6 of the
