@@ -2,7 +2,8 @@
 # Regenerates fuzz/corpus/tcbc/seed-*.tcbc after a .tcbc format change:
 # short pieces of the bundled CMU capture compressed by `tcb compress`
 # (at the default tolerance; one with 16-key blocks; one of the whole clip
-# at every 8th frame, whose root rotation is stored relative to a center),
+# at every 8th frame, whose root rotation is stored relative to a center;
+# one of that clip reduced, with tracks on key times of their own),
 # then one of them truncated and one with a byte changed.
 #
 #   bash fuzz/make-tcbc-seeds.sh        # from the repository's root
@@ -26,6 +27,9 @@ cut 344 8 > "$work/every8.bvh"
 $tcb compress "$work/tiny.bvh" -o "$out/seed-tiny.tcbc" > /dev/null
 $tcb compress "$work/tiny.bvh" -o "$out/seed-blocks.tcbc" --seek-keys 16 > /dev/null
 $tcb compress "$work/every8.bvh" -o "$out/seed-centered.tcbc" --tolerance 0.05 > /dev/null
+# A reduced clip: tracks on key times of their own beside the grid's.
+$tcb reduce "$work/every8.bvh" --rotation hermite -o "$work/reduced.json" --tolerance 0.05 > /dev/null 2>&1
+$tcb compress "$work/reduced.json" -o "$out/seed-own-key-times.tcbc" --tolerance 0.05 > /dev/null 2>&1
 size=$(stat -c %s "$out/seed-tiny.tcbc")
 head -c $((size / 2)) "$out/seed-tiny.tcbc" > "$out/seed-tiny-truncated.tcbc"
 # One byte of the stream changed (the checksum then disagrees).

@@ -577,6 +577,20 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
         .rotation
         .or((extension(&args.input) == "bvh").then_some(tcb_core::RotationMode::Hermite));
     let loaded = load_input(&args.input, rotation, args.animation.as_ref())?;
+    // The grid's rotations play `hermite` in a packed clip: say so where
+    // the input's do not (the error is measured against the input).
+    let tracks = loaded.clip.tracks();
+    let most = tracks.iter().map(|t| t.data.times().len()).max();
+    let replayed = tracks
+        .iter()
+        .filter(|t| Some(t.data.times().len()) == most)
+        .filter(|t| matches!(&t.data, tcb_core::TrackData::Quat(r) if r.settings().rotation != tcb_core::RotationMode::Hermite))
+        .count();
+    if replayed > 0 {
+        eprintln!(
+            "tcb: {replayed} rotation(s) on the clip's grid are squad or slerp: a packed clip plays them as hermite, measured against the input as it plays them (for a clip from tcb reduce of a BVH, reduce with --rotation hermite)"
+        );
+    }
     let options = tcb_fit::CompressOptions::default()
         .tolerance(args.error.tolerance)
         .shell(args.error.shell)
@@ -901,7 +915,7 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
     let (clip, runtime) = load_tcbc(&args.clip)?;
     let packed = runtime.packed().expect("compiled from a packed clip");
     let head = packed.head();
-    let values = head.keys * head.lanes();
+    let values = head.stored_values();
     let mut out = String::new();
     use std::fmt::Write as _;
     writeln!(
@@ -912,9 +926,10 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
     )?;
     writeln!(
         out,
-        "clip: {:?}, {} tracks, {} channels, {} keys each, {} to {} s ({} s apart)",
+        "clip: {:?}, {} tracks ({} on key times of their own), {} channels, grid of {} keys, {} to {} s ({} s apart)",
         head.name,
-        head.tracks.len(),
+        head.tracks.len() + head.loose.len(),
+        head.loose.len(),
         clip.channel_count(),
         head.keys,
         head.start,
@@ -937,9 +952,10 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
     write_packed_tracks(&mut out, head)?;
     writeln!(
         out,
-        "stored: {values} values in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",
+        "stored: {values} values, {} of them in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",
+        head.keys * head.lanes(),
         packed.stream_bits(),
-        packed.stream_bits() as f64 / values.max(1) as f64,
+        packed.stream_bits() as f64 / (head.keys * head.lanes()).max(1) as f64,
         8.0 * file as f64 / values.max(1) as f64
     )?;
     writeln!(
@@ -1031,10 +1047,14 @@ fn write_packed_tracks(out: &mut String, head: &tcb_runtime::PackSource) -> Resu
     writeln!(out, "tracks:")?;
     writeln!(
         out,
-        "  {:<32} {:<6} {:>7} {:>14}  relative to",
+        "  {:<32} {:<6} {:>7} {:>14}  relative to / keys of its own",
         "name", "kind", "stored", "step"
     )?;
-    for t in &head.tracks {
+    let mut loose = head.loose.iter().peekable();
+    for (i, t) in head.tracks.iter().enumerate() {
+        while let Some(l) = loose.next_if(|l| l.at < head.place(i)) {
+            write_loose_track(out, l)?;
+        }
         let center = t.center.map_or(String::new(), |c| {
             format!("  [{:.4}, {:.4}, {:.4}, {:.4}]", c[0], c[1], c[2], c[3])
         });
@@ -1047,6 +1067,29 @@ fn write_packed_tracks(out: &mut String, head: &tcb_runtime::PackSource) -> Resu
             t.step
         )?;
     }
+    for l in loose {
+        write_loose_track(out, l)?;
+    }
+    Ok(())
+}
+
+/// A line of [`write_packed_tracks`] for a track on key times of its own.
+fn write_loose_track(out: &mut String, t: &tcb_runtime::pack::LooseTrack) -> Result<(), BoxError> {
+    use std::fmt::Write as _;
+    let tangents = if t.tangents.is_some() {
+        ", explicit tangents"
+    } else {
+        ""
+    };
+    writeln!(
+        out,
+        "  {:<32} {:<6} {:>7} {:>14e}  {} keys{tangents}",
+        t.name,
+        t.kind.name(),
+        t.kind.dim(),
+        t.step,
+        t.times.len()
+    )?;
     Ok(())
 }
 

@@ -338,6 +338,47 @@ fn compresses_a_bvh_within_the_tolerance_and_the_file_plays() {
     assert_success(&o);
 }
 
+/// `tcb reduce` then `tcb compress` (issue 28's composition): the reduced
+/// clip's tracks on key times of their own keep them (`info` counts them),
+/// the file is within the tolerance of the reduced clip by its own
+/// measurement, and runtime and `--scalar` agree on it.
+#[test]
+fn a_reduced_clip_compresses_with_its_own_key_times() {
+    let (reduced, _, _) = reduce_short("composed.json", &["--rotation", "hermite"]);
+    let out = dir().join("composed.tcbc");
+    let o = tcb_to("compress", &reduced, &out, &["--tolerance", "0.002"]);
+    assert_success(&o);
+    let line = stdout(&o).lines().last().unwrap().to_string();
+    let error: f64 = line
+        .split_once(" max error ")
+        .and_then(|(_, t)| t.split_once(' '))
+        .expect(&line)
+        .0
+        .parse()
+        .expect(&line);
+    assert!(
+        line.starts_with("compressed: tracks 32, keys 240,") && error <= 0.002,
+        "{line}"
+    );
+    let o = tcb(&["info", out.to_str().unwrap()]);
+    assert_success(&o);
+    let info = common::stdout(&o);
+    let own = info
+        .split_once(" tracks (")
+        .and_then(|(_, t)| t.split_once(' '))
+        .expect(&info)
+        .0;
+    assert!(own.parse::<usize>().expect(&info) > 0, "{info}");
+    let times = [0.0, 0.3, 0.51, 1.0, 1.99];
+    let runtime = sample_at(&out, &times);
+    let reference = sample_with(&out, &times, &["--scalar"]);
+    for (a, b) in runtime.iter().zip(&reference) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{a:?} {b:?}");
+        }
+    }
+}
+
 /// Bad requests and files: one line on stderr, exit 1, nothing written.
 #[test]
 fn bad_compress_input_is_a_clear_error_and_writes_nothing() {

@@ -130,7 +130,7 @@ impl Compressed {
     pub fn summary_line(&self) -> String {
         format!(
             "compressed: tracks {}, keys {}, values {}, bytes {}, {:.2} bits per value, max error {:e} ({}, joint {}, time {})",
-            self.packed.head().tracks.len(),
+            self.packed.head().tracks.len() + self.packed.head().loose.len(),
             self.packed.head().keys,
             self.values,
             self.bytes,
@@ -197,7 +197,7 @@ pub fn compress(
     );
     packed.skeleton = skeleton.cloned();
     let bytes = check_written(&packed)?;
-    let values = packed.head().keys * packed.head().lanes();
+    let values = packed.head().stored_values();
     Ok(Compressed {
         packed,
         settings,

@@ -300,13 +300,65 @@ pub(crate) fn sample_into(
         values, velocities, ..
     } = pose;
     if clip.packed.is_some() {
-        // One group, decoded from its stream (`crate::pack`).
-        for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
-            g.sample_packed(time, cursor, cache, values, velocities.as_deref_mut());
-        }
+        sample_packed(
+            clip,
+            time,
+            (cursors, caches),
+            loose,
+            loose_rot,
+            values,
+            velocities,
+        );
         return;
     }
-    for ((g, cursor), cache) in clip.groups.iter().zip(cursors.iter_mut()).zip(caches) {
+    sample_rest(
+        clip,
+        0,
+        time,
+        (cursors, caches),
+        loose,
+        loose_rot,
+        values,
+        velocities,
+    );
+}
+
+/// [`sample_into`] of a packed clip: its first group decodes its keys from
+/// the stream (`crate::pack`); the others, and loose lanes, hold its tracks
+/// on key times of their own. Out of line, so that the f32 clips' path
+/// stays as it was.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn sample_packed(
+    clip: &Clip,
+    time: f64,
+    (cursors, caches): (&mut [Cursor], &mut [KeyCache]),
+    loose: &mut LooseState,
+    loose_rot: &mut LooseState,
+    values: &mut [f32x8],
+    velocities: &mut Option<Vec<f32x8>>,
+) {
+    let v = velocities.as_deref_mut();
+    clip.groups[0].sample_packed(time, &mut cursors[0], &mut caches[0], values, v);
+    let rest = (&mut cursors[1..], &mut caches[1..]);
+    sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
+}
+
+/// [`sample_into`] of `clip`'s groups from `first` on (with their cursors
+/// and caches) and its loose lanes.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn sample_rest(
+    clip: &Clip,
+    first: usize,
+    time: f64,
+    (cursors, caches): (&mut [Cursor], &mut [KeyCache]),
+    loose: &mut LooseState,
+    loose_rot: &mut LooseState,
+    values: &mut [f32x8],
+    velocities: &mut Option<Vec<f32x8>>,
+) {
+    for ((g, cursor), cache) in clip.groups[first..].iter().zip(cursors).zip(caches) {
         g.sample(time, cursor, cache, values, velocities.as_deref_mut());
     }
     if clip.loose.blocks > 0 {

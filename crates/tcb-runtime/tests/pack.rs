@@ -135,7 +135,8 @@ fn file_round_trip() {
 
 /// The skeleton a file keeps reads back; a file of an older version
 /// (1: no skeleton section; 2: zigzag residuals; 3: a stored segment
-/// table, no centers, no header-less lanes) or a newer one is refused
+/// table, no centers, no header-less lanes; 4: no block table; 5: no tracks
+/// on key times of their own) or a newer one is refused
 /// in one line that says so; a skeleton whose joint names a later parent,
 /// or whose rest is not finite, is refused in one line.
 #[test]
@@ -168,14 +169,15 @@ fn skeleton_round_trip_and_other_versions() {
         (2, "older"),
         (3, "older"),
         (4, "older"),
-        (6, "newer"),
+        (5, "older"),
+        (7, "newer"),
     ] {
         let mut b = packed.to_bytes();
         b[8..12].copy_from_slice(&version.to_le_bytes());
         let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
         assert!(
             msg.starts_with(&format!(
-                ".tcbc version {version}; this build reads version 5"
+                ".tcbc version {version}; this build reads version 6"
             )) && msg.contains(says)
                 && !msg.contains('\n'),
             "{msg}"
@@ -280,6 +282,7 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
         interval: 1.0,
         keys: 2,
         tracks: (0..7).map(track).collect(),
+        loose: Vec::new(),
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();
     Packed::from_bytes(&bytes).unwrap();
@@ -315,6 +318,7 @@ fn constant_tracks_have_no_headers_and_centers_are_unit() {
             track("a", TrackKind::Vec3, 0),
             track("b", TrackKind::Scalar, 0),
         ],
+        loose: Vec::new(),
     };
     let packed = Packed::encode(&zeros).unwrap();
     assert_eq!(packed.stream_bits(), 0);
@@ -332,9 +336,9 @@ fn constant_tracks_have_no_headers_and_centers_are_unit() {
         b
     };
     // The lane table is the three rows of 4 lanes before the block table
-    // (2 blocks of 64 keys), the stream's length (0 bytes of stream) and
-    // the joint count (0).
-    let base = bytes.len() - 4 - 8 - 4 - 4;
+    // (2 blocks of 64 keys), the stream's length (0 bytes of stream), the
+    // count of tracks on their own key times (0) and the joint count (0).
+    let base = bytes.len() - 4 - 8 - 4 - 4 - 4;
     let mut lying = bytes.clone();
     lying[base] = 33;
     let msg = Packed::from_bytes(&reseal(lying)).unwrap_err().to_string();
@@ -355,4 +359,118 @@ fn constant_tracks_have_no_headers_and_centers_are_unit() {
     turned.tracks[2] = q;
     let msg = Packed::encode(&turned).unwrap_err().to_string();
     assert!(msg.contains("not a unit quaternion"), "{msg}");
+}
+
+/// A reduced clip's shape: tracks on the capture's grid, and beside them
+/// tracks on key times of their own (a vector with explicit tangents, a
+/// `hermite` rotation with the rule's, a constant scalar of two keys, a
+/// vector whose `post` differs from the grid's). The grid's tracks are
+/// packed, the others keep their keys; the file reads back, loads,
+/// verifies, and plays its reference bit for bit, forward and seeking.
+#[test]
+fn tracks_on_their_own_key_times_keep_their_keys() {
+    use glam::{Quat, Vec3};
+    use tcb_core::params::{Extrapolation, KeyParams};
+    use tcb_core::{NamedTrack, RotationTrack, SourceClip, Track, TrackData, TrackSettings};
+    let hermite = TrackSettings {
+        rotation: RotationMode::Hermite,
+        ..TrackSettings::default()
+    };
+    let grid: Vec<f64> = (0..100).map(|k| k as f64 / 30.0).collect();
+    let own = [0.0, 0.2, 0.45, 1.0, 1.6, 2.9, 3.3];
+    let wave = |t: f64, f: f64| Vec3::new((t * f).sin() as f32, (t * 1.3).cos() as f32, 0.25);
+    let turn = |t: f64| Quat::from_rotation_y((0.8 * t) as f32) * Quat::from_rotation_x(0.3);
+    let vec3 = |times: &[f64], f: f64, keys: Vec<KeyParams<Vec3>>, s: &TrackSettings| {
+        let v = times.iter().map(|t| wave(*t, f)).collect();
+        TrackData::Vec3(Track::new(times.to_vec(), v, keys, s).unwrap())
+    };
+    let tangents = own
+        .iter()
+        .map(|t| KeyParams {
+            tangent_in: Some(wave(*t, 2.0) * 0.5),
+            tangent_out: Some(wave(*t, 0.5)),
+            ..KeyParams::default()
+        })
+        .collect();
+    let quat = |times: &[f64]| {
+        let q = times.iter().map(|t| turn(*t)).collect();
+        TrackData::Quat(RotationTrack::new(times.to_vec(), q, vec![], &hermite).unwrap())
+    };
+    let level = Track::new(vec![0.0, 3.3], vec![0.5f32, 0.5], vec![], &hermite).unwrap();
+    let cycle = TrackSettings {
+        post: Extrapolation::Repeat,
+        ..hermite
+    };
+    let named = |name: &str, data| NamedTrack {
+        name: name.into(),
+        data,
+    };
+    let clip = SourceClip::new(
+        "reduced",
+        vec![
+            named("b", vec3(&own, 1.0, tangents, &hermite)),
+            named("a", vec3(&grid, 2.0, vec![], &hermite)),
+            named("c", quat(&own[1..])),
+            named("r", quat(&grid)),
+            named("d", TrackData::Scalar(level)),
+            named("e", vec3(&grid, 3.0, vec![], &cycle)),
+        ],
+    )
+    .unwrap();
+    let steps = vec![1.0 / 4096.0; 6];
+    let source = PackSource::quantize(&clip, &steps).unwrap();
+    let grid_names: Vec<&str> = source.tracks.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(grid_names, ["a", "r"]);
+    let places: Vec<(usize, &str, bool)> = source
+        .loose
+        .iter()
+        .map(|t| (t.at, t.name.as_str(), t.tangents.is_some()))
+        .collect();
+    assert_eq!(
+        places,
+        [
+            (0, "b", true),
+            (2, "c", false),
+            (4, "d", false),
+            (5, "e", false)
+        ]
+    );
+    assert_eq!(
+        source.to_clip().unwrap().column_names(),
+        clip.column_names()
+    );
+    for block in [16, 64] {
+        plays_its_reference(&source, block);
+    }
+    let packed = Packed::encode(&source).unwrap();
+    let bytes = packed.to_bytes();
+    assert_eq!(Packed::from_bytes(&bytes).unwrap(), packed);
+    assert_eq!(packed.decode().unwrap(), source);
+    let loaded = Clip::from_bytes(&bytes).unwrap();
+    loaded.verify_packed().unwrap();
+    assert_eq!(loaded.to_bytes().unwrap(), bytes);
+    // The loose tracks' keys stay within half a step (and what normalizing
+    // a rotation adds).
+    let back = source.to_clip().unwrap();
+    let loose = clip.tracks().iter().zip(back.tracks());
+    for (t, b) in loose.filter(|(t, _)| !["a", "r"].contains(&t.name.as_str())) {
+        for k in 0..t.data.times().len() {
+            let time = t.data.times()[k];
+            let (mut x, mut y) = ([0.0f32; 4], [0.0f32; 4]);
+            t.data
+                .sample_into(time, &mut x[..t.data.kind().dim()], None);
+            b.data
+                .sample_into(time, &mut y[..t.data.kind().dim()], None);
+            let off = x
+                .iter()
+                .zip(&y)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f32::max);
+            assert!(
+                off <= 1.0 / 8192.0 + 1e-6,
+                "{} key {k}: {x:?} {y:?}",
+                t.name
+            );
+        }
+    }
 }

@@ -159,16 +159,17 @@ impl Clip {
     /// assert!(small.quantization_error(hips).unwrap() < 1e-3); // in the clip's units
     /// ```
     pub fn compile_with(source: &tcb_core::SourceClip, options: &CompileOptions) -> Self {
-        compile_impl(source, options, false)
+        compile_impl(source, options, None)
     }
 }
 
-/// [`Clip::compile_with`]; with `groups_only`, small groups stay groups
-/// rather than loose lanes (a packed clip's one group).
+/// [`Clip::compile_with`]; with `pinned`, the group of that track stays a
+/// group, however small, and comes first (a packed clip's group on its
+/// grid).
 pub(crate) fn compile_impl(
     source: &tcb_core::SourceClip,
     options: &CompileOptions,
-    groups_only: bool,
+    pinned: Option<usize>,
 ) -> Clip {
     let mut grouping = group_tracks(source, options);
     // How much normalizing can grow a quantization error of each rotation
@@ -179,11 +180,16 @@ pub(crate) fn compile_impl(
             rot_gain[row.track] = normalize_gain(&row.controls);
         }
     }
-    let loose = if groups_only {
-        LooseTracks::default()
-    } else {
-        choose_loose(&mut grouping, options)
-    };
+    // The pinned group: the first to take the track's grid.
+    let pinned_group = pinned.and_then(|track| {
+        let rows = grouping.vectors.iter().zip(&grouping.rotations);
+        rows.enumerate()
+            .find(|(_, (v, r))| {
+                v.iter().any(|x| x.track == track) || r.iter().any(|x| x.track == track)
+            })
+            .map(|(g, _)| g)
+    });
+    let loose = choose_loose(&mut grouping, options, pinned_group);
     let mut per_track = PerTrack {
         slots: source
             .tracks()
@@ -198,13 +204,14 @@ pub(crate) fn compile_impl(
         quantized: vec![false; source.tracks().len()],
     };
     let mut blocks = PoseBlocks::default();
+    let first = pinned_group.map(|g| grouping.keep[..g].iter().filter(|k| **k).count());
     let Grouping {
         grids,
         vectors,
         rotations,
         keep,
     } = grouping;
-    let groups: Vec<Group> = grids
+    let mut groups: Vec<Group> = grids
         .into_iter()
         .zip(vectors)
         .zip(rotations)
@@ -212,6 +219,9 @@ pub(crate) fn compile_impl(
         .filter(|(_, keep)| *keep)
         .map(|(((grid, v), r), _)| build_group(grid, &v, &r, options, &mut per_track, &mut blocks))
         .collect();
+    if let Some(i) = first {
+        groups[..=i].rotate_right(1);
+    }
     let (loose, loose_rot, loose_rot_tracks) =
         build_loose(loose, options, &rot_gain, &mut per_track, &mut blocks);
     Clip {
@@ -281,9 +291,13 @@ fn group_tracks(source: &tcb_core::SourceClip, options: &CompileOptions) -> Grou
 /// the values (so that squad runs in f64 for values only inside the
 /// segments left). Groups with `reset` rotations stay groups (reset gives
 /// the identity rather than zero).
-fn choose_loose(grouping: &mut Grouping, options: &CompileOptions) -> LooseTracks {
+fn choose_loose(
+    grouping: &mut Grouping,
+    options: &CompileOptions,
+    pinned: Option<usize>,
+) -> LooseTracks {
     let mut out = LooseTracks::default();
-    for g in 0..grouping.grids.len() {
+    for g in (0..grouping.grids.len()).filter(|g| Some(*g) != pinned) {
         let grid = &mut grouping.grids[g];
         let (vectors, rotations) = (&grouping.vectors[g], &mut grouping.rotations[g]);
         let resets = [grid.pre, grid.post].contains(&Extrapolation::Reset);

@@ -77,9 +77,22 @@ impl Clip {
         };
         let source = packed.decode()?;
         let reference = source.to_clip()?;
-        let full = compile_impl(&reference, &CompileOptions::default(), true);
+        let full = compile_impl(
+            &reference,
+            &CompileOptions::default(),
+            Some(source.place(0)),
+        );
+        grid_group(&full, &source)?;
+        // Tracks on key times of their own are compiled from the same
+        // reference tracks both ways: their lanes and groups must agree.
+        if full.layout != self.layout
+            || format!("{:?}", (&full.loose, &full.loose_rot, &full.groups[1..]))
+                != format!("{:?}", (&self.loose, &self.loose_rot, &self.groups[1..]))
+        {
+            return err("the tracks on key times of their own miss their reference");
+        }
         let (Some(want), Some(got)) = (full.groups.first(), self.groups.first()) else {
-            return err("a packed clip compiles to one group");
+            return err("a packed clip compiles to one group on its grid");
         };
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
         if bits(&want.grid.times.to_vec()) != bits(&got.grid.times.to_vec()) {
@@ -170,13 +183,8 @@ fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
     }
     let end_times: Vec<f64> = at.iter().map(|&k| head.time(k)).collect();
     let reference = ends.reference(&end_times)?;
-    let clip = compile_impl(&reference, &CompileOptions::default(), true);
-    if clip.groups.len() != 1 {
-        return err(format!(
-            "a packed clip compiles to one group, not {}",
-            clip.groups.len()
-        ));
-    }
+    let clip = compile_impl(&reference, &CompileOptions::default(), Some(head.place(0)));
+    grid_group(&clip, head)?;
     let g = &clip.groups[0];
     if !(g.grid.eases.is_empty() && g.grid.steps.is_empty() && g.exact.entries.is_empty()) {
         return err("a packed clip's keys have no eases, steps or exact segments");
@@ -184,7 +192,32 @@ fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
     Ok(clip)
 }
 
-/// The decoder's tables for `clip`'s one group (compiled by
+/// Check that `clip`'s first group holds the grid's tracks of `head`, and
+/// nothing else (a track on key times of its own whose times are the
+/// reference's would join it).
+fn grid_group(clip: &Clip, head: &crate::PackSource) -> Result<(), PackError> {
+    let g = clip.groups.first();
+    let vectors: usize = head
+        .tracks
+        .iter()
+        .filter(|t| t.kind != TrackKind::Quat)
+        .map(|t| t.kind.dim())
+        .sum();
+    let rotations = head.tracks.len()
+        - head
+            .tracks
+            .iter()
+            .filter(|t| t.kind != TrackKind::Quat)
+            .count();
+    if g.is_none_or(|g| (g.vector_channels, g.rotations) != (vectors, rotations)) {
+        return err(
+            "a track on key times of its own has the key times of the grid's ends, and would share their group: a packed clip cannot hold it",
+        );
+    }
+    Ok(())
+}
+
+/// The decoder's tables for `clip`'s first group (compiled by
 /// [`compile_ends`]): per lane its slot, step and chord weights, the
 /// rotations whose `w` is rebuilt, and the controls no decoded key gives
 /// (keys 0 and n-1, the sentinels).
@@ -200,15 +233,17 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
     let mut rebuild = vec![[true; 8]; g.hq_blocks];
     let mut center: Vec<Option<[[f32; 8]; 4]>> = vec![None; g.hq_blocks];
     let rot_from = g.vec_blocks;
-    for (t, slot) in head.tracks.iter().zip(clip.layout.tracks()) {
+    for (i, t) in head.tracks.iter().enumerate() {
+        let slot = &clip.layout.tracks()[head.place(i)];
+        // Flat indices in the group's planes.
+        let index = slot.index.map(|at| at - 8 * g.vec_out);
         // Every interior key's weights are key 1's (`PackSource::validate`).
         let w = if n > 2 {
             key_weights(&[0, 1, 2].map(|k| head.time(k)), t, 1)
         } else {
             [0.0; 4]
         };
-        for c in 0..t.kind.dim() {
-            let at = slot.index[c];
+        for (c, &at) in index.iter().enumerate().take(t.kind.dim()) {
             let (p, l) = (at / 8, at % 8);
             if c < t.stored() {
                 lane_slot.push(at as u32);
@@ -219,7 +254,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
             }
         }
         if t.kind == TrackKind::Quat {
-            let at = slot.index[0];
+            let at = index[0];
             let b = (at / 8 - rot_from) / 4;
             rebuild[b][at % 8] = t.rebuild_w;
             if let Some(r) = t.center {

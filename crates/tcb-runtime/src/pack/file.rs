@@ -9,7 +9,8 @@
 //! key times are not listed, and the block table is read from the file).
 
 use super::{
-    MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS, VERSION, check_block, err,
+    LooseTangents, LooseTrack, MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS,
+    VERSION, check_block, err,
 };
 use glam::{Quat, Vec3};
 use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
@@ -47,6 +48,49 @@ impl Writer {
         self.len(s.len());
         self.0.extend_from_slice(s.as_bytes());
     }
+    fn kind_and_settings(&mut self, kind: TrackKind, s: &TrackSettings) {
+        let ix = |i: Option<usize>| i.expect("a known value") as u8;
+        self.u8(ix(KINDS.iter().position(|k| *k == kind)));
+        self.u8(ix(TangentRule::ALL
+            .iter()
+            .position(|v| *v == s.tangent_rule)));
+        self.u8(ix(Ends::ALL.iter().position(|v| *v == s.ends)));
+        self.u8(u8::from(s.match_speed));
+        self.u8(u8::from(s.continuity_fade));
+        self.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.pre)));
+        self.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.post)));
+        self.u8(ix(RotationMode::ALL.iter().position(|v| *v == s.rotation)));
+        self.u8(ix(Hemisphere::ALL.iter().position(|v| *v == s.hemisphere)));
+    }
+    /// Per component a base and a width, then the offsets (`Reader::ints`).
+    fn ints(&mut self, comps: &[Vec<i32>]) {
+        for c in comps {
+            let base = c.iter().copied().min().unwrap_or(0);
+            let span = c.iter().map(|x| x.abs_diff(base)).max().unwrap_or(0);
+            let w = 32 - span.leading_zeros();
+            self.u32(base as u32);
+            self.u8(w as u8);
+            let mut bits = vec![0u8; (c.len() * w as usize).div_ceil(8)];
+            for (k, x) in c.iter().enumerate() {
+                let v = x.abs_diff(base);
+                for b in 0..w as usize {
+                    let p = k * w as usize + b;
+                    bits[p / 8] |= (((v >> b) & 1) as u8) << (p % 8);
+                }
+            }
+            self.0.extend_from_slice(&bits);
+        }
+    }
+}
+
+/// `w` bits (at most 25) at bit `pos` of `bytes`, least significant first
+/// (bits past the end read as 0).
+fn bits_at(bytes: &[u8], pos: usize, w: u32) -> u32 {
+    let mut window = [0u8; 8];
+    let from = (pos / 8).min(bytes.len());
+    let to = (from + 8).min(bytes.len());
+    window[..to - from].copy_from_slice(&bytes[from..to]);
+    ((u64::from_le_bytes(window) >> (pos % 8)) & ((1u64 << w) - 1)) as u32
 }
 
 struct Reader<'a> {
@@ -186,15 +230,7 @@ impl<'a> Reader<'a> {
         let r = self;
         let name = r.str(&format!("track {i}'s name"))?;
         let what = |f: &str| format!("track {name}: {f}");
-        let kind = r.pick(&KINDS, &what("kind"))?;
-        let tangent_rule = r.pick(TangentRule::ALL, &what("tangent rule"))?;
-        let ends = r.pick(Ends::ALL, &what("ends"))?;
-        let match_speed = r.pick(&[false, true], &what("match_speed"))?;
-        let continuity_fade = r.pick(&[false, true], &what("continuity_fade"))?;
-        let pre = r.pick(Extrapolation::ALL, &what("pre"))?;
-        let post = r.pick(Extrapolation::ALL, &what("post"))?;
-        let rotation = r.pick(RotationMode::ALL, &what("rotation mode"))?;
-        let hemisphere = r.pick(Hemisphere::ALL, &what("hemisphere"))?;
+        let (kind, settings) = r.kind_and_settings(&name)?;
         let rebuild_w = r.pick(&[false, true], &what("rebuild_w"))?;
         // Tension, continuity and bias, where not all 0.
         let tcb = if r.pick(&[false, true], &what("tension flag"))? {
@@ -216,16 +252,6 @@ impl<'a> Reader<'a> {
         } else {
             None
         };
-        let settings = TrackSettings {
-            tangent_rule,
-            ends,
-            match_speed,
-            continuity_fade,
-            pre,
-            post,
-            rotation,
-            hemisphere,
-        };
         Ok(PackTrack {
             name,
             kind,
@@ -236,6 +262,107 @@ impl<'a> Reader<'a> {
             center,
             values: Vec::new(),
         })
+    }
+
+    /// A track's kind and settings (a byte each).
+    fn kind_and_settings(&mut self, name: &str) -> Result<(TrackKind, TrackSettings), PackError> {
+        let r = self;
+        let what = |f: &str| format!("track {name}: {f}");
+        let kind = r.pick(&KINDS, &what("kind"))?;
+        let settings = TrackSettings {
+            tangent_rule: r.pick(TangentRule::ALL, &what("tangent rule"))?,
+            ends: r.pick(Ends::ALL, &what("ends"))?,
+            match_speed: r.pick(&[false, true], &what("match_speed"))?,
+            continuity_fade: r.pick(&[false, true], &what("continuity_fade"))?,
+            pre: r.pick(Extrapolation::ALL, &what("pre"))?,
+            post: r.pick(Extrapolation::ALL, &what("post"))?,
+            rotation: r.pick(RotationMode::ALL, &what("rotation mode"))?,
+            hemisphere: r.pick(Hemisphere::ALL, &what("hemisphere"))?,
+        };
+        Ok((kind, settings))
+    }
+
+    /// The tracks on key times of their own (since version 6): a count,
+    /// then per track its place among all tracks, name, kind and settings,
+    /// key count and f64 times, value step and integers, and a flag for
+    /// explicit tangents (then their step and integers, incoming then
+    /// outgoing). Counts the bytes left cannot hold are refused before
+    /// anything is allocated for them.
+    fn loose(&mut self) -> Result<Vec<LooseTrack>, PackError> {
+        let count = self.u32("the count of tracks on their own key times")? as usize;
+        // A track takes at least 42 bytes (place, name length, kind and
+        // settings, key count, two times, step, flag).
+        if count > self.left() / 42 {
+            return err(format!(
+                "{count} tracks on their own key times claimed with {} bytes left",
+                self.left()
+            ));
+        }
+        (0..count)
+            .map(|i| {
+                let at = self.u32(&format!("loose track {i}'s place"))? as usize;
+                let name = self.str(&format!("loose track {i}'s name"))?;
+                let (kind, settings) = self.kind_and_settings(&name)?;
+                let what = |f: &str| format!("track {name}: {f}");
+                let n = self.u32(&what("key count"))? as usize;
+                if n > self.left() / 8 {
+                    return err(format!(
+                        "track {name}: {n} keys claimed with {} bytes left",
+                        self.left()
+                    ));
+                }
+                let times = (0..n)
+                    .map(|_| self.f64(&what("key times")))
+                    .collect::<Result<Vec<f64>, _>>()?;
+                let step = self.f32(&what("step"))?;
+                let values = self.ints(kind.dim(), n, &what("values"))?;
+                let tangents = if self.pick(&[false, true], &what("tangent flag"))? {
+                    Some(LooseTangents {
+                        step: self.f32(&what("tangent step"))?,
+                        incoming: self.ints(kind.dim(), n, &what("incoming tangents"))?,
+                        outgoing: self.ints(kind.dim(), n, &what("outgoing tangents"))?,
+                    })
+                } else {
+                    None
+                };
+                let t = LooseTrack {
+                    at,
+                    name,
+                    kind,
+                    settings,
+                    times,
+                    step,
+                    values,
+                    tangents,
+                };
+                t.validate()?;
+                Ok(t)
+            })
+            .collect()
+    }
+
+    /// `dim` components of `n` integers each: per component a base
+    /// (`i32`) and a width (`u8`, at most 25), then the `n` offsets from
+    /// the base in `width` bits each, least significant first, padded to a
+    /// byte.
+    fn ints(&mut self, dim: usize, n: usize, what: &str) -> Result<Vec<Vec<i32>>, PackError> {
+        (0..dim)
+            .map(|_| {
+                let base = self.u32(what)? as i32;
+                let w = u32::from(self.u8(what)?);
+                if w > 25 {
+                    return err(format!("{what}: a width of {w} bits (at most 25)"));
+                }
+                let bytes = self.take((n * w as usize).div_ceil(8), what)?;
+                Ok((0..n)
+                    .map(|k| base.wrapping_add(bits_at(bytes, k * w as usize, w) as i32))
+                    .collect())
+            })
+            .collect()
+    }
+
+    fn left(&self) -> usize {
+        self.bytes.len() - self.at
     }
 
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], PackError> {
@@ -299,20 +426,8 @@ impl Packed {
         w.len(SEGMENT_KEYS);
         w.len(h.tracks.len());
         for t in &h.tracks {
-            let s = &t.settings;
-            let ix = |i: Option<usize>| i.expect("a known value") as u8;
             w.str(&t.name);
-            w.u8(ix(KINDS.iter().position(|k| *k == t.kind)));
-            w.u8(ix(TangentRule::ALL
-                .iter()
-                .position(|v| *v == s.tangent_rule)));
-            w.u8(ix(Ends::ALL.iter().position(|v| *v == s.ends)));
-            w.u8(u8::from(s.match_speed));
-            w.u8(u8::from(s.continuity_fade));
-            w.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.pre)));
-            w.u8(ix(Extrapolation::ALL.iter().position(|v| *v == s.post)));
-            w.u8(ix(RotationMode::ALL.iter().position(|v| *v == s.rotation)));
-            w.u8(ix(Hemisphere::ALL.iter().position(|v| *v == s.hemisphere)));
+            w.kind_and_settings(t.kind, &t.settings);
             w.u8(u8::from(t.rebuild_w));
             let tcb = [t.tcb.tension, t.tcb.continuity, t.tcb.bias];
             let given = tcb.iter().any(|x| x.to_bits() != 0);
@@ -336,6 +451,24 @@ impl Packed {
         let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
         w.len(self.stream_len);
         w.0.extend_from_slice(&bytes[..self.stream_len]);
+        w.len(h.loose.len());
+        for t in &h.loose {
+            w.len(t.at);
+            w.str(&t.name);
+            w.kind_and_settings(t.kind, &t.settings);
+            w.len(t.times.len());
+            for x in &t.times {
+                w.f64(*x);
+            }
+            w.f32(t.step);
+            w.ints(&t.values);
+            w.u8(u8::from(t.tangents.is_some()));
+            if let Some(g) = &t.tangents {
+                w.f32(g.step);
+                w.ints(&g.incoming);
+                w.ints(&g.outgoing);
+            }
+        }
         let joints = self.skeleton.as_ref().map_or(&[][..], Skeleton::joints);
         w.len(joints.len());
         for j in joints {
@@ -404,6 +537,7 @@ impl Packed {
         let [abs_bits, delta_bits, base_width] = r.block_widths(stored)?;
         let headed = base_width.iter().filter(|b| **b != super::FLAT).count();
         let (block_at, stream, len) = r.stream(keys, block, headed)?;
+        let loose = r.loose()?;
         let skeleton = r.skeleton()?;
         if r.at != body.len() {
             return err(format!("{} bytes after the stream", body.len() - r.at));
@@ -416,6 +550,7 @@ impl Packed {
                 interval,
                 keys,
                 tracks,
+                loose,
             },
             abs_bits,
             delta_bits,

@@ -67,8 +67,12 @@ pub struct PackSource {
     pub interval: f64,
     /// Keys per track (>= 2).
     pub keys: usize,
-    /// The tracks.
+    /// The tracks on the grid (the stream's), in file order.
     pub tracks: Vec<PackTrack>,
+    /// The tracks on key times of their own ([`LooseTrack`]), each at its
+    /// place among all the clip's tracks (`at`, increasing); the grid's
+    /// tracks fill the other places in order.
+    pub loose: Vec<LooseTrack>,
 }
 
 /// One track of a [`PackSource`].
@@ -96,6 +100,38 @@ pub struct PackTrack {
     pub center: Option<[f32; 4]>,
     /// Per stored component, one integer per key (`|x| < 2^24`).
     pub values: Vec<Vec<i32>>,
+}
+
+/// A track of a [`PackSource`] on key times of its own.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LooseTrack {
+    /// Its position among all the clip's tracks (file order).
+    pub at: usize,
+    /// Its name.
+    pub name: String,
+    /// Its kind.
+    pub kind: TrackKind,
+    /// Its settings, as the source had them.
+    pub settings: TrackSettings,
+    /// Key times (f64, strictly increasing, at least 2).
+    pub times: Vec<f64>,
+    /// Quantization step of the values (finite, > 0).
+    pub step: f32,
+    /// Per component (`kind.dim()`), one integer per key (`|x| < 2^24`).
+    pub values: Vec<Vec<i32>>,
+    /// Explicit tangents, where the track's are not the rule's on its values.
+    pub tangents: Option<LooseTangents>,
+}
+
+/// The explicit tangents of a [`LooseTrack`] (value per second).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LooseTangents {
+    /// Quantization step (finite, > 0).
+    pub step: f32,
+    /// Per component, one integer per key: incoming, then outgoing.
+    pub incoming: Vec<Vec<i32>>,
+    /// As `incoming`.
+    pub outgoing: Vec<Vec<i32>>,
 }
 
 impl PackTrack {
@@ -177,9 +213,33 @@ impl PackSource {
         self.tracks.iter().map(PackTrack::stored).sum()
     }
 
+    /// Integers stored over all tracks: the grid's keys times its lanes,
+    /// and each loose track's values and tangents.
+    pub fn stored_values(&self) -> usize {
+        let loose: usize = self.loose.iter().map(LooseTrack::stored_values).sum();
+        self.keys * self.lanes() + loose
+    }
+
+    /// The grid's track `i`'s place among all the clip's tracks.
+    pub fn place(&self, i: usize) -> usize {
+        // Places taken by loose tracks before it move it on.
+        let mut at = i;
+        for l in &self.loose {
+            if l.at <= at {
+                at += 1;
+            } else {
+                break;
+            }
+        }
+        at
+    }
+
     /// Check what the format and the runtime need (see the field docs).
     pub fn validate(&self) -> Result<(), PackError> {
         self.validate_head()?;
+        for t in &self.loose {
+            t.validate()?;
+        }
         for t in &self.tracks {
             let at = |m: String| err(format!("track {}: {m}", t.name));
             if t.values.len() != t.stored() {
@@ -207,12 +267,31 @@ impl PackSource {
         if self.tracks.is_empty() {
             return err("a packed clip with no tracks");
         }
-        if self.keys.saturating_mul(self.tracks.len()) > MAX_TRACK_KEYS {
+        let loose_keys = self
+            .loose
+            .iter()
+            .fold(0usize, |n, t| n.saturating_add(t.times.len()));
+        if self
+            .keys
+            .saturating_mul(self.tracks.len())
+            .saturating_add(loose_keys)
+            > MAX_TRACK_KEYS
+        {
             return err(format!(
-                "{} keys of {} tracks: a packed clip holds at most {MAX_TRACK_KEYS} track keys (loading compiles them in full)",
+                "{} keys of {} tracks on the grid and {loose_keys} of tracks on their own: a packed clip holds at most {MAX_TRACK_KEYS} track keys (loading compiles them in full)",
                 self.keys,
                 self.tracks.len()
             ));
+        }
+        let total = self.tracks.len() + self.loose.len();
+        for (i, t) in self.loose.iter().enumerate() {
+            let after = i.checked_sub(1).map(|j| self.loose[j].at);
+            if t.at >= total || after.is_some_and(|a| t.at <= a) {
+                return err(format!(
+                    "track {} is placed at {} among {total} tracks (places increase, below the count)",
+                    t.name, t.at
+                ));
+            }
         }
         if self.keys < 2 {
             return err(format!(
@@ -291,8 +370,12 @@ impl PackSource {
     /// of them for [`to_clip`](Self::to_clip), or a few (a loader's, see
     /// `crate::compile`).
     pub(crate) fn reference(&self, times: &[f64]) -> Result<SourceClip, PackError> {
-        let mut tracks = Vec::with_capacity(self.tracks.len());
+        let mut tracks = Vec::with_capacity(self.tracks.len() + self.loose.len());
+        let mut loose = self.loose.iter().peekable();
         for t in &self.tracks {
+            while let Some(l) = loose.next_if(|l| l.at == tracks.len()) {
+                tracks.push(l.reference()?);
+            }
             let (s, n) = (&t.settings, times.len());
             let vals: Vec<[f32; 4]> = (0..n).map(|k| t.value(k)).collect();
             let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", t.name));
@@ -337,6 +420,9 @@ impl PackSource {
                 data,
             });
         }
+        for l in loose {
+            tracks.push(l.reference()?);
+        }
         SourceClip::new(self.name.clone(), tracks)
             .map_err(|d| PackError(format!("track {} appears twice", d.0)))
     }
@@ -351,7 +437,10 @@ pub struct KeyValues {
     start: f64,
     interval: f64,
     keys: usize,
+    /// The tracks on the grid, in file order.
     tracks: Vec<TrackKeys>,
+    /// The tracks on key times of their own, in file order.
+    loose: Vec<loose::LooseKeys>,
 }
 
 /// One track of [`KeyValues`].
@@ -370,33 +459,47 @@ struct TrackKeys {
 }
 
 impl KeyValues {
-    /// Sample `clip` at its keys: every track on one even grid (to 1e-6 of
-    /// the interval).
+    /// Sample `clip` at its keys. The grid is the key times of the track
+    /// with the most keys (the first such), which must be evenly spaced (to
+    /// 1e-6 of the interval); every track with those keys is packed on it,
+    /// and the others keep their own keys ([`LooseTrack`]: a reduced clip's
+    /// tracks).
     pub fn sample(clip: &SourceClip) -> Result<KeyValues, PackError> {
-        let times = clip.key_times();
-        let n = times.len();
+        let Some(most) = clip.tracks().iter().max_by_key(|t| t.data.times().len()) else {
+            return err("a packed clip needs a track");
+        };
+        // (`max_by_key` keeps the last of equals: take the first.)
+        let n = most.data.times().len();
+        let first = clip.tracks().iter().find(|t| t.data.times().len() == n);
+        let times = first.map_or(&[][..], |t| t.data.times()).to_vec();
         if n < 2 {
             return err("a packed clip needs 2 keys or more");
         }
         let (start, interval) = (times[0], (times[n - 1] - times[0]) / (n - 1) as f64);
+        let on_grid =
+            |t: &f64, k: usize| (t - (start + k as f64 * interval)).abs() <= 1e-6 * interval;
         for (k, t) in times.iter().enumerate() {
-            if (t - (start + k as f64 * interval)).abs() > 1e-6 * interval {
+            if !on_grid(t, k) {
                 return err(format!(
-                    "key time {t} s (number {k} of the clip's {n}, all tracks together) is not on an even grid of {interval} s from {start} s: a packed clip needs every track on one grid of evenly spaced keys (capture, baked animation); sample it on such a grid first"
+                    "key time {t} s (number {k} of the {n} of track {}, the track with the most keys) is not on an even grid of {interval} s from {start} s: a packed clip keeps its longest tracks on one grid of evenly spaced keys (capture, baked animation); sample it on such a grid first",
+                    first.map_or("", |t| t.name.as_str())
                 ));
             }
         }
         let mut tracks = Vec::with_capacity(clip.tracks().len());
-        for t in clip.tracks() {
-            if t.data.times().len() != n {
-                return err(format!(
-                    "track {} has {} keys, the clip {n}",
-                    t.name,
-                    t.data.times().len()
-                ));
+        let mut loose = Vec::new();
+        // The grid's tracks share `pre` and `post`: the first one's.
+        let mut ends = None;
+        for (at, t) in clip.tracks().iter().enumerate() {
+            let own = t.data.times();
+            let s = t.data.settings();
+            let on = own.len() == n && own.iter().enumerate().all(|(k, x)| on_grid(x, k));
+            if !on || *ends.get_or_insert((s.pre, s.post)) != (s.pre, s.post) {
+                loose.push(loose::LooseKeys::of(at, t)?);
+                continue;
             }
             let kind = t.data.kind();
-            let mut values: Vec<[f32; 4]> = times
+            let mut values: Vec<[f32; 4]> = own
                 .iter()
                 .map(|&time| {
                     let mut v = [0.0f32; 4];
@@ -446,12 +549,30 @@ impl KeyValues {
             interval,
             keys: n,
             tracks,
+            loose,
         })
     }
 
-    /// Track `i`'s largest magnitude over its components and keys.
+    /// Tracks, on the grid and not.
+    pub fn track_count(&self) -> usize {
+        self.tracks.len() + self.loose.len()
+    }
+
+    /// Track `i` (file order): on the grid (its index there) or loose.
+    fn which(&self, i: usize) -> Result<usize, &loose::LooseKeys> {
+        match self.loose.binary_search_by_key(&i, |l| l.at) {
+            Ok(j) => Err(&self.loose[j]),
+            Err(before) => Ok(i - before),
+        }
+    }
+
+    /// Track `i`'s largest magnitude over its components and keys (file
+    /// order).
     pub fn largest(&self, i: usize) -> f32 {
-        let t = &self.tracks[i];
+        let t = match self.which(i) {
+            Ok(g) => &self.tracks[g],
+            Err(l) => return l.largest(),
+        };
         let dim = t.kind.dim();
         t.values
             .iter()
@@ -463,15 +584,23 @@ impl KeyValues {
     /// keeps one sign stores `x y z` unless its rounded keys would leave one
     /// hemisphere.
     pub fn quantize(&self, steps: &[f32]) -> Result<PackSource, PackError> {
-        if steps.len() != self.tracks.len() {
+        if steps.len() != self.track_count() {
             return err(format!(
                 "{} steps for {} tracks",
                 steps.len(),
-                self.tracks.len()
+                self.track_count()
             ));
         }
-        let mut tracks = Vec::with_capacity(steps.len());
-        for (t, &step) in self.tracks.iter().zip(steps) {
+        let mut tracks = Vec::with_capacity(self.tracks.len());
+        let mut loose = Vec::with_capacity(self.loose.len());
+        for (i, &step) in steps.iter().enumerate() {
+            let t = match self.which(i) {
+                Ok(g) => &self.tracks[g],
+                Err(l) => {
+                    loose.push(l.quantize(step)?);
+                    continue;
+                }
+            };
             let q = |x: f32| {
                 let v = (f64::from(x) / f64::from(step)).round();
                 if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
@@ -515,6 +644,7 @@ impl KeyValues {
             interval: self.interval,
             keys: self.keys,
             tracks,
+            loose,
         })
     }
 }
@@ -1290,11 +1420,13 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads (version 5: a table of
+/// The format version this build writes and reads (version 6: tracks on
+/// key times of their own beside the grid's; version 5: a table of
 /// where each block starts; version 4: rotations whose `w` changes sign
 /// kept relative to a center, constant components without headers; older
 /// versions are refused with a one-line error).
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 mod file;
+mod loose;
 pub(crate) mod store;
