@@ -449,6 +449,14 @@ fn tracks_on_their_own_key_times_keep_their_keys() {
     let loaded = Clip::from_bytes(&bytes).unwrap();
     loaded.verify_packed().unwrap();
     assert_eq!(loaded.to_bytes().unwrap(), bytes);
+    // A track of its own on the grid's times and ends belongs on the grid.
+    let mut on_grid = source.clone();
+    let times = on_grid.times();
+    let own = &mut on_grid.loose[1];
+    own.times = times;
+    own.values = vec![vec![0; 100]; 4];
+    let e = Packed::encode(&on_grid).unwrap_err().to_string();
+    assert!(e.contains("belongs on the grid"), "{e}");
     // The loose tracks' keys stay within half a step (and what normalizing
     // a rotation adds).
     let back = source.to_clip().unwrap();

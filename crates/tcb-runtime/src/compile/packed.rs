@@ -2,10 +2,12 @@
 //! keys as playback reaches them, and needs from the file only what no key
 //! holds (the ends' controls and the sentinels, the chord weights, the
 //! layout). Those come from a reference of the few keys at the ends
-//! (`END_KEYS` each side), compiled as usual into one group; the grid is
-//! then the clip's own even one. [`Clip::verify_packed`] compiles the whole
-//! reference and checks every stored segment against the decoder, bit for
-//! bit (what `tcb compress` runs before writing, and the tests).
+//! (`END_KEYS` each side), compiled as usual into one group, pinned first;
+//! the grid is then the clip's own even one. Tracks on key times of their
+//! own are in that reference in full and compile as any clip's (loose
+//! lanes, or groups after the first). [`Clip::verify_packed`] compiles the
+//! whole reference and checks every stored segment against the decoder,
+//! bit for bit (what `tcb compress` runs before writing, and the tests).
 
 use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
@@ -166,7 +168,8 @@ impl Clip {
 }
 
 /// The reference of the stream's first and last `END_KEYS` keys (all of
-/// them for a short clip), at their real times, compiled into one group.
+/// them for a short clip), at their real times, compiled into one group
+/// (first), with the tracks on key times of their own in full.
 fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
     let head = packed.head();
     let n = head.keys;
@@ -203,12 +206,11 @@ fn grid_group(clip: &Clip, head: &crate::PackSource) -> Result<(), PackError> {
         .filter(|t| t.kind != TrackKind::Quat)
         .map(|t| t.kind.dim())
         .sum();
-    let rotations = head.tracks.len()
-        - head
-            .tracks
-            .iter()
-            .filter(|t| t.kind != TrackKind::Quat)
-            .count();
+    let rotations = head
+        .tracks
+        .iter()
+        .filter(|t| t.kind == TrackKind::Quat)
+        .count();
     if g.is_none_or(|g| (g.vector_channels, g.rotations) != (vectors, rotations)) {
         return err(
             "a track on key times of its own has the key times of the grid's ends, and would share their group: a packed clip cannot hold it",

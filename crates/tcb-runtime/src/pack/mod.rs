@@ -20,6 +20,12 @@
 //! so playback decodes one key per key it crosses (shifts and adds), and a
 //! seek decodes from the start of its 64-key block.
 //!
+//! Tracks on key times of their own (a reduced clip's, beside the tracks it
+//! keeps on the capture's grid) keep their keys ([`LooseTrack`]): f64
+//! times, and values (and explicit tangents, where the tangent rule does
+//! not give them) in integers of their own steps, decoded at load into the
+//! reference's tracks and compiled as any clip's.
+//!
 //! [`PackSource`] is the description in integers (what the encoder in
 //! `tcb-fit` searches over); [`PackSource::to_clip`] is its reference, an
 //! ordinary `tcb_core::SourceClip` whose values are the dequantized integers;
@@ -284,7 +290,22 @@ impl PackSource {
             ));
         }
         let total = self.tracks.len() + self.loose.len();
+        let ends = self
+            .tracks
+            .first()
+            .map(|t| (t.settings.pre, t.settings.post));
         for (i, t) in self.loose.iter().enumerate() {
+            // Compiled, such a track would join the grid's group.
+            let s = &t.settings;
+            if t.times.len() == self.keys
+                && Some((s.pre, s.post)) == ends
+                && (0..self.keys).all(|k| t.times[k].to_bits() == self.time(k).to_bits())
+            {
+                return err(format!(
+                    "track {} is on the grid's key times with its pre and post: it belongs on the grid",
+                    t.name
+                ));
+            }
             let after = i.checked_sub(1).map(|j| self.loose[j].at);
             if t.at >= total || after.is_some_and(|a| t.at <= a) {
                 return err(format!(
