@@ -353,9 +353,23 @@ impl<'a> Reader<'a> {
                 if w > 25 {
                     return err(format!("{what}: a width of {w} bits (at most 25)"));
                 }
-                let bytes = self.take((n * w as usize).div_ceil(8), what)?;
-                Ok((0..n)
-                    .map(|k| base.wrapping_add(bits_at(bytes, k * w as usize, w) as i32))
+                let bits = n * w as usize;
+                let bytes = self.take(bits.div_ceil(8), what)?;
+                let offsets: Vec<u32> = (0..n).map(|k| bits_at(bytes, k * w as usize, w)).collect();
+                // Only as `Writer::ints` writes them (a file read writes back
+                // the same bytes): the base the smallest value, the width
+                // the fewest bits of the largest offset, the padding zero.
+                let least = offsets.iter().copied().min().unwrap_or(0);
+                let most = offsets.iter().copied().max().unwrap_or(0);
+                let pad = bytes.last().map_or(0, |b| b >> (bits % 8) << (bits % 8));
+                if least != 0 || w != 32 - most.leading_zeros() || (!bits.is_multiple_of(8) && pad != 0) {
+                    return err(format!(
+                        "{what}: not coded as written (the base is the smallest value, the width the fewest bits, the padding zero)"
+                    ));
+                }
+                Ok(offsets
+                    .into_iter()
+                    .map(|off| base.wrapping_add(off as i32))
                     .collect())
             })
             .collect()
