@@ -50,7 +50,7 @@ pub(crate) struct LooseLane {
     pub grid: TimeGrid,
     /// Components used (1 to 4).
     pub dim: usize,
-    /// Per key (and sentinel pseudo-key, see `clip::per_key`), per
+    /// Per key (and sentinel pseudo-key, see `store::per_key`), per
     /// component: `[P, TO, TI]`, at `key(key * dim + c)`.
     keys: Keys,
     /// Where lane 0 of its first control plane is in the instance's
@@ -77,7 +77,7 @@ enum Keys {
 
 impl LooseLane {
     /// A lane on `grid` from its components' controls per stored segment
-    /// (`[P0, P1, M0, M1]` each, as `clip.rs` builds them for every track),
+    /// (`[P0, P1, M0, M1]` each, as `crate::compile` builds them for every track),
     /// stored per key.
     pub fn new(grid: TimeGrid, comps: &[&Vec<[f32; 4]>]) -> Self {
         let per: Vec<Vec<[f32; KEY_STRIDE]>> = comps.iter().map(|r| per_key(r)).collect();
