@@ -29,8 +29,9 @@ impl Clip {
     /// as playback reaches them (see [`crate::pack`]). It decodes the keys
     /// of the stream's first and last blocks only (about 0.3 ms for CMU
     /// 01_01, where the whole reference would take 30), and allocates a
-    /// few bytes per component (the grid's times are `start + k interval`,
-    /// not a list); see
+    /// few bytes per component for the grid (its times are `start + k
+    /// interval`, not a list); tracks on key times of their own are
+    /// compiled in full, to f32 controls. See
     /// [`verify_packed`](Self::verify_packed) for the check of every key.
     pub fn from_packed(packed: Arc<Packed>) -> Result<Clip, PackError> {
         if packed.stream_structure()? != packed.bits {

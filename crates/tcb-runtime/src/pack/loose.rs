@@ -85,25 +85,22 @@ impl LooseTrack {
                 .collect()
         };
         let values = keys(&self.values, self.step);
-        let tangents = self
-            .tangents
-            .as_ref()
-            .map(|t| (keys(&t.incoming, t.step), keys(&t.outgoing, t.step)));
-        let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", self.name));
-        let (times, s) = (self.times.clone(), &self.settings);
-        let params = |tangents: &Option<(Keys, Keys)>| -> Vec<KeyParams<[f32; 4]>> {
-            match tangents {
-                None => Vec::new(),
-                Some((i, o)) => (0..n)
+        // Explicit tangents on every key, or none (the rule's).
+        let p: Vec<KeyParams<[f32; 4]>> = match &self.tangents {
+            None => Vec::new(),
+            Some(t) => {
+                let (i, o) = (keys(&t.incoming, t.step), keys(&t.outgoing, t.step));
+                (0..n)
                     .map(|k| KeyParams {
                         tangent_in: Some(i[k]),
                         tangent_out: Some(o[k]),
                         ..KeyParams::default()
                     })
-                    .collect(),
+                    .collect()
             }
         };
-        let p = params(&tangents);
+        let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", self.name));
+        let (times, s) = (self.times.clone(), &self.settings);
         let data = match self.kind {
             TrackKind::Scalar => {
                 TrackData::Scalar(vector::<f32>(times, &values, &p, s).map_err(e)?)
@@ -257,7 +254,8 @@ impl LooseKeys {
 
     /// Quantized in steps of `step` (its tangents in steps of `step` over
     /// its longest interval, so that a tangent's rounding moves the curve
-    /// about as much as a value's).
+    /// about as much as a value's, or coarser where their integers would
+    /// reach 2^22).
     pub fn quantize(&self, step: f32) -> Result<LooseTrack, PackError> {
         let dim = self.kind.dim();
         let ints = |keys: &[[f32; 4]], step: f32| -> Result<Vec<Vec<i32>>, PackError> {
@@ -287,7 +285,14 @@ impl LooseKeys {
         let tangents = match &self.tangents {
             None => None,
             Some((i, o)) => {
-                let step = (f64::from(step) / longest) as f32;
+                // No finer than keeps the largest tangent's integer below
+                // 2^22 (as the search keeps the values').
+                let largest = i
+                    .iter()
+                    .chain(o)
+                    .flat_map(|v| v[..dim].iter().map(|x| f64::from(x.abs())))
+                    .fold(0.0f64, f64::max);
+                let step = (f64::from(step) / longest).max(largest / f64::from(1u32 << 22)) as f32;
                 if !(step.is_finite() && step > 0.0) {
                     return err(format!(
                         "track {}: no tangent step for intervals up to {longest} s",
