@@ -46,7 +46,13 @@
 //!
 //! with `d` the difference, `v` the clip's value (0 in place of the
 //! second term where it changes sign) and `s` from Markov's inequality:
-//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Rotations
+//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Where
+//! the two curves do not play one segment with the same key times and
+//! controls, f32 playback (`s` and the basis in f32) puts each sample off
+//! its polynomial by up to 2^-21 (|p0| + |p1| + |m0| + |m1|), which the
+//! bound adds where that is more than 5e-5 of the value: on controls far
+//! larger than the value, a key moved by f32 makes the reader's `s` round
+//! apart from the clip's between the samples. Rotations
 //! are normalized (or squad), no polynomials: their error is an estimate
 //! from samples taken more densely wherever either curve turns fast. A
 //! track whose read-back overflows f32 where the clip is finite is refused.
@@ -115,8 +121,9 @@ pub struct TimeRounding {
     /// The largest difference from the reference (relative to max(1,
     /// |value|)) of the track as `tcb import` reads the export back,
     /// bounded over every interval between the keys, the stored times and
-    /// the ends of ease phases from 9 points in each (33 where eased; see
-    /// the module docs).
+    /// the ends of ease phases from 9 points in each (33 where eased),
+    /// f32 playback's rounding included where it is large (see the module
+    /// docs).
     pub error: f64,
 }
 
@@ -769,7 +776,7 @@ fn time_rounding_note(
         ),
     };
     Some(format!(
-        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: shift the clip's times toward 0, or accept it with a larger max error)"
+        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: put the keys on times f32 holds, such as multiples of 1/64 s, or shift the clip's times toward 0, or accept it with a larger max error)"
     ))
 }
 
@@ -927,8 +934,10 @@ const EASED_SAMPLING: (usize, f64) = (32, 0.13);
 /// which f32 keys and tangents of that size cannot keep small (issue 29
 /// class 6). Rotations (up to sign) are no polynomials: for them an
 /// estimate that samples where they turn fast
-/// ([`rotation_interval_error`]). Infinite where `back` is not finite and
-/// `data` is.
+/// ([`rotation_interval_error`]). Vector tracks' samples are each off
+/// their polynomial by f32 playback's rounding ([`PlaybackRounding`]),
+/// counted where it is more than [`PLAYBACK_ROUNDING_FLOOR`]. Infinite
+/// where `back` is not finite and `data` is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
@@ -980,7 +989,8 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
             data.sample_into(t.clamp(first, last), &mut want[..dim], None);
             back.sample_into(t, &mut got[..dim], None);
         }
-        let e = interval_error(&want[..=points], &got[..=points], dim, slack);
+        let rounding = PlaybackRounding::between(data, back, mid.clamp(first, last), mid);
+        let e = interval_error(&want[..=points], &got[..=points], dim, slack, rounding);
         worst = worst.max(e);
         if worst == f64::INFINITY {
             break;
@@ -991,8 +1001,20 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
 
 /// [`read_back_error`]'s bound over one interval from the samples `want`
 /// and `got` (`dim` components each) at its evenly spaced points, a
-/// polynomial straying `slack` of its samples' range between two of them.
-fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -> f64 {
+/// polynomial straying `slack` of its samples' range between two of them,
+/// each sample off its polynomial by up to `rounding` (f32 playback).
+///
+/// With `n` the difference's rounding and `r` its samples' range, the
+/// polynomial difference is within `max |d_i| + n + slack (r + 2 n)` of 0
+/// and a sample of it, played, within `n` more; the least `|value|` is
+/// bounded the same way with the clip's own rounding.
+fn interval_error(
+    want: &[[f32; 4]],
+    got: &[[f32; 4]],
+    dim: usize,
+    slack: f64,
+    rounding: PlaybackRounding,
+) -> f64 {
     let mut worst = 0.0f64;
     for c in 0..dim {
         let w: Vec<f64> = want.iter().map(|v| f64::from(v[c])).collect();
@@ -1017,6 +1039,7 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -
             x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                 - x.iter().copied().fold(f64::INFINITY, f64::min)
         };
+        let (n, own) = (rounding.difference[c], rounding.clip[c]);
         let (d_slack, w_slack) = (slack * range(&d), slack * range(&w));
         for i in 0..d.len() - 1 {
             let off = d[i].abs().max(d[i + 1].abs()) + d_slack;
@@ -1025,10 +1048,119 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -
             } else {
                 0.0
             };
-            worst = worst.max(off / least.max(1.0));
+            let sampled = off / least.max(1.0);
+            // With f32 playback's rounding, where it is more than the
+            // floor (below it, the curve's own f32 precision).
+            let rounded =
+                (off + (2.0 + 2.0 * slack) * n) / (least - (2.0 + 2.0 * slack) * own).max(1.0);
+            worst = worst.max(if rounded - sampled > PLAYBACK_ROUNDING_FLOOR {
+                rounded
+            } else {
+                sampled
+            });
         }
     }
     worst
+}
+
+/// How far one f32 evaluation of a vector segment (`tcb_core::Track`'s,
+/// the runtime's kernels') can be from the segment's polynomial at the
+/// exact parameter, per unit of `|p0| + |p1| + |m0| + |m1|` (each
+/// component): `s` rounded to f32 (half an ulp of `s`, on a slope of at
+/// most 1.5 per unit), the Hermite basis (a few ulps near `s` = 1, where
+/// `2 s^3 - 3 s^2 + 1` cancels), the four products and the three sums.
+/// 2^-21 (8 f32 ulps of 1); the worst of 2 million random segments was 6.
+/// On controls far larger than the value (tangents of 1e24 leading to a
+/// key of 1.85) this is far larger than the value's own ulp.
+const PLAYBACK_ROUNDING: f64 = 4.0 * f32::EPSILON as f64;
+
+/// Below this (relative to max(1, |value|)), what [`PLAYBACK_ROUNDING`]
+/// adds to a track's bound is left out: the f32 precision of a curve whose
+/// controls are not far larger than its values, which the clip played in
+/// f32 has as well. The bound of [`PLAYBACK_ROUNDING`] is a worst case,
+/// some 10 times what such a curve's samples show (a vector track on 0.3
+/// s and 1.1 s keys, tangents of 5 beside values of 1: bounded at 3e-5,
+/// read back within 1e-6); counted, it would put every export of 30 fps
+/// keys above the default `max_error`.
+const PLAYBACK_ROUNDING_FLOOR: f64 = 5e-5;
+
+/// How far f32 playback can put a sample off its polynomial, per
+/// component, in one interval of [`read_back_error`]: the clip's own
+/// ([`PLAYBACK_ROUNDING`] times its segment's controls) and the difference
+/// of the clip and its read-back (both curves'). Zero where both play one
+/// segment on the same key times with the same controls: then they
+/// compute the same f32 numbers at every time, and only there. Where a key
+/// moved (glTF's f32 times), one `s` can round apart from the other and
+/// the two differ by the segment's rounding, which on controls far larger
+/// than the value is far more than the value's ulp (issue 29 class 6:
+/// reported exact, read back 1.7e-4 off a component of 1.1e21 beside
+/// controls of 1e24).
+#[derive(Clone, Copy, Default)]
+struct PlaybackRounding {
+    clip: [f64; 4],
+    difference: [f64; 4],
+}
+
+impl PlaybackRounding {
+    /// For `data` played at `t` (inside its keys) and `back` at `t_back`.
+    fn between(data: &TrackData, back: &TrackData, t: f64, t_back: f64) -> PlaybackRounding {
+        let (a, b) = (played_segment(data, t), played_segment(back, t_back));
+        if a == b {
+            return PlaybackRounding::default();
+        }
+        let size = |p: &Option<PlayedSegment>| {
+            let mut s = [0.0f64; 4];
+            if let Some(p) = p {
+                for control in &p.controls {
+                    for (s, x) in s.iter_mut().zip(control) {
+                        *s += f64::from(x.abs());
+                    }
+                }
+            }
+            s
+        };
+        let (sa, sb) = (size(&a), size(&b));
+        PlaybackRounding {
+            clip: sa.map(|x| PLAYBACK_ROUNDING * x),
+            difference: std::array::from_fn(|c| PLAYBACK_ROUNDING * (sa[c] + sb[c])),
+        }
+    }
+}
+
+/// The segment a vector track plays at a time inside its keys: its key
+/// times, controls (`p0`, `p1`, `m0`, `m1`) and ease, all its value
+/// depends on there.
+#[derive(PartialEq)]
+struct PlayedSegment {
+    times: (f64, f64),
+    controls: [[f32; 4]; 4],
+    ease: SegmentEase,
+}
+
+/// The segment `data` plays at `t`; `None` for rotations, outside the keys
+/// and at the last key (held: the key itself), and on `step` segments
+/// (the key itself: basis `[1, 0, 0, 0]`).
+fn played_segment(data: &TrackData, t: f64) -> Option<PlayedSegment> {
+    fn of<V: TcbValue>(track: &Track<V>, t: f64) -> Option<PlayedSegment> {
+        let times = track.times();
+        if !(times[0] <= t && t < times[times.len() - 1]) {
+            return None;
+        }
+        let k = tcb_core::track::segment_from(times, t, 0);
+        let seg = &track.segments()[k];
+        (seg.interp != Interp::Step).then(|| PlayedSegment {
+            times: (times[k], times[k + 1]),
+            controls: [seg.p0, seg.p1, seg.m0, seg.m1].map(V::to_array),
+            ease: seg.ease,
+        })
+    }
+    match data {
+        TrackData::Scalar(t_) => of(t_, t),
+        TrackData::Vec2(t_) => of(t_, t),
+        TrackData::Vec3(t_) => of(t_, t),
+        TrackData::Vec4(t_) => of(t_, t),
+        TrackData::Quat(_) => None,
+    }
 }
 
 /// How far apart (largest component) two neighbouring samples of a
