@@ -54,7 +54,9 @@
 //! larger than the value, a key moved by f32 makes the reader's `s` round
 //! apart from the clip's between the samples. Rotations
 //! are normalized (or squad), no polynomials: their error is an estimate
-//! from samples taken more densely wherever either curve turns fast. A
+//! from samples taken more densely wherever either curve turns fast, plus,
+//! for hermite rotations, the f32 rounding of their cubics divided by the
+//! least length of the cubics at the samples (where more than 5e-5). A
 //! track whose read-back overflows f32 where the clip is finite is refused.
 
 use crate::error::Error;
@@ -974,7 +976,13 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
                 back.sample_into(t, &mut b, None);
                 (a, b)
             };
-            worst = worst.max(rotation_interval_error(sample, w[0], w[1], points));
+            let e = rotation_interval_error(sample, w[0], w[1], points);
+            let rounding = hermite_rotation_rounding(data, back, w, first, last, points);
+            worst = worst.max(if rounding > PLAYBACK_ROUNDING_FLOOR {
+                e + rounding
+            } else {
+                e
+            });
             if worst == f64::INFINITY {
                 break;
             }
@@ -1159,8 +1167,54 @@ fn played_segment(data: &TrackData, t: f64) -> Option<PlayedSegment> {
         TrackData::Vec2(t_) => of(t_, t),
         TrackData::Vec3(t_) => of(t_, t),
         TrackData::Vec4(t_) => of(t_, t),
-        TrackData::Quat(_) => None,
+        // A hermite rotation plays its curve segments as a Vec4 cubic in
+        // f32, normalized; slerp and squad segments in f64, `step` holds.
+        TrackData::Quat(r) => {
+            let h = r.hermite_track()?;
+            let k = tcb_core::track::segment_from(h.times(), t, 0);
+            if r.interps()[k] == Interp::Curve {
+                of(h, t)
+            } else {
+                None
+            }
+        }
     }
+}
+
+/// For a hermite rotation ([`read_back_error`]'s interval `w`): what f32
+/// playback's rounding of the un-normalized cubics ([`PlaybackRounding`],
+/// largest component) can move the rotation, divided by the least length
+/// of the clip's or the read-back's cubic at `points + 1` samples (an
+/// estimate, as the rotation's error is). 0 where both play one segment
+/// on the same times and controls, or neither plays a hermite segment.
+fn hermite_rotation_rounding(
+    data: &TrackData,
+    back: &TrackData,
+    w: &[f64],
+    first: f64,
+    last: f64,
+    points: usize,
+) -> f64 {
+    let mid = 0.5 * (w[0] + w[1]);
+    let rounding = PlaybackRounding::between(data, back, mid.clamp(first, last), mid);
+    let n = rounding.difference.into_iter().fold(0.0, f64::max);
+    if n == 0.0 {
+        return 0.0;
+    }
+    fn cubic(d: &TrackData) -> Option<&Track<glam::Vec4>> {
+        match d {
+            TrackData::Quat(r) => r.hermite_track(),
+            _ => None,
+        }
+    }
+    let length = |h: Option<&Track<glam::Vec4>>, t: f64| {
+        h.map_or(f64::INFINITY, |h| f64::from(h.sample(t).length()))
+    };
+    let least = (0..=points)
+        .map(|i| w[0] + (w[1] - w[0]) * i as f64 / points as f64)
+        .map(|t| length(cubic(data), t.clamp(first, last)).min(length(cubic(back), t)))
+        .fold(f64::INFINITY, f64::min);
+    2.0 * n / least
 }
 
 /// How far apart (largest component) two neighbouring samples of a
