@@ -938,8 +938,9 @@ const EASED_SAMPLING: (usize, f64) = (32, 0.13);
 /// estimate that samples where they turn fast
 /// ([`rotation_interval_error`]). Vector tracks' samples are each off
 /// their polynomial by f32 playback's rounding ([`PlaybackRounding`]),
-/// counted where it is more than [`PLAYBACK_ROUNDING_FLOOR`]. Infinite
-/// where `back` is not finite and `data` is.
+/// counted where it is more than [`PLAYBACK_ROUNDING_FLOOR`]; hermite
+/// rotations add it as [`hermite_rotation_rounding`] estimates it, on the
+/// same condition. Infinite where `back` is not finite and `data` is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
@@ -1135,9 +1136,9 @@ impl PlaybackRounding {
     }
 }
 
-/// The segment a vector track plays at a time inside its keys: its key
-/// times, controls (`p0`, `p1`, `m0`, `m1`) and ease, all its value
-/// depends on there.
+/// The segment a vector track (or a hermite rotation's cubic) plays at a
+/// time inside its keys: its key times, controls (`p0`, `p1`, `m0`, `m1`)
+/// and ease, all its f32 value depends on there.
 #[derive(PartialEq)]
 struct PlayedSegment {
     times: (f64, f64),
@@ -1145,9 +1146,10 @@ struct PlayedSegment {
     ease: SegmentEase,
 }
 
-/// The segment `data` plays at `t`; `None` for rotations, outside the keys
-/// and at the last key (held: the key itself), and on `step` segments
-/// (the key itself: basis `[1, 0, 0, 0]`).
+/// The segment `data` plays at `t` in f32 (for a rotation, its hermite
+/// cubic's); `None` outside the keys and at the last key (held: the key
+/// itself), on `step` segments (the key itself: basis `[1, 0, 0, 0]`) and
+/// on rotations' slerp and squad segments (played in f64).
 fn played_segment(data: &TrackData, t: f64) -> Option<PlayedSegment> {
     fn of<V: TcbValue>(track: &Track<V>, t: f64) -> Option<PlayedSegment> {
         let times = track.times();
@@ -1214,7 +1216,9 @@ fn hermite_rotation_rounding(
         .map(|i| w[0] + (w[1] - w[0]) * i as f64 / points as f64)
         .map(|t| length(cubic(data), t.clamp(first, last)).min(length(cubic(back), t)))
         .fold(f64::INFINITY, f64::min);
-    2.0 * n / least
+    // Unit rotations up to sign are never more than 2 apart in a
+    // component (and a cubic of length 0 would give infinity).
+    (2.0 * n / least).min(2.0)
 }
 
 /// How far apart (largest component) two neighbouring samples of a
