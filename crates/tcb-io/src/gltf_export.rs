@@ -46,9 +46,17 @@
 //!
 //! with `d` the difference, `v` the clip's value (0 in place of the
 //! second term where it changes sign) and `s` from Markov's inequality:
-//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Rotations
+//! 0.116 for degree 3 at 8 intervals, 0.13 for degree 6 at 32. Where
+//! the two curves do not play one segment with the same key times and
+//! controls, f32 playback (`s` and the basis in f32) puts each sample off
+//! its polynomial by up to 2^-21 (|p0| + |p1| + |m0| + |m1|), which the
+//! bound adds where that is more than 5e-5 of the value: on controls far
+//! larger than the value, a key moved by f32 makes the reader's `s` round
+//! apart from the clip's between the samples. Rotations
 //! are normalized (or squad), no polynomials: their error is an estimate
-//! from samples taken more densely wherever either curve turns fast. A
+//! from samples taken more densely wherever either curve turns fast, plus,
+//! for hermite rotations, the f32 rounding of their cubics divided by the
+//! least length of the cubics at the samples (where more than 5e-5). A
 //! track whose read-back overflows f32 where the clip is finite is refused.
 
 use crate::error::Error;
@@ -115,8 +123,9 @@ pub struct TimeRounding {
     /// The largest difference from the reference (relative to max(1,
     /// |value|)) of the track as `tcb import` reads the export back,
     /// bounded over every interval between the keys, the stored times and
-    /// the ends of ease phases from 9 points in each (33 where eased; see
-    /// the module docs).
+    /// the ends of ease phases from 9 points in each (33 where eased),
+    /// f32 playback's rounding included where it is large (see the module
+    /// docs).
     pub error: f64,
 }
 
@@ -769,7 +778,7 @@ fn time_rounding_note(
         ),
     };
     Some(format!(
-        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: shift the clip's times toward 0, or accept it with a larger max error)"
+        "{what}, above the max error {max_error:e} (f32 keeps about 7 significant digits of a time: put the keys on times f32 holds, such as multiples of 1/64 s, or shift the clip's times toward 0, or accept it with a larger max error)"
     ))
 }
 
@@ -927,8 +936,11 @@ const EASED_SAMPLING: (usize, f64) = (32, 0.13);
 /// which f32 keys and tangents of that size cannot keep small (issue 29
 /// class 6). Rotations (up to sign) are no polynomials: for them an
 /// estimate that samples where they turn fast
-/// ([`rotation_interval_error`]). Infinite where `back` is not finite and
-/// `data` is.
+/// ([`rotation_interval_error`]). Vector tracks' samples are each off
+/// their polynomial by f32 playback's rounding ([`PlaybackRounding`]),
+/// counted where it is more than [`PLAYBACK_ROUNDING_FLOOR`]; hermite
+/// rotations add it as [`hermite_rotation_rounding`] estimates it, on the
+/// same condition. Infinite where `back` is not finite and `data` is.
 fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
     let dim = data.kind().dim();
     let rotation = data.kind() == TrackKind::Quat;
@@ -965,7 +977,13 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
                 back.sample_into(t, &mut b, None);
                 (a, b)
             };
-            worst = worst.max(rotation_interval_error(sample, w[0], w[1], points));
+            let e = rotation_interval_error(sample, w[0], w[1], points);
+            let rounding = hermite_rotation_rounding(data, back, w, first, last, points);
+            worst = worst.max(if rounding > PLAYBACK_ROUNDING_FLOOR {
+                e + rounding
+            } else {
+                e
+            });
             if worst == f64::INFINITY {
                 break;
             }
@@ -980,7 +998,8 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
             data.sample_into(t.clamp(first, last), &mut want[..dim], None);
             back.sample_into(t, &mut got[..dim], None);
         }
-        let e = interval_error(&want[..=points], &got[..=points], dim, slack);
+        let rounding = PlaybackRounding::between(data, back, mid.clamp(first, last), mid);
+        let e = interval_error(&want[..=points], &got[..=points], dim, slack, rounding);
         worst = worst.max(e);
         if worst == f64::INFINITY {
             break;
@@ -991,8 +1010,20 @@ fn read_back_error(data: &TrackData, back: &TrackData) -> f64 {
 
 /// [`read_back_error`]'s bound over one interval from the samples `want`
 /// and `got` (`dim` components each) at its evenly spaced points, a
-/// polynomial straying `slack` of its samples' range between two of them.
-fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -> f64 {
+/// polynomial straying `slack` of its samples' range between two of them,
+/// each sample off its polynomial by up to `rounding` (f32 playback).
+///
+/// With `n` the difference's rounding and `r` its samples' range, the
+/// polynomial difference is within `max |d_i| + n + slack (r + 2 n)` of 0
+/// and a sample of it, played, within `n` more; the least `|value|` is
+/// bounded the same way with the clip's own rounding.
+fn interval_error(
+    want: &[[f32; 4]],
+    got: &[[f32; 4]],
+    dim: usize,
+    slack: f64,
+    rounding: PlaybackRounding,
+) -> f64 {
     let mut worst = 0.0f64;
     for c in 0..dim {
         let w: Vec<f64> = want.iter().map(|v| f64::from(v[c])).collect();
@@ -1017,6 +1048,7 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -
             x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                 - x.iter().copied().fold(f64::INFINITY, f64::min)
         };
+        let (n, own) = (rounding.difference[c], rounding.clip[c]);
         let (d_slack, w_slack) = (slack * range(&d), slack * range(&w));
         for i in 0..d.len() - 1 {
             let off = d[i].abs().max(d[i + 1].abs()) + d_slack;
@@ -1025,10 +1057,168 @@ fn interval_error(want: &[[f32; 4]], got: &[[f32; 4]], dim: usize, slack: f64) -
             } else {
                 0.0
             };
-            worst = worst.max(off / least.max(1.0));
+            let sampled = off / least.max(1.0);
+            // With f32 playback's rounding, where it is more than the
+            // floor (below it, the curve's own f32 precision).
+            let rounded =
+                (off + (2.0 + 2.0 * slack) * n) / (least - (2.0 + 2.0 * slack) * own).max(1.0);
+            worst = worst.max(if rounded - sampled > PLAYBACK_ROUNDING_FLOOR {
+                rounded
+            } else {
+                sampled
+            });
         }
     }
     worst
+}
+
+/// How far one f32 evaluation of a vector segment (`tcb_core::Track`'s,
+/// the runtime's kernels') can be from the segment's polynomial at the
+/// exact parameter, per unit of `|p0| + |p1| + |m0| + |m1|` (each
+/// component): `s` rounded to f32 (half an ulp of `s`, on a slope of at
+/// most 1.5 per unit), the Hermite basis (a few ulps near `s` = 1, where
+/// `2 s^3 - 3 s^2 + 1` cancels), the four products and the three sums.
+/// 2^-21 (8 f32 ulps of 1); the worst of 2 million random segments was 6.
+/// On controls far larger than the value (tangents of 1e24 leading to a
+/// key of 1.85) this is far larger than the value's own ulp.
+const PLAYBACK_ROUNDING: f64 = 4.0 * f32::EPSILON as f64;
+
+/// Below this (relative to max(1, |value|)), what [`PLAYBACK_ROUNDING`]
+/// adds to a track's bound is left out: the f32 precision of a curve whose
+/// controls are not far larger than its values, which the clip played in
+/// f32 has as well. The bound of [`PLAYBACK_ROUNDING`] is a worst case,
+/// some 10 times what such a curve's samples show (a vector track on 0.3
+/// s and 1.1 s keys, tangents of 5 beside values of 1: bounded at 3e-5,
+/// read back within 1e-6); counted, it would put every export of 30 fps
+/// keys above the default `max_error`.
+const PLAYBACK_ROUNDING_FLOOR: f64 = 5e-5;
+
+/// How far f32 playback can put a sample off its polynomial, per
+/// component, in one interval of [`read_back_error`]: the clip's own
+/// ([`PLAYBACK_ROUNDING`] times its segment's controls) and the difference
+/// of the clip and its read-back (both curves'). Zero where both play one
+/// segment on the same key times with the same controls: then they
+/// compute the same f32 numbers at every time, and only there. Where a key
+/// moved (glTF's f32 times), one `s` can round apart from the other and
+/// the two differ by the segment's rounding, which on controls far larger
+/// than the value is far more than the value's ulp (issue 29 class 6:
+/// reported exact, read back 1.7e-4 off a component of 1.1e21 beside
+/// controls of 1e24).
+#[derive(Clone, Copy, Default)]
+struct PlaybackRounding {
+    clip: [f64; 4],
+    difference: [f64; 4],
+}
+
+impl PlaybackRounding {
+    /// For `data` played at `t` (inside its keys) and `back` at `t_back`.
+    fn between(data: &TrackData, back: &TrackData, t: f64, t_back: f64) -> PlaybackRounding {
+        let (a, b) = (played_segment(data, t), played_segment(back, t_back));
+        if a == b {
+            return PlaybackRounding::default();
+        }
+        let size = |p: &Option<PlayedSegment>| {
+            let mut s = [0.0f64; 4];
+            if let Some(p) = p {
+                for control in &p.controls {
+                    for (s, x) in s.iter_mut().zip(control) {
+                        *s += f64::from(x.abs());
+                    }
+                }
+            }
+            s
+        };
+        let (sa, sb) = (size(&a), size(&b));
+        PlaybackRounding {
+            clip: sa.map(|x| PLAYBACK_ROUNDING * x),
+            difference: std::array::from_fn(|c| PLAYBACK_ROUNDING * (sa[c] + sb[c])),
+        }
+    }
+}
+
+/// The segment a vector track (or a hermite rotation's cubic) plays at a
+/// time inside its keys: its key times, controls (`p0`, `p1`, `m0`, `m1`)
+/// and ease, all its f32 value depends on there.
+#[derive(PartialEq)]
+struct PlayedSegment {
+    times: (f64, f64),
+    controls: [[f32; 4]; 4],
+    ease: SegmentEase,
+}
+
+/// The segment `data` plays at `t` in f32 (for a rotation, its hermite
+/// cubic's); `None` outside the keys and at the last key (held: the key
+/// itself), on `step` segments (the key itself: basis `[1, 0, 0, 0]`) and
+/// on rotations' slerp and squad segments (played in f64).
+fn played_segment(data: &TrackData, t: f64) -> Option<PlayedSegment> {
+    fn of<V: TcbValue>(track: &Track<V>, t: f64) -> Option<PlayedSegment> {
+        let times = track.times();
+        if !(times[0] <= t && t < times[times.len() - 1]) {
+            return None;
+        }
+        let k = tcb_core::track::segment_from(times, t, 0);
+        let seg = &track.segments()[k];
+        (seg.interp != Interp::Step).then(|| PlayedSegment {
+            times: (times[k], times[k + 1]),
+            controls: [seg.p0, seg.p1, seg.m0, seg.m1].map(V::to_array),
+            ease: seg.ease,
+        })
+    }
+    match data {
+        TrackData::Scalar(t_) => of(t_, t),
+        TrackData::Vec2(t_) => of(t_, t),
+        TrackData::Vec3(t_) => of(t_, t),
+        TrackData::Vec4(t_) => of(t_, t),
+        // A hermite rotation plays its curve segments as a Vec4 cubic in
+        // f32, normalized; slerp and squad segments in f64, `step` holds.
+        TrackData::Quat(r) => {
+            let h = r.hermite_track()?;
+            let k = tcb_core::track::segment_from(h.times(), t, 0);
+            if r.interps()[k] == Interp::Curve {
+                of(h, t)
+            } else {
+                None
+            }
+        }
+    }
+}
+
+/// For a hermite rotation ([`read_back_error`]'s interval `w`): what f32
+/// playback's rounding of the un-normalized cubics ([`PlaybackRounding`],
+/// largest component) can move the rotation, divided by the least length
+/// of the clip's or the read-back's cubic at `points + 1` samples (an
+/// estimate, as the rotation's error is). 0 where both play one segment
+/// on the same times and controls, or neither plays a hermite segment.
+fn hermite_rotation_rounding(
+    data: &TrackData,
+    back: &TrackData,
+    w: &[f64],
+    first: f64,
+    last: f64,
+    points: usize,
+) -> f64 {
+    let mid = 0.5 * (w[0] + w[1]);
+    let rounding = PlaybackRounding::between(data, back, mid.clamp(first, last), mid);
+    let n = rounding.difference.into_iter().fold(0.0, f64::max);
+    if n == 0.0 {
+        return 0.0;
+    }
+    fn cubic(d: &TrackData) -> Option<&Track<glam::Vec4>> {
+        match d {
+            TrackData::Quat(r) => r.hermite_track(),
+            _ => None,
+        }
+    }
+    let length = |h: Option<&Track<glam::Vec4>>, t: f64| {
+        h.map_or(f64::INFINITY, |h| f64::from(h.sample(t).length()))
+    };
+    let least = (0..=points)
+        .map(|i| w[0] + (w[1] - w[0]) * i as f64 / points as f64)
+        .map(|t| length(cubic(data), t.clamp(first, last)).min(length(cubic(back), t)))
+        .fold(f64::INFINITY, f64::min);
+    // Unit rotations up to sign are never more than 2 apart in a
+    // component (and a cubic of length 0 would give infinity).
+    (2.0 * n / least).min(2.0)
 }
 
 /// How far apart (largest component) two neighbouring samples of a
