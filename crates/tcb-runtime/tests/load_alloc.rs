@@ -26,13 +26,9 @@ fn load(bytes: &[u8]) -> Clip {
     clip.unwrap()
 }
 
-#[test]
-fn a_long_constant_clip_loads_in_less_than_its_file() {
-    // The most keys a packed clip of one track may have, all one value: a
-    // file of its block table and a few bytes, where a list of its key
-    // times would take 32 MiB.
-    let keys = tcb_runtime::pack::MAX_TRACK_KEYS;
-    let track = PackTrack {
+/// A scalar track `level` of `keys` keys, every one 0.75.
+fn level(keys: usize) -> PackTrack {
+    PackTrack {
         name: "level".into(),
         kind: TrackKind::Scalar,
         settings: TrackSettings::default(),
@@ -41,7 +37,16 @@ fn a_long_constant_clip_loads_in_less_than_its_file() {
         step: 0.25,
         center: None,
         values: vec![vec![3; keys]],
-    };
+    }
+}
+
+#[test]
+fn a_long_constant_clip_loads_in_less_than_its_file() {
+    // The most keys a packed clip of one track may have, all one value: a
+    // file of its block table and a few bytes, where a list of its key
+    // times would take 32 MiB.
+    let keys = tcb_runtime::pack::MAX_TRACK_KEYS;
+    let track = level(keys);
     let source = PackSource {
         name: "long".into(),
         start: 0.0,
@@ -82,16 +87,7 @@ fn capture_loads_in_less_than_its_file() {
 fn tracks_on_their_own_key_times_load_in_a_bounded_multiple_of_their_file() {
     use tcb_runtime::pack::LooseTrack;
     let keys = 100_000;
-    let grid = PackTrack {
-        name: "level".into(),
-        kind: TrackKind::Scalar,
-        settings: TrackSettings::default(),
-        tcb: Tcb::default(),
-        rebuild_w: false,
-        step: 0.25,
-        center: None,
-        values: vec![vec![3; 2]],
-    };
+    let grid = level(2);
     let own = LooseTrack {
         at: 0,
         name: "turn".into(),
