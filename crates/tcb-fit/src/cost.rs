@@ -1,6 +1,6 @@
 //! What a compiled clip costs to play: an estimate of the runtime's
 //! instructions per frame, for [`crate::reduce()`] to keep a reduced clip
-//! no slower than its source (with `never_slower`).
+//! no slower than its source (`ReduceOptions::speed`).
 //!
 //! The runtime samples every channel every frame, so a clip's cost is set
 //! by its layout, not by its keys: each group of tracks sharing a key grid
@@ -30,8 +30,7 @@
 //! It is a guide for choosing between layouts, not a measurement: `tcb
 //! reduce` also times both clips.
 
-use std::collections::HashMap;
-use tcb_core::{Extrapolation, SourceClip, TrackKind};
+use tcb_core::SourceClip;
 
 /// Per frame, whatever the clip: the instance's own work.
 const BASE: f64 = 105.0;
@@ -88,35 +87,7 @@ pub fn frame_cost(compiled: &tcb_runtime::Clip, source: &SourceClip) -> f64 {
     BASE + groups
         + loose(stats.loose_vector_tracks, LOOSE_VECTOR_BLOCK)
         + loose(stats.loose_rotation_tracks, LOOSE_ROTATION_BLOCK)
-        + CROSSING * loose_keys(source) as f64 / frames
-}
-
-/// Keys of the tracks the compiler plays as loose lanes: those whose grid
-/// (key times, `pre`, `post`) holds fewer than 8 vector channels and no
-/// rotation, or fewer than 8 rotations and no vector channel (the rule of
-/// `tcb_runtime`'s `choose_loose`; eases and steps, which also part grids
-/// there, are not looked at, so tracks that differ only in them count as
-/// sharing one).
-fn loose_keys(source: &SourceClip) -> usize {
-    type Key = (Vec<u64>, Extrapolation, Extrapolation);
-    // Per grid: vector channels, rotations, keys of its tracks.
-    let mut grids: HashMap<Key, (usize, usize, usize)> = HashMap::new();
-    for t in source.tracks() {
-        let times = t.data.times();
-        let s = t.data.settings();
-        let key = (times.iter().map(|x| x.to_bits()).collect(), s.pre, s.post);
-        let g = grids.entry(key).or_default();
-        match t.data.kind() {
-            TrackKind::Quat => g.1 += 1,
-            kind => g.0 += kind.dim(),
-        }
-        g.2 += times.len();
-    }
-    grids
-        .values()
-        .filter(|(v, r, _)| (*r == 0 && *v < 8) || (*v == 0 && *r < 8))
-        .map(|g| g.2)
-        .sum()
+        + CROSSING * stats.loose_keys as f64 / frames
 }
 
 #[cfg(test)]
@@ -138,7 +109,8 @@ mod tests {
         )
     }
 
-    /// `loose_keys` finds the tracks the compiler plays as loose lanes.
+    /// The compiler's count of loose lanes and their keys, which the cost
+    /// model reads.
     #[test]
     fn loose_tracks_are_those_the_compiler_leaves_loose() {
         let cases: Vec<(Vec<String>, usize, usize)> = vec![
@@ -193,7 +165,7 @@ mod tests {
             let source = clip(&tracks);
             let compiled = tcb_runtime::Clip::compile(&source);
             assert_eq!(compiled.loose_track_count(), loose, "{tracks:?}");
-            assert_eq!(loose_keys(&source), keys, "{tracks:?}");
+            assert_eq!(compiled.stats().loose_keys, keys, "{tracks:?}");
         }
     }
 

@@ -58,6 +58,9 @@ pub struct ClipStats {
     pub loose_vector_tracks: usize,
     /// `hermite` rotations on key times of their own (loose lanes).
     pub loose_rotation_tracks: usize,
+    /// Keys of the loose lanes, all counted (what forward playback over
+    /// the clip crosses, each crossing a load).
+    pub loose_keys: usize,
     /// Rotation segments (per track) evaluated exactly, in f64 squad,
     /// because the compiled cubic would miss the reference there.
     pub exact_segments: usize,
@@ -198,6 +201,12 @@ impl Clip {
                 .collect(),
             loose_vector_tracks: self.loose.lanes.len(),
             loose_rotation_tracks: self.loose_rot_tracks,
+            // (the identity lanes that pad rotations to whole blocks, after
+            // the tracks' lanes, are not tracks)
+            loose_keys: (self.loose.lanes.iter())
+                .chain(&self.loose_rot.lanes[..self.loose_rot_tracks])
+                .map(|lane| lane.grid.keys())
+                .sum(),
             exact_segments: self
                 .groups
                 .iter()

@@ -189,6 +189,7 @@ pub(crate) fn compile_impl(
             })
             .map(|(g, _)| g)
     });
+    join_constants(&mut grouping, pinned_group);
     let loose = choose_loose(&mut grouping, options, pinned_group);
     let mut per_track = PerTrack {
         slots: source
@@ -282,6 +283,73 @@ fn group_tracks(source: &tcb_core::SourceClip, options: &CompileOptions) -> Grou
         }
     }
     out
+}
+
+/// Step 1b: a constant rotation (every key the same, the curve still) that
+/// would be a loose lane takes a free lane of a group's last rotation block
+/// instead, on that group's key times: it costs nothing there, where a
+/// loose block costs more per frame than a group's (`tcb_fit::cost`). A
+/// reduced clip keeps each constant track as 2 keys of its own (the
+/// contract of `docs/reduce.md`), which would otherwise play as loose
+/// lanes beside a grid that has room for them.
+///
+/// The lane plays `normalize((h1 + h2) q)` at the group's `s` where the
+/// reference plays it at the track's own (the identity exactly; any other
+/// rotation within an ulp or two, inside the 1e-6 rotations are held to).
+/// Neither the track nor the group may `reset` (the identity rather than
+/// the constant outside the keys), and the pinned group (a packed clip's,
+/// whose lanes are the stream's) takes none.
+fn join_constants(grouping: &mut Grouping, pinned: Option<usize>) {
+    let Grouping {
+        grids,
+        vectors,
+        rotations,
+        ..
+    } = grouping;
+    let resets = |g: &TimeGrid| [g.pre, g.post].contains(&Extrapolation::Reset);
+    // Groups that stay groups whatever joins them, with a free lane.
+    let targets: Vec<usize> = (0..grids.len())
+        .filter(|&h| {
+            Some(h) != pinned
+                && !resets(&grids[h])
+                && (!vectors[h].is_empty() || rotations[h].len() >= 8)
+        })
+        .collect();
+    let mut targets = targets.into_iter();
+    let mut target = targets.next();
+    for g in 0..grids.len() {
+        // Only rotations that would be loose lanes (`choose_loose`).
+        if !vectors[g].is_empty() || rotations[g].len() >= 8 || resets(&grids[g]) {
+            continue;
+        }
+        let mut i = 0;
+        while i < rotations[g].len() {
+            while let Some(h) = target
+                && rotations[h].len().is_multiple_of(8)
+            {
+                target = targets.next();
+            }
+            let Some(h) = target else {
+                return;
+            };
+            if h == g || !rotation::is_constant(&rotations[g][i].controls) {
+                i += 1;
+                continue;
+            }
+            let row = rotations[g].remove(i);
+            let controls = rotation::held(&row.controls, grids[h].times.len() + 1);
+            // In track order, as if it had been on the grid: a clip whose
+            // other tracks are its source's compiles as the source does.
+            let at = rotations[h].partition_point(|r| r.track < row.track);
+            rotations[h].insert(
+                at,
+                RotationRow {
+                    track: row.track,
+                    controls,
+                },
+            );
+        }
+    }
 }
 
 /// Step 2: small groups of vector channels only, and of fewer than 8

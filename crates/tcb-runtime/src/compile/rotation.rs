@@ -112,6 +112,37 @@ pub(crate) fn rotation_controls(t: &RotationTrack, exact_velocities: bool) -> Ro
     }
 }
 
+/// Whether `rot` holds one value: every stored segment of every component
+/// is `[q, q, 0, 0]` with the same `q` (bit for bit), and no segment is
+/// played exactly.
+pub(crate) fn is_constant(rot: &RotationControls) -> bool {
+    rot.exact.iter().all(Option::is_none)
+        && rot.comps.iter().all(|comp| {
+            let q = comp.first().map_or(0.0, |c| c[0]);
+            comp.iter().all(|c| {
+                c[0].to_bits() == q.to_bits()
+                    && c[1].to_bits() == q.to_bits()
+                    && c[2] == 0.0
+                    && c[3] == 0.0
+            })
+        })
+}
+
+/// A constant rotation ([`is_constant`]) over `segments` stored segments
+/// (a grid of `segments - 1` keys).
+pub(crate) fn held(rot: &RotationControls, segments: usize) -> RotationControls {
+    RotationControls {
+        comps: rot
+            .comps
+            .iter()
+            .map(|comp| vec![[comp[0][0], comp[0][0], 0.0, 0.0]; segments])
+            .collect(),
+        exact: vec![None; segments],
+        velocity_only: vec![false; segments],
+        piece: vec![[0.0, 1.0]; segments],
+    }
+}
+
 /// `ctl` with its tangents (`M0`, `M1` of each component) fitted to squad's
 /// values over the segment in least squares, its ends kept: the cubic then
 /// follows the curve more closely than the one through its end
