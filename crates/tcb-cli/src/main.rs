@@ -238,11 +238,19 @@ struct ReduceArgs {
     /// glTF input: the animation to reduce, by name or index (default: the first).
     #[arg(long, value_name = "NAME_OR_INDEX")]
     animation: Option<String>,
-    /// Put fitted tracks back on the input's shared key grid where the
-    /// reduced clip would otherwise play slower than the input (by the
-    /// estimate of instructions per frame printed on stderr), at the cost of
-    /// bytes. Default: the fewest bytes.
-    #[arg(long)]
+    /// When fitted tracks go back on the input's shared key grid, at the
+    /// cost of bytes, where the reduced clip would play slower than the
+    /// input (by the estimate of instructions per frame printed on stderr):
+    /// `balanced` when the fits add a larger share per frame than they save
+    /// of the input's bytes, `never-slower` always, `fewest-bytes` never
+    #[arg(
+        long,
+        value_name = "balanced|never-slower|fewest-bytes",
+        default_value = "balanced"
+    )]
+    speed: tcb_fit::Speed,
+    /// `--speed never-slower` (kept for scripts that use it).
+    #[arg(long, hide = true, conflicts_with = "speed")]
     never_slower: bool,
     /// Milliseconds for the quick timing of input and output that follows
     /// the reduction (ns per joint per frame, both from one run; 0: none).
@@ -726,7 +734,11 @@ fn reduce(args: &ReduceArgs) -> Result<(), BoxError> {
         .rotation_tolerance(args.error.rotation_tolerance)
         .knots(args.knots)
         .tangents(args.tangents)
-        .never_slower(args.never_slower);
+        .speed(if args.never_slower {
+            tcb_fit::Speed::NeverSlower
+        } else {
+            args.speed
+        });
     let input = tcb_fit::reduce::Input {
         doc: &loaded.doc,
         clip: &loaded.clip,
@@ -765,7 +777,7 @@ fn report_speed(input: &tcb_core::SourceClip, reduced: &tcb_fit::Reduced, ms: u6
         "tcb: estimated runtime cost: input {c0:.0}, output {c1:.0} instructions per frame ({:.2}x){}",
         c1 / c0,
         if c1 > c0 {
-            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (--never-slower trades bytes for it; docs/benchmarks.md)"
+            ": slower; tracks on key times of their own play as loose lanes, which cost more per frame than a shared grid's (--speed never-slower trades bytes for it; docs/benchmarks.md)"
         } else {
             ""
         }
@@ -774,7 +786,7 @@ fn report_speed(input: &tcb_core::SourceClip, reduced: &tcb_fit::Reduced, ms: u6
         eprintln!(
             "tcb: fits put back on the input's key grid to play no slower than the input: \
              the fewest bytes found ({} keys, {} bytes) would cost {cost:.0} instructions per frame \
-             (without --never-slower: kept)",
+             (with --speed fewest-bytes: kept)",
             smaller.keys, smaller.bytes
         );
     }

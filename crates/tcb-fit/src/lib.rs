@@ -46,4 +46,4 @@ pub mod reduce;
 
 pub use compress::{CompressOptions, Compressed, compress};
 pub use fit::{Norm, Tangents};
-pub use reduce::{Knots, Metric, ReduceError, ReduceOptions, Reduced, reduce};
+pub use reduce::{Knots, Metric, ReduceError, ReduceOptions, Reduced, Speed, reduce};

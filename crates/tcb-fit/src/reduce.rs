@@ -29,13 +29,17 @@
 //!    twice a shared grid's bytes per key) are put back on the input's
 //!    keys, those keeping the largest share first, where the compiled clip
 //!    gets smaller and still holds.
-//! 6. Speed, with [`ReduceOptions::never_slower`]: a fit taken off the
-//!    input's shared key grid plays as a loose lane, dearer per frame than
-//!    its lane in the grid's blocks ([`crate::cost`]). Unless the clip's
-//!    estimated cost per frame is at most the input's, fitted tracks (not
-//!    those of 2 keys) are put back on the input's keys where that brings it
-//!    within the input's cost, with the fewest bytes; where nothing does,
-//!    the fewest bytes are kept. Either way both costs are reported.
+//! 6. Speed ([`ReduceOptions::speed`]): a fit taken off the input's
+//!    shared key grid plays as a loose lane, dearer per frame than its lane
+//!    in the grid's blocks ([`crate::cost`]). Where the clip's estimated
+//!    cost per frame is above the input's, fitted tracks (not those of 2
+//!    keys) are put back on the input's keys where that brings it within
+//!    the input's cost, with the fewest bytes: by default ([`Speed::Balanced`])
+//!    only when the fits save a smaller share of the input's bytes than
+//!    they add to its cost (capture, where most tracks stay dense), always
+//!    with [`Speed::NeverSlower`], never with [`Speed::FewestBytes`]. Where
+//!    nothing brings it within, the fewest bytes are kept. Either way both
+//!    costs are reported.
 //!
 //! Tracks the fitter does not take are kept as they are (exact): tracks
 //! whose `linear` or `offset-repeat` extrapolation is checked outside their
@@ -163,12 +167,43 @@ pub struct ReduceOptions {
     pub knots: Knots,
     /// Stored or derived tangents (`--tangents`).
     pub tangents: Tangents,
-    /// Put fitted tracks back on their input's shared key grid where the
-    /// reduced clip would otherwise cost more per frame than its source by
-    /// [`crate::cost::frame_cost`] (`--never-slower`), at the cost of
-    /// bytes. Off by default: the fewest bytes [`reduce`] finds, with both
-    /// costs reported ([`Reduced::before_cost`], [`Reduced::after_cost`]).
-    pub never_slower: bool,
+    /// When fitted tracks go back on their input's shared key grid, at the
+    /// cost of bytes, because the reduced clip would otherwise cost more
+    /// per frame than its source by [`crate::cost::frame_cost`]
+    /// (`--speed`; both costs are reported: [`Reduced::before_cost`],
+    /// [`Reduced::after_cost`]).
+    pub speed: Speed,
+}
+
+/// When [`reduce`] trades bytes for speed (step 6 of the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Speed {
+    /// Put fits back on the input's grid where the fewest bytes would cost
+    /// a larger share more per frame than they save of the input's bytes
+    /// (`(after - before) / before` of the cost above `1 - after / before`
+    /// of the compiled bytes). Capture, whose jitter leaves most tracks
+    /// dense, plays no slower; a smooth clip keeps its few keys.
+    #[default]
+    Balanced,
+    /// Put fits back wherever the fewest bytes would play slower.
+    NeverSlower,
+    /// Keep the fewest bytes.
+    FewestBytes,
+}
+
+impl std::str::FromStr for Speed {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "balanced" => Ok(Speed::Balanced),
+            "never-slower" => Ok(Speed::NeverSlower),
+            "fewest-bytes" => Ok(Speed::FewestBytes),
+            _ => Err(format!(
+                "unknown speed rule {s:?} (expected balanced, never-slower or fewest-bytes)"
+            )),
+        }
+    }
 }
 
 impl ReduceOptions {
@@ -214,10 +249,10 @@ impl ReduceOptions {
         self
     }
 
-    /// These options with [`never_slower`](Self::never_slower) set to `on`.
+    /// These options with [`speed`](Self::speed) set to `rule`.
     #[must_use]
-    pub fn never_slower(mut self, on: bool) -> Self {
-        self.never_slower = on;
+    pub fn speed(mut self, rule: Speed) -> Self {
+        self.speed = rule;
         self
     }
 }
@@ -297,8 +332,8 @@ pub struct Reduced {
     /// The output's.
     pub after_cost: f64,
     /// The fewest bytes the fits gave, where they were declined for a
-    /// clip within the input's cost (with [`ReduceOptions::never_slower`]):
-    /// their counts and estimated cost.
+    /// clip within the input's cost ([`ReduceOptions::speed`]): their
+    /// counts and estimated cost.
     pub declined: Option<(Counts, f64)>,
     /// The measured error of the output, by the metric, on the runtime.
     pub worst: Worst,
@@ -493,13 +528,21 @@ pub fn reduce(
     let (fitted, attempts) = fit_in_rounds(&plan, &mut cache, &verify, progress)?;
     let best = put_back_for_bytes(&plan, &cache, fitted, &verify)?;
     let before_cost = cost::frame_cost(&reference.compiled, input.clip);
-    let (best, declined) = if !options.never_slower {
+    let smallest = (
+        counts(&best.doc, &best.compiled),
+        cost::frame_cost(&best.compiled, &best.clip),
+    );
+    let put_back = match options.speed {
+        Speed::FewestBytes => false,
+        Speed::NeverSlower => true,
+        Speed::Balanced => {
+            let saved = 1.0 - smallest.0.bytes as f64 / before.bytes as f64;
+            smallest.1 / before_cost - 1.0 > saved
+        }
+    };
+    let (best, declined) = if !put_back {
         (best, None)
     } else {
-        let smallest = (
-            counts(&best.doc, &best.compiled),
-            cost::frame_cost(&best.compiled, &best.clip),
-        );
         let faster = put_back_for_speed(&plan, &cache, best, &verify, before_cost)?;
         let declined = (counts(&faster.doc, &faster.compiled) != smallest.0).then_some(smallest);
         (faster, declined)
