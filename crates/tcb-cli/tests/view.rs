@@ -139,9 +139,11 @@ struct Report {
     page_shot: PathBuf,
 }
 
-/// Where the root was drawn before and after a drag across the view.
+/// Where the joint the drag moved most was drawn before and after it.
 #[derive(Deserialize)]
 struct Orbit {
+    /// The joint the drag moved most.
+    joint: String,
     before: Point,
     after: Point,
 }
@@ -362,7 +364,7 @@ fn playback_orbit_and_picking_respond(r: &Report) {
     assert!(p.playing.time != p.before && p.playing.speed == 2.0);
     let o = r.orbit.as_ref().unwrap();
     let turned = (o.after.x - o.before.x).hypot(o.after.y - o.before.y);
-    eprintln!("a drag of 200 px moved the joint drawn farthest from the centre {turned:.1} px");
+    eprintln!("a drag of 200 px moved {} {turned:.1} px", o.joint);
     assert!(turned > 20.0, "{turned}");
     let clicked = r.pick.clicked.as_deref().unwrap();
     let after = r.pick.after_click.as_ref().unwrap();
