@@ -108,7 +108,7 @@ pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
         TrackKind::Quat,
     ];
     let defaults = settings(u)?;
-    let mut tracks = Vec::new();
+    let mut tracks: Vec<TrackDoc> = Vec::new();
     for i in 0..u.int_in_range(1..=6u8)? {
         let kind = *u.choose(&kinds)?;
         let n = u.int_in_range(1..=9usize)?;
@@ -122,9 +122,20 @@ pub fn arbitrary_doc(u: &mut Unstructured) -> arbitrary::Result<ClipDoc> {
                 _ => f64::from(u8::arbitrary(u)?) / 64.0 + 1.0 / 128.0,
             };
         }
-        let values = (0..n)
+        // Now and then the key times of the track before (a shared grid),
+        // or one value held (a constant track, which a reduced clip keeps
+        // at 2 keys and the compiler may move into a group's free lane).
+        if let Some(before) = tracks.last().filter(|_| u.ratio(1, 4u8).unwrap_or(false)) {
+            times.clone_from(&before.times);
+        }
+        let n = times.len();
+        let mut values = (0..n)
             .map(|_| value(u))
             .collect::<arbitrary::Result<Vec<_>>>()?;
+        if u.ratio(1, 4u8)? {
+            let first = values[0];
+            values.fill(first);
+        }
         let keys = if bool::arbitrary(u)? {
             (0..n)
                 .map(|_| {
@@ -174,7 +185,7 @@ pub(crate) type ReduceInput = (
 
 pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
     use tcb_core::skeleton::{Joint, Skeleton, Transform};
-    use tcb_fit::{Knots, Metric, ReduceOptions, Tangents};
+    use tcb_fit::{Knots, Metric, ReduceOptions, Speed, Tangents};
     let mut doc = arbitrary_doc(u).ok()?;
     let skeleton = if bool::arbitrary(u).unwrap_or(false) {
         let mut joints = Vec::new();
@@ -227,6 +238,10 @@ pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
         .tangents(
             *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
                 .unwrap_or(&Tangents::Best),
+        )
+        .speed(
+            *u.choose(&[Speed::Balanced, Speed::NeverSlower, Speed::FewestBytes])
+                .unwrap_or(&Speed::Balanced),
         );
     Some((doc, clip, skeleton, options))
 }
