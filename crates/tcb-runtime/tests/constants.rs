@@ -156,3 +156,51 @@ fn a_full_rotation_block_has_no_lane_to_give() {
     assert_eq!(compiled.loose_track_count(), 1);
     plays_as_the_reference(&source, compiled, 0.0);
 }
+
+/// A packed clip's grid group keeps its lanes, the stream's, even a
+/// constant rotation's where a group on other key times has a free lane.
+#[test]
+fn a_packed_grid_keeps_its_constant_lanes() {
+    use glam::{Quat, Vec3};
+    use tcb_core::{NamedTrack, RotationTrack, SourceClip, Track, TrackData, TrackSettings};
+    use tcb_runtime::pack::{PackSource, Packed};
+    let hermite = TrackSettings {
+        rotation: tcb_core::RotationMode::Hermite,
+        ..TrackSettings::default()
+    };
+    let grid: Vec<f64> = (0..40).map(|k| f64::from(k) / 30.0).collect();
+    let own = [0.05, 0.2, 0.45, 0.9, 1.25];
+    let quat = |times: &[f64], rate: f32| {
+        let q = times
+            .iter()
+            .map(|t| Quat::from_rotation_y(rate * *t as f32) * Quat::from_rotation_x(0.3))
+            .collect();
+        TrackData::Quat(RotationTrack::new(times.to_vec(), q, vec![], &hermite).unwrap())
+    };
+    let v: Vec<Vec3> = own.iter().map(|t| Vec3::new(*t as f32, 1.0, 0.5)).collect();
+    let named = |name: &str, data| NamedTrack {
+        name: name.into(),
+        data,
+    };
+    let clip = SourceClip::new(
+        "packed",
+        vec![
+            named("still", quat(&grid, 0.0)),
+            named("turn", quat(&grid, 0.8)),
+            named(
+                "v",
+                TrackData::Vec3(Track::new(own.to_vec(), v, vec![], &hermite).unwrap()),
+            ),
+            named("w", quat(&own, -0.5)),
+        ],
+    )
+    .unwrap();
+    let source = PackSource::quantize(&clip, &[1.0 / 4096.0; 4]).unwrap();
+    let names: Vec<&str> = source.tracks.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(names, ["still", "turn"]);
+    let bytes = Packed::encode(&source).unwrap().to_bytes();
+    let loaded = Clip::from_bytes(&bytes).unwrap();
+    loaded.verify_packed().unwrap();
+    let reference = source.to_clip().unwrap();
+    plays_as_the_reference(&reference, loaded, 0.0);
+}

@@ -298,7 +298,7 @@ fn group_tracks(source: &tcb_core::SourceClip, options: &CompileOptions) -> Grou
 /// rotation within an ulp or two, inside the 1e-6 rotations are held to).
 /// Neither the track nor the group may `reset` (the identity rather than
 /// the constant outside the keys), and the pinned group (a packed clip's,
-/// whose lanes are the stream's) takes none.
+/// whose lanes are the stream's) neither gives nor takes a lane.
 fn join_constants(grouping: &mut Grouping, pinned: Option<usize>) {
     let Grouping {
         grids,
@@ -318,8 +318,13 @@ fn join_constants(grouping: &mut Grouping, pinned: Option<usize>) {
     let mut targets = targets.into_iter();
     let mut target = targets.next();
     for g in 0..grids.len() {
-        // Only rotations that would be loose lanes (`choose_loose`).
-        if !vectors[g].is_empty() || rotations[g].len() >= 8 || resets(&grids[g]) {
+        // Only rotations that would be loose lanes (`choose_loose`); the
+        // pinned group keeps its lanes, however few.
+        if Some(g) == pinned
+            || !vectors[g].is_empty()
+            || rotations[g].len() >= 8
+            || resets(&grids[g])
+        {
             continue;
         }
         let mut i = 0;
