@@ -663,11 +663,13 @@ fn play_packed(clip: tcb_runtime::Clip, reference: &tcb_core::SourceClip, u: &mu
     let (mut playing, mut against) = (make(&clip), make(&reference));
     // The reference compiled on its own may lay its tracks out otherwise
     // (a few rotations as loose lanes where the packed clip has its grid's
-    // group): then rotations are held to the contract's 1e-6, as the
-    // runtime is against the scalar reference, and vectors stay exact.
+    // group; a constant rotation in a free lane of the grid's group, which
+    // a packed clip's grid never gives): then rotations are held to the
+    // contract's 1e-6, as the runtime is against the scalar reference, and
+    // vectors stay exact.
     let laid_out_alike = {
         let (a, b) = (clip.stats(), reference.stats());
-        a.grids.len() == b.grids.len()
+        a.grids == b.grids
             && (a.loose_vector_tracks, a.loose_rotation_tracks)
                 == (b.loose_vector_tracks, b.loose_rotation_tracks)
     };
