@@ -192,124 +192,59 @@ fn every_numeric_flag_at_its_edges() {
     let dir = scratch("flags");
     let root = root();
     for (name, from) in [
-        ("bounce.json", "examples/clips/bounce.json"),
+        ("b.json", "examples/clips/bounce.json"),
         ("cmu.bvh", "fuzz/corpus/bvh/cmu-01_01-4-frames.bvh"),
     ] {
         std::fs::copy(root.join(from), dir.join(name)).unwrap();
     }
-    std::fs::copy(root.join("examples/clips/bounce.json"), dir.join("b.json")).unwrap();
     assert!(judge(
         &dir,
         &["compress", "cmu.bvh", "-o", "cmu.tcbc"],
         Some("cmu.tcbc")
     ));
-    // (the arguments before the edge value, the file the run would write)
-    let cases: &[(&[&str], Option<&str>)] = &[
-        (&["sample", "IN", "--at"], None),
-        (&["sample", "IN", "--fps"], None),
-        (&["sample", "IN", "--fps", "10", "--from"], None),
-        (&["sample", "IN", "--fps", "10", "--to"], None),
-        (&["sample", "IN", "--inbetweens"], None),
+    // (the arguments before the edge value, `IN` for the input; the file
+    // the run would write)
+    let cases: &[(&str, Option<&str>)] = &[
+        ("sample IN --at", None),
+        ("sample IN --fps", None),
+        ("sample IN --fps 10 --from", None),
+        ("sample IN --fps 10 --to", None),
+        ("sample IN --inbetweens", None),
+        ("export IN -o o.glb --max-error", Some("o.glb")),
+        ("reduce IN -o o.json --tolerance", Some("o.json")),
+        ("reduce IN -o o.json --shell", Some("o.json")),
         (
-            &["export", "IN", "-o", "o.glb", "--max-error"],
-            Some("o.glb"),
-        ),
-        (
-            &["reduce", "IN", "-o", "o.json", "--tolerance"],
+            "reduce IN -o o.json --metric value --rotation-tolerance",
             Some("o.json"),
         ),
-        (&["reduce", "IN", "-o", "o.json", "--shell"], Some("o.json")),
+        ("reduce IN -o o.json --timing-ms", Some("o.json")),
+        ("compress IN -o o.tcbc --tolerance", Some("o.tcbc")),
+        ("compress IN -o o.tcbc --shell", Some("o.tcbc")),
+        ("compress IN -o o.tcbc --seek-keys", Some("o.tcbc")),
         (
-            &[
-                "reduce",
-                "IN",
-                "-o",
-                "o.json",
-                "--metric",
-                "value",
-                "--rotation-tolerance",
-            ],
-            Some("o.json"),
-        ),
-        (
-            &["reduce", "IN", "-o", "o.json", "--timing-ms"],
-            Some("o.json"),
-        ),
-        (
-            &["compress", "IN", "-o", "o.tcbc", "--tolerance"],
+            "compress IN -o o.tcbc --metric value --rotation-tolerance",
             Some("o.tcbc"),
         ),
-        (
-            &["compress", "IN", "-o", "o.tcbc", "--shell"],
-            Some("o.tcbc"),
-        ),
-        (
-            &["compress", "IN", "-o", "o.tcbc", "--seek-keys"],
-            Some("o.tcbc"),
-        ),
-        (
-            &[
-                "compress",
-                "IN",
-                "-o",
-                "o.tcbc",
-                "--metric",
-                "value",
-                "--rotation-tolerance",
-            ],
-            Some("o.tcbc"),
-        ),
-        (
-            &["bench", "IN", "--rounds", "1", "--slice-ms", "1", "--fps"],
-            None,
-        ),
-        (
-            &[
-                "bench",
-                "IN",
-                "--rounds",
-                "1",
-                "--slice-ms",
-                "1",
-                "--instances",
-            ],
-            None,
-        ),
-        (
-            &[
-                "bench",
-                "IN",
-                "--rounds",
-                "1",
-                "--slice-ms",
-                "1",
-                "--threads",
-            ],
-            None,
-        ),
-        (&["bench", "IN", "--slice-ms", "1", "--rounds"], None),
-        (&["bench", "IN", "--rounds", "1", "--slice-ms"], None),
-        (&["plot", "IN", "-o", "o.svg", "--from"], Some("o.svg")),
-        (&["plot", "IN", "-o", "o.svg", "--to"], Some("o.svg")),
-        (
-            &["plot", "IN", "-o", "o.svg", "--inbetweens"],
-            Some("o.svg"),
-        ),
-        (
-            &["plot", "IN", "-o", "o.svg", "--path", "--components"],
-            Some("o.svg"),
-        ),
-        (&["plot", "IN", "-o", "o.svg", "--track"], Some("o.svg")),
-        (&["view", "IN", "-o", "o.html", "--fps"], Some("o.html")),
-        (&["view", "IN", "-o", "o.html", "--joint"], Some("o.html")),
-        (&["info", "IN", "--animation"], None),
+        ("bench IN --rounds 1 --slice-ms 1 --fps", None),
+        ("bench IN --rounds 1 --slice-ms 1 --instances", None),
+        ("bench IN --rounds 1 --slice-ms 1 --threads", None),
+        ("bench IN --slice-ms 1 --rounds", None),
+        ("bench IN --rounds 1 --slice-ms", None),
+        ("plot IN -o o.svg --from", Some("o.svg")),
+        ("plot IN -o o.svg --to", Some("o.svg")),
+        ("plot IN -o o.svg --inbetweens", Some("o.svg")),
+        ("plot IN -o o.svg --path --components", Some("o.svg")),
+        ("plot IN -o o.svg --track", Some("o.svg")),
+        ("view IN -o o.html --fps", Some("o.html")),
+        ("view IN -o o.html --joint", Some("o.html")),
+        ("info IN --animation", None),
     ];
     for input in ["b.json", "cmu.bvh", "cmu.tcbc"] {
         for (head, output) in cases {
             for edge in EDGES {
                 let mut args: Vec<&str> = head
-                    .iter()
-                    .map(|a| if *a == "IN" { input } else { a })
+                    .split(' ')
+                    .map(|a| if a == "IN" { input } else { a })
                     .collect();
                 args.push(edge);
                 judge(&dir, &args, *output);

@@ -540,15 +540,18 @@ pub fn reduce(
             smallest.1 / before_cost - 1.0 > saved
         }
     };
-    let (best, declined) = if !put_back {
-        (best, None)
+    // The clip kept, its counts and cost, and the fewest bytes if declined.
+    let (best, (after, after_cost), declined) = if !put_back {
+        (best, smallest, None)
     } else {
         let faster = put_back_for_speed(&plan, &cache, best, &verify, before_cost)?;
-        let declined = (counts(&faster.doc, &faster.compiled) != smallest.0).then_some(smallest);
-        (faster, declined)
+        let kept = (
+            counts(&faster.doc, &faster.compiled),
+            cost::frame_cost(&faster.compiled, &faster.clip),
+        );
+        let declined = (kept.0 != smallest.0).then_some(smallest);
+        (faster, kept, declined)
     };
-    let after = counts(&best.doc, &best.compiled);
-    let after_cost = cost::frame_cost(&best.compiled, &best.clip);
     let kept = (0..best.kept.len())
         .filter(|&i| best.kept[i])
         .map(|i| input.clip.tracks()[i].name.clone())
