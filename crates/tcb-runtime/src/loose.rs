@@ -47,20 +47,21 @@ pub(crate) const PAD_SPAN: f64 = 1e300;
 /// One loose track.
 #[derive(Clone, Debug)]
 pub(crate) struct LooseLane {
-    pub grid: TimeGrid,
-    /// Components used (1 to 4).
-    pub dim: usize,
     /// Per key (and sentinel pseudo-key, see `store::per_key`), per
     /// component: `[P, TO, TI]`, at `key(key * dim + c)`.
     keys: Keys,
     /// Where lane 0 of its first control plane is in the instance's
     /// controls, as f32s (set by [`Loose::new`]).
     ctl_at: u32,
-    /// No segment eases or steps: a real segment loads as
-    /// [`LooseState::load_plain`] does. Derivable from `grid` (two lengths
-    /// on a compacted grid), but kept: deriving it cost `sparse` 1.8% more
-    /// instructions, and it lies in `ctl_at`'s padding.
-    plain: bool,
+    /// The number of components (1 to 4) where no segment eases or steps
+    /// and the keys are f32, so that a real segment loads as
+    /// [`LooseState::load_plain`] does; 0 otherwise (set by
+    /// [`Loose::new`]). Derivable, but kept: one byte read instead of
+    /// three tests per load.
+    plain: u8,
+    pub grid: TimeGrid,
+    /// Components used (1 to 4).
+    pub dim: usize,
 }
 
 /// A loose lane's keys, in f32 or in 16 bits with a range per component
@@ -68,11 +69,17 @@ pub(crate) struct LooseLane {
 #[derive(Clone, Debug)]
 enum Keys {
     F32(Vec<[f32; KEY_STRIDE]>),
-    U16 {
-        q: Vec<[u16; KEY_STRIDE]>,
-        min: Vec<[f32; KEY_STRIDE]>,
-        scale: Vec<[f32; KEY_STRIDE]>,
-    },
+    /// Boxed, so that the enum is one `Vec` wide and the lane's hot fields
+    /// share a cache line.
+    U16(Box<U16Keys>),
+}
+
+/// 16-bit keys and their range per component and control.
+#[derive(Clone, Debug)]
+struct U16Keys {
+    q: Vec<[u16; KEY_STRIDE]>,
+    min: Vec<[f32; KEY_STRIDE]>,
+    scale: Vec<[f32; KEY_STRIDE]>,
 }
 
 impl LooseLane {
@@ -86,11 +93,11 @@ impl LooseLane {
             .map(|i| per[i % dim][i / dim])
             .collect();
         LooseLane {
-            grid,
-            dim,
             keys: Keys::F32(keys),
             ctl_at: 0,
-            plain: false,
+            plain: 0,
+            grid,
+            dim,
         }
     }
 
@@ -99,7 +106,8 @@ impl LooseLane {
     pub fn key(&self, i: usize) -> [f32; KEY_STRIDE] {
         match &self.keys {
             Keys::F32(k) => k[i],
-            Keys::U16 { q, min, scale } => {
+            Keys::U16(u) => {
+                let U16Keys { q, min, scale } = &**u;
                 let c = i % self.dim;
                 std::array::from_fn(|j| min[c][j] + f32::from(q[i][j]) * scale[c][j])
             }
@@ -111,10 +119,11 @@ impl LooseLane {
         use std::mem::size_of_val;
         match &self.keys {
             Keys::F32(k) => size_of_val(k.as_slice()),
-            Keys::U16 { q, min, scale } => {
-                size_of_val(q.as_slice())
-                    + size_of_val(min.as_slice())
-                    + size_of_val(scale.as_slice())
+            Keys::U16(u) => {
+                size_of::<U16Keys>()
+                    + size_of_val(u.q.as_slice())
+                    + size_of_val(u.min.as_slice())
+                    + size_of_val(u.scale.as_slice())
             }
         }
     }
@@ -162,7 +171,7 @@ impl LooseLane {
         if !(finite(&min) && finite(&scale) && finite(&error)) {
             return None;
         }
-        self.keys = Keys::U16 { q, min, scale };
+        self.keys = Keys::U16(Box::new(U16Keys { q, min, scale }));
         Some(error)
     }
 
@@ -187,7 +196,7 @@ impl LooseLane {
                 k[ka * N..][..N].try_into().expect("N components"),
                 k[kb * N..][..N].try_into().expect("N components"),
             ),
-            Keys::U16 { .. } => (
+            Keys::U16(_) => (
                 std::array::from_fn(|c| self.key(ka * N + c)),
                 std::array::from_fn(|c| self.key(kb * N + c)),
             ),
@@ -333,7 +342,7 @@ impl Loose {
                     unbounded: block_lanes(b).any(|l| match &l.keys {
                         Keys::F32(k) => k.iter().flatten().any(|x| !x.is_finite()),
                         // Quantized lanes are finite (quant keeps the rest in f32).
-                        Keys::U16 { .. } => false,
+                        Keys::U16(_) => false,
                     }),
                     ctl: ctl_planes - planes..ctl_planes,
                 }
@@ -343,7 +352,11 @@ impl Loose {
             let ctl: &Block = &block[l / 8];
             lane.ctl_at = index_u32(8 * ctl.ctl.start + l % 8);
             let g = &lane.grid;
-            lane.plain = g.eases.iter().all(|e| e.is_none()) && !g.steps.contains(&true);
+            let plain = g.eases.iter().all(|e| e.is_none()) && !g.steps.contains(&true);
+            lane.plain = match lane.keys {
+                Keys::F32(_) if plain => lane.dim as u8,
+                _ => 0,
+            };
         }
         let (order, seek_after) = key_order(&lanes);
         Loose {
@@ -556,21 +569,23 @@ impl LooseState {
     /// key, or only a few).
     #[inline(never)]
     fn stream(&mut self, loose: &Loose, time: f64) {
-        let mut budget = 4 * loose.lanes.len() + 64;
-        while let Some(&[l, seg]) = loose.order.get(self.next) {
+        // In registers, stored once: the loads write through `self`.
+        let mut next = self.next;
+        let seek_at = next + 4 * loose.lanes.len() + 64;
+        while let Some(&[l, seg]) = loose.order.get(next) {
             let (l, seg) = (l as usize, seg as usize);
             let lane = &loose.lanes[l];
             let t = lane.grid.times.listed();
             // The entry's time is its segment's first key (`seg >= 1`).
             let start = t[seg - 1];
             if time < start {
+                self.next = next;
                 self.next_time = start;
                 return;
             }
-            if budget == 0 {
+            if next == seek_at {
                 return self.seek(loose, time);
             }
-            budget -= 1;
             match t.get(seg) {
                 // A lane that also passed the segment's end has its next
                 // entry due in this same loop (dense keys, sampled at a
@@ -579,8 +594,9 @@ impl LooseState {
                 Some(&end) => self.load_real(loose, l, seg, start, end),
                 None => self.load_inline(loose, l, seg),
             }
-            self.next += 1;
+            next += 1;
         }
+        self.next = next;
         // `next_time` is infinite past the end, which an infinite `time` passes.
         self.next_time = f64::INFINITY;
     }
@@ -590,11 +606,11 @@ impl LooseState {
     #[inline(always)]
     fn load_real(&mut self, loose: &Loose, l: usize, seg: usize, ws: f64, we: f64) {
         let lane = &loose.lanes[l];
-        match (&lane.keys, lane.dim) {
-            (Keys::F32(k), 1) if lane.plain => self.load_plain::<1>(lane, l, seg, ws, we, k),
-            (Keys::F32(k), 2) if lane.plain => self.load_plain::<2>(lane, l, seg, ws, we, k),
-            (Keys::F32(k), 3) if lane.plain => self.load_plain::<3>(lane, l, seg, ws, we, k),
-            (Keys::F32(k), _) if lane.plain => self.load_plain::<4>(lane, l, seg, ws, we, k),
+        match (&lane.keys, lane.plain) {
+            (Keys::F32(k), 1) => self.load_plain::<1>(lane, l, seg, ws, we, k),
+            (Keys::F32(k), 2) => self.load_plain::<2>(lane, l, seg, ws, we, k),
+            (Keys::F32(k), 3) => self.load_plain::<3>(lane, l, seg, ws, we, k),
+            (Keys::F32(k), 4) => self.load_plain::<4>(lane, l, seg, ws, we, k),
             _ => self.load_inline(loose, l, seg),
         }
     }
@@ -613,7 +629,7 @@ impl LooseState {
         we: f64,
         k: &[[f32; KEY_STRIDE]],
     ) {
-        debug_assert!(lane.plain && lane.dim == N && seg >= 1);
+        debug_assert!(usize::from(lane.plain) == N && lane.dim == N && seg >= 1);
         debug_assert_eq!((seg - 1, seg), lane.grid.key_pair(seg));
         self.set_window(l, seg, [ws, we, we - ws], None);
         // Keys `seg - 1` and `seg`, `N` components each.
