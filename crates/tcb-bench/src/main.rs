@@ -84,9 +84,18 @@ struct Args {
     /// Largest allowed growth of a scenario's instruction count, percent.
     #[arg(long, value_name = "PCT", default_value_t = 2.0)]
     icount_max_growth: f64,
+    /// Time the runtime's default-build kernels even where the CPU has
+    /// AVX2 (`tcb_runtime::force_baseline_simd`), to compare with a run
+    /// without it; the instruction counts (--icount) always do
+    #[arg(long, conflicts_with = "icount")]
+    baseline_simd: bool,
     /// Run one scenario's pass and exit (what --icount runs under valgrind).
     #[arg(long, value_name = "NAME", hide = true)]
     icount_pass: Option<String>,
+    /// With --icount-pass: run the AVX2 kernels where the CPU has them,
+    /// instead of the baseline every count uses (to count them by hand).
+    #[arg(long, hide = true, requires = "icount_pass")]
+    icount_avx2: bool,
 }
 
 fn main() -> ExitCode {
@@ -248,6 +257,9 @@ fn icount_jobs(
 /// `--icount-pass NAME` (hidden): the one runtime pass that `--icount`
 /// counts, run inside callgrind.
 fn run_pass(args: &Args, name: &str) -> Result<bool, Box<dyn std::error::Error>> {
+    // The same instructions on every CPU: the gate's counts do not depend
+    // on whether the runner has AVX2 (`tcb_runtime::simd`).
+    tcb_runtime::force_baseline_simd(!args.icount_avx2);
     if icount::EXTRA.contains(&name) {
         icount::run_extra(name, &args.bvh)?;
         return Ok(true);
@@ -268,6 +280,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if args.icount {
         return run_icount(args);
     }
+    tcb_runtime::force_baseline_simd(args.baseline_simd);
     let timing = timing(args)?;
     // Find and read the saved report first: a bad name or file should fail
     // before a minute of timing.

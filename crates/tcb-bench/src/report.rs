@@ -428,6 +428,14 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
     let _ = writeln!(out, "build: {}", here.flags);
     let _ = writeln!(
         out,
+        "kernels: {}",
+        match tcb_runtime::simd() {
+            tcb_runtime::Simd::Avx2 => "the group kernels' AVX2 instance, chosen at run time",
+            tcb_runtime::Simd::Baseline => "the build's own instructions",
+        }
+    );
+    let _ = writeln!(
+        out,
         "timing: median of {} rounds of about {} ms per implementation{}\n",
         timing.rounds,
         timing.slice.as_millis(),

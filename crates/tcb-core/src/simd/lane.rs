@@ -2,9 +2,10 @@
 //!
 //! [`Lane`] extends [`Real`] with division, comparisons, selects and a few
 //! functions. It is implemented for `f32` and `f64` (one lane: the scalar
-//! reference) and for `wide::f32x8` and `wide::f64x4` (the runtime's
-//! kernels), so time mapping, ease, normalization and the Hermite basis run
-//! the same operations in the same order on one lane and on eight (as
+//! reference), for `wide::f32x8` and `wide::f64x4` (the runtime's
+//! kernels) and for [`crate::simd::w8::W8`] (their AVX2 instance), so time
+//! mapping, ease, normalization and the Hermite basis run the same
+//! operations in the same order on one lane and on eight (as
 //! ultraviolet and wide do). Branches become selects: every side of a
 //! choice is computed and the mask picks, so a formula has no branch that
 //! depends on a lane's data.
@@ -208,5 +209,52 @@ mod tests {
             let want = (a[i] / 3.0).sqrt();
             assert!(got[i].to_bits() == want.to_bits() || (want.is_nan() && got[i].is_nan()));
         }
+    }
+
+    /// Each lane of `W8`'s operations equals `f32x8`'s, bit for bit.
+    #[test]
+    fn w8_lanes_agree_with_wide() {
+        use crate::simd::w8::W8;
+        let xs = [-2.5f32, -0.0, 0.0, 0.5, 1.0, 3.75, 1e30, f32::NAN];
+        let ys = [1.0f32, 0.0, -0.0, 0.5, 2.0, -3.0, 1e-30, 0.0];
+        let (wa, wb) = (W8(xs), W8(ys));
+        let (va, vb) = (f32x8::new(xs), f32x8::new(ys));
+        let same = |w: W8, v: f32x8| {
+            for (x, y) in w.0.iter().zip(v.to_array()) {
+                assert!(
+                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+                    "{x} {y}"
+                );
+            }
+        };
+        same(wa + wb, va + vb);
+        same(wa - wb, va - vb);
+        same(wa * wb, va * vb);
+        same(wa / wb, va / vb);
+        same(-wa, -va);
+        same((wa / W8::of(3.0)).sqrt(), (va / f32x8::of(3.0)).sqrt());
+        same(wa.abs(), va.abs());
+        same(wa.floor(), va.floor());
+        same(
+            W8::select(wa.lt(wb), wa, wb),
+            f32x8::select(va.lt(vb), va, vb),
+        );
+        same(
+            W8::select(wa.le(wb), wa, wb),
+            f32x8::select(va.le(vb), va, vb),
+        );
+        same(
+            W8::select(wa.eq(wb), wa, wb),
+            f32x8::select(va.eq(vb), va, vb),
+        );
+        same(
+            wa.clamp_to(W8::of(0.0), wb.abs()),
+            va.clamp_to(f32x8::of(0.0), vb.abs()),
+        );
+        let m = wa.lt(wb);
+        assert_eq!(m.any(), va.lt(vb).any());
+        assert_eq!(m.all(), va.lt(vb).all());
+        assert!(!(m & !m).any());
+        assert!((m | !m).all());
     }
 }

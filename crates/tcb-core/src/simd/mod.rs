@@ -1,5 +1,6 @@
 //! The formulas the runtime's SIMD kernels share with the reference, over
-//! lane types (`f32`, `f64`, and `wide`'s `f32x8` and `f64x4`): the lane
+//! lane types (`f32`, `f64`, `wide`'s `f32x8` and `f64x4`, and [`w8::W8`],
+//! eight lanes for kernels compiled for AVX2 at run time): the lane
 //! trait, the Hermite basis row, squad in power form and extrapolation over
 //! lanes with per-lane mode masks.
 //!
@@ -19,3 +20,4 @@ pub mod basis;
 pub mod extrapolate;
 pub mod lane;
 pub mod squad;
+pub mod w8;

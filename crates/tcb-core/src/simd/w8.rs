@@ -1,0 +1,139 @@
+//! Eight `f32` lanes as a plain array, for kernels compiled for an
+//! instruction set chosen at run time.
+//!
+//! `wide::f32x8` picks its instructions when `wide` is compiled: two SSE2
+//! halves in a default x86-64 build, even inside a function compiled with
+//! `#[target_feature(enable = "avx2")]`. [`W8`]'s operations are
+//! element-wise loops over an array, which the compiler turns into one
+//! vector instruction each for the features of the function they are
+//! inlined into. The runtime's AVX2 instance of its kernels runs the same
+//! formulas ([`crate::simd::basis::hermite`], [`crate::quat::normalize`])
+//! on [`W8`] as its default instance runs on `wide::f32x8`: the same IEEE
+//! operations per lane in the same order, so the same bits (no operation
+//! is fused; Rust does not contract `a * b + c`).
+//!
+//! Inside a `#[target_feature]` function, build arrays of [`W8`] without
+//! closures passed to generic functions (`std::array::from_fn`, `map`): such
+//! a closure inherits the features and can then not be inlined into the
+//! generic function, which has none, so each element becomes a call.
+use crate::simd::basis::Real;
+use crate::simd::lane::{Lane, Mask};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Eight `f32` lanes (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct W8(pub [f32; 8]);
+
+/// Per-lane booleans of [`W8`]: all bits set or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct M8(pub [u32; 8]);
+
+macro_rules! binop {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl $tr for W8 {
+            type Output = W8;
+            #[inline(always)]
+            fn $f(self, o: W8) -> W8 {
+                W8(std::array::from_fn(|i| self.0[i] $op o.0[i]))
+            }
+        }
+    };
+}
+binop!(Add, add, +);
+binop!(Sub, sub, -);
+binop!(Mul, mul, *);
+binop!(Div, div, /);
+impl Neg for W8 {
+    type Output = W8;
+    #[inline(always)]
+    fn neg(self) -> W8 {
+        W8(self.0.map(|x| -x))
+    }
+}
+macro_rules! mop {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl $tr for M8 {
+            type Output = M8;
+            #[inline(always)]
+            fn $f(self, o: M8) -> M8 {
+                M8(std::array::from_fn(|i| self.0[i] $op o.0[i]))
+            }
+        }
+    };
+}
+mop!(BitAnd, bitand, &);
+mop!(BitOr, bitor, |);
+impl Not for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn not(self) -> M8 {
+        M8(self.0.map(|x| !x))
+    }
+}
+impl Mask for M8 {
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0.iter().fold(0, |a, &x| a | x) != 0
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self.0.iter().fold(u32::MAX, |a, &x| a & x) == u32::MAX
+    }
+}
+impl Real for W8 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        W8([x; 8])
+    }
+}
+#[inline(always)]
+fn m(b: bool) -> u32 {
+    if b { u32::MAX } else { 0 }
+}
+impl Lane for W8 {
+    type Mask = M8;
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        W8([x as f32; 8])
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M8 {
+        M8(std::array::from_fn(|i| m(self.0[i] < o.0[i])))
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M8 {
+        M8(std::array::from_fn(|i| m(self.0[i] <= o.0[i])))
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M8 {
+        M8(std::array::from_fn(|i| m(self.0[i] == o.0[i])))
+    }
+    #[inline(always)]
+    fn select(k: M8, a: Self, b: Self) -> Self {
+        W8(std::array::from_fn(|i| {
+            f32::from_bits((a.0[i].to_bits() & k.0[i]) | (b.0[i].to_bits() & !k.0[i]))
+        }))
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        W8(self.0.map(f32::floor))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        W8(self.0.map(f32::sqrt))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        W8(self.0.map(f32::abs))
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        (W8(self.0.map(f32::sin)), W8(self.0.map(f32::cos)))
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        W8(std::array::from_fn(|i| self.0[i].atan2(x.0[i])))
+    }
+}

@@ -1,0 +1,78 @@
+//! The instruction set of the sampling kernels, chosen at run time.
+//!
+//! A default x86-64 build runs `wide`'s `f32x8` as two SSE2 halves. Where
+//! the CPU has AVX2 and FMA, the group kernels (vector channels, and
+//! rotation values) run an instance compiled for them instead, on
+//! [`tcb_core::simd::w8::W8`]: the same formulas, the same IEEE operations
+//! per lane in the same order, so the same bits (`tests/isa.rs` compares
+//! the two on every scenario shape). Builds with `-C target-cpu=x86-64-v3`
+//! or `native` have AVX2 everywhere and gain nothing from it.
+//!
+//! ```
+//! use tcb_runtime::Simd;
+//! let now = tcb_runtime::simd();
+//! tcb_runtime::force_baseline_simd(true);
+//! assert_eq!(tcb_runtime::simd(), Simd::Baseline);
+//! tcb_runtime::force_baseline_simd(false);
+//! assert_eq!(tcb_runtime::simd(), now);
+//! ```
+
+use std::sync::atomic::{AtomicU8, Ordering};
+
+/// Which instance of the kernels sampling runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Simd {
+    /// The build's own instructions (`wide` as compiled).
+    Baseline,
+    /// AVX2 and FMA, detected at run time, in a build that does not enable
+    /// them (a default x86-64 build).
+    Avx2,
+}
+
+/// What [`avx2`] answers: not yet detected, the AVX2 instance, or the
+/// baseline (detected or forced).
+const UNKNOWN: u8 = 0;
+const AVX2: u8 = 1;
+const BASELINE: u8 = 2;
+static STATE: AtomicU8 = AtomicU8::new(UNKNOWN);
+
+/// The instance sampling runs now, on this CPU and in this build.
+pub fn simd() -> Simd {
+    if avx2() { Simd::Avx2 } else { Simd::Baseline }
+}
+
+/// Run the build's own instructions even where AVX2 was detected (`true`),
+/// or go back to detection (`false`), for every thread: to compare the two
+/// instances, or to count the same instructions on every CPU (the
+/// instruction-count gate does). Takes effect from the next kernel call.
+pub fn force_baseline_simd(on: bool) {
+    STATE.store(if on { BASELINE } else { detect() }, Ordering::Relaxed);
+}
+
+/// Whether the AVX2 instance runs: one load once detected.
+#[inline(always)]
+pub(crate) fn avx2() -> bool {
+    match STATE.load(Ordering::Relaxed) {
+        AVX2 => true,
+        UNKNOWN => first(),
+        _ => false,
+    }
+}
+
+/// The first call: detect, and remember (out of line).
+#[cold]
+#[inline(never)]
+fn first() -> bool {
+    let state = detect();
+    STATE.store(state, Ordering::Relaxed);
+    state == AVX2
+}
+
+/// The CPU has AVX2 and FMA and the build does not already enable AVX2.
+fn detect() -> u8 {
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        return AVX2;
+    }
+    BASELINE
+}

@@ -1,0 +1,114 @@
+//! The AVX2 instance of the group kernels (`tcb_runtime::simd`) against
+//! the build's own, bit for bit: the CMU capture in both rotation modes,
+//! every bundled clip, and tangents beyond f32 (the out-of-range redo), at
+//! keys, between them and beyond them, with and without velocities. One
+//! test in its own binary: it switches the process-wide choice.
+
+use glam::Quat;
+use std::sync::Arc;
+use tcb_core::params::{KeyParams, RotationMode};
+use tcb_core::{NamedTrack, RotationTrack, TrackData, TrackSettings};
+use tcb_runtime::{Clip, Instance, Simd};
+
+/// Rows of `clip` at `times` with the instance `force_baseline` picks.
+fn rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> {
+    tcb_runtime::force_baseline_simd(baseline);
+    let compiled = Arc::new(Clip::compile(clip));
+    let n = clip.channel_count();
+    let (mut v, mut dv) = (vec![0.0f32; n], vec![0.0f32; n]);
+    let mut plain = Instance::new(compiled.clone());
+    let mut with_v = Instance::new(compiled).with_velocities();
+    let mut out = Vec::new();
+    for &t in times {
+        plain.sample(t).write_row(&mut v, None);
+        out.extend(v.iter().map(|x| x.to_bits()));
+        with_v.sample(t).write_row(&mut v, Some(&mut dv));
+        out.extend(v.iter().chain(&dv).map(|x| x.to_bits()));
+    }
+    out
+}
+
+fn same_bits(name: &str, clip: &tcb_core::SourceClip, times: &[f64]) {
+    let avx2 = rows(clip, times, false);
+    let base = rows(clip, times, true);
+    if let Some(i) = (0..base.len()).find(|&i| avx2[i] != base[i]) {
+        panic!(
+            "{name}: value {i} is {} with AVX2 and {} without",
+            f32::from_bits(avx2[i]),
+            f32::from_bits(base[i])
+        );
+    }
+}
+
+/// Keys, a quarter and three quarters between them, and beyond both ends.
+fn times_of(clip: &tcb_core::SourceClip) -> Vec<f64> {
+    let keys = clip.key_times();
+    let mut t: Vec<f64> = keys
+        .windows(2)
+        .flat_map(|w| {
+            [
+                w[0],
+                w[0] + 0.25 * (w[1] - w[0]),
+                w[0] + 0.75 * (w[1] - w[0]),
+            ]
+        })
+        .collect();
+    if let (Some(&a), Some(&b)) = (keys.first(), keys.last()) {
+        t.extend([a - 1.0, b, b + 0.5, b + 7.25]);
+    }
+    t
+}
+
+#[test]
+fn the_avx2_kernels_give_the_baselines_bits() {
+    tcb_runtime::force_baseline_simd(false);
+    if tcb_runtime::simd() != Simd::Avx2 {
+        eprintln!("skipped: this CPU or build runs no AVX2 instance");
+        return;
+    }
+    let bvh = include_str!("../../../data/cmu-01_01.bvh");
+    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
+    for mode in [RotationMode::Squad, RotationMode::Hermite] {
+        let clip = bvh.to_clip_doc("cmu", mode).unwrap().build().unwrap();
+        same_bits(&format!("cmu {mode:?}"), &clip, &times_of(&clip));
+    }
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    for dir in ["examples/clips", "tools/check/clips"] {
+        for entry in std::fs::read_dir(format!("{root}/{dir}")).unwrap() {
+            let path = entry.unwrap().path();
+            let clip = tcb_io::load_clip(&path).unwrap();
+            same_bits(&path.display().to_string(), &clip, &times_of(&clip));
+        }
+    }
+    // Tangents of 2.3e36 on one of 9 `hermite` rotations on one grid: its
+    // |p|^2 overflows f32, and the group kernel redoes the block scaled.
+    let t = vec![0.0, 1.0, 2.0];
+    let q = vec![
+        Quat::from_rotation_x(0.3),
+        Quat::from_rotation_y(1.2),
+        Quat::IDENTITY,
+    ];
+    let huge = Quat::from_xyzw(2.3e36, 1.9, 1.9, 7.0);
+    let s = TrackSettings {
+        rotation: RotationMode::Hermite,
+        ..TrackSettings::default()
+    };
+    let named = (0..9)
+        .map(|i| {
+            let mut keys = vec![KeyParams::default(); 3];
+            if i == 5 {
+                keys[1].tangent_in = Some(huge);
+                keys[1].tangent_out = Some(huge);
+            }
+            let track = RotationTrack::new(t.clone(), q.clone(), keys, &s).unwrap();
+            NamedTrack {
+                name: format!("r{i}"),
+                data: TrackData::Quat(track),
+            }
+        })
+        .collect();
+    let clip = tcb_core::SourceClip::new("huge", named).unwrap();
+    let times = [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0];
+    same_bits("huge tangents", &clip, &times);
+    tcb_runtime::force_baseline_simd(false);
+}
