@@ -4,6 +4,7 @@
 use crate::exact::{Exact, SQ_STRIDE};
 use crate::segment::Segment;
 use tcb_core::simd::basis::hermite;
+use tcb_core::simd::lane::Lane;
 use wide::{f32x8, f64x4};
 
 #[inline(always)]
@@ -182,9 +183,9 @@ pub(crate) use tcb_core::quat::normalize;
 /// [`normalize`] may run as it is (all bits set there, none elsewhere; NaN
 /// is out of range).
 #[inline(always)]
-pub(crate) fn in_range(p: &[f32x8; 4]) -> f32x8 {
+pub(crate) fn in_range<L: Lane>(p: &[L; 4]) -> L::Mask {
     let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
-    n2.simd_gt(f32x8::splat(1e-30)) & n2.simd_lt(f32x8::splat(1e30))
+    n2.gt(L::splat(1e-30)) & n2.lt(L::splat(1e30))
 }
 
 /// Rewrite `out` (and `vel`) with [`normalize`] of a block where `|p|^2`
@@ -328,19 +329,15 @@ pub(crate) fn identity(out: &mut [f32x8]) {
 /// with closures (see `tcb_core::simd::w8`).
 #[cfg(target_arch = "x86_64")]
 mod v3 {
-    use crate::kernel::{normalize, quat_keys};
+    use crate::kernel::{in_range, normalize, quat_keys};
     use crate::segment::Segment;
     use tcb_core::simd::basis::hermite;
-    use tcb_core::simd::lane::{Lane, Mask};
+    use tcb_core::simd::lane::Mask;
     use tcb_core::simd::w8::W8;
     use wide::f32x8;
 
-    /// [`vectors`], where `crate::isa::avx2` said so. Out of line and cold
-    /// for the caller's sake: the baseline's loop, inlined where it is
-    /// called, keeps its registers (inline, the two calls cost
-    /// `character-hermite` 3.7% more instructions in the baseline).
-    #[cold]
-    #[inline(never)]
+    /// [`vectors`], where `crate::isa::avx2` said so.
+    #[inline(always)]
     pub(super) fn vectors_here(c: Segment, h: [f32; 4], out: &mut [f32x8]) {
         debug_assert!(crate::isa::avx2());
         // SAFETY: `crate::isa::avx2` detected AVX2 and FMA on this CPU
@@ -351,9 +348,8 @@ mod v3 {
         }
     }
 
-    /// [`quats`], where `crate::isa::avx2` said so (see [`vectors_here`]).
-    #[cold]
-    #[inline(never)]
+    /// [`quats`], where `crate::isa::avx2` said so.
+    #[inline(always)]
     pub(super) fn quats_here(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
         debug_assert!(crate::isa::avx2());
         // SAFETY: as in `vectors_here`.
@@ -389,7 +385,6 @@ mod v3 {
     #[target_feature(enable = "avx2,fma")]
     fn quats(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
         let h = rows(h);
-        let (lo, hi) = (W8([1e-30; 8]), W8([1e30; 8]));
         let mut ok = true;
         for ((((p0, p1), m0), m1), o) in quat_keys(c).zip(out.as_chunks_mut::<4>().0) {
             let p = [
@@ -398,8 +393,7 @@ mod v3 {
                 hermite(&h, w(&p0[2]), w(&p1[2]), w(&m0[2]), w(&m1[2])),
                 hermite(&h, w(&p0[3]), w(&p1[3]), w(&m0[3]), w(&m1[3])),
             ];
-            let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
-            ok &= (n2.gt(lo) & n2.lt(hi)).all();
+            ok &= in_range(&p).all();
             let (q, _) = normalize(p, None);
             *o = [
                 f32x8::new(q[0].0),
