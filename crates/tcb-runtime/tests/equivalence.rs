@@ -9,6 +9,8 @@ use tcb_core::{
 };
 use tcb_runtime::{Clip, Instance};
 
+mod common;
+
 /// A small deterministic generator (xorshift64*), so failures replay from a seed.
 struct Rng(u64);
 
@@ -888,34 +890,8 @@ fn step_segments_hold_their_keys_past_overflowing_tangents() {
 /// call (`kernel::hermite_quats`).
 #[test]
 fn rotations_with_huge_tangents_stay_unit() {
-    let t = vec![0.0, 1.0, 2.0];
-    let q = vec![
-        Quat::from_rotation_x(0.3),
-        Quat::from_rotation_y(1.2),
-        Quat::IDENTITY,
-    ];
-    let huge = Quat::from_xyzw(2.3e36, 1.9, 1.9, 7.0);
-    let s = TrackSettings {
-        rotation: RotationMode::Hermite,
-        ..TrackSettings::default()
-    };
     for (tracks, at) in [(1, 0), (9, 0), (9, 5), (16, 15)] {
-        let named = (0..tracks)
-            .map(|i| {
-                let mut keys = vec![KeyParams::default(); 3];
-                if i == at {
-                    keys[1].tangent_in = Some(huge);
-                    keys[1].tangent_out = Some(huge);
-                }
-                let track =
-                    RotationTrack::new(t.clone(), q.clone(), keys, &s).expect("finite tangents");
-                NamedTrack {
-                    name: format!("r{i}"),
-                    data: TrackData::Quat(track),
-                }
-            })
-            .collect();
-        let clip = tcb_core::SourceClip::new("huge", named).expect("unique track names");
+        let clip = common::huge_tangent_rotations(tracks, at);
         let compiled = Arc::new(Clip::compile(&clip));
         assert_eq!(compiled.group_count(), usize::from(tracks > 1));
         for velocities in [false, true] {

@@ -4,11 +4,11 @@
 //! keys, between them and beyond them, with and without velocities. One
 //! test in its own binary: it switches the process-wide choice.
 
-use glam::Quat;
 use std::sync::Arc;
-use tcb_core::params::{KeyParams, RotationMode};
-use tcb_core::{NamedTrack, RotationTrack, TrackData, TrackSettings};
+use tcb_core::params::RotationMode;
 use tcb_runtime::{Clip, Instance, Simd};
+
+mod common;
 
 /// Rows of `clip` at `times` with the instance `force_baseline` picks.
 fn rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> {
@@ -82,32 +82,7 @@ fn the_avx2_kernels_give_the_baselines_bits() {
     }
     // Tangents of 2.3e36 on one of 9 `hermite` rotations on one grid: its
     // |p|^2 overflows f32, and the group kernel redoes the block scaled.
-    let t = vec![0.0, 1.0, 2.0];
-    let q = vec![
-        Quat::from_rotation_x(0.3),
-        Quat::from_rotation_y(1.2),
-        Quat::IDENTITY,
-    ];
-    let huge = Quat::from_xyzw(2.3e36, 1.9, 1.9, 7.0);
-    let s = TrackSettings {
-        rotation: RotationMode::Hermite,
-        ..TrackSettings::default()
-    };
-    let named = (0..9)
-        .map(|i| {
-            let mut keys = vec![KeyParams::default(); 3];
-            if i == 5 {
-                keys[1].tangent_in = Some(huge);
-                keys[1].tangent_out = Some(huge);
-            }
-            let track = RotationTrack::new(t.clone(), q.clone(), keys, &s).unwrap();
-            NamedTrack {
-                name: format!("r{i}"),
-                data: TrackData::Quat(track),
-            }
-        })
-        .collect();
-    let clip = tcb_core::SourceClip::new("huge", named).unwrap();
+    let clip = common::huge_tangent_rotations(9, 5);
     let times = [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0];
     same_bits("huge tangents", &clip, &times);
     tcb_runtime::force_baseline_simd(false);

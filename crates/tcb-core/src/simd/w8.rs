@@ -30,21 +30,22 @@ pub struct W8(pub [f32; 8]);
 #[repr(C, align(32))]
 pub struct M8(pub [u32; 8]);
 
-macro_rules! binop {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for W8 {
-            type Output = W8;
+/// `$t`'s operator `$tr` lane by lane.
+macro_rules! elementwise {
+    ($t:ident, $tr:ident, $f:ident, $op:tt) => {
+        impl $tr for $t {
+            type Output = $t;
             #[inline(always)]
-            fn $f(self, o: W8) -> W8 {
-                W8(std::array::from_fn(|i| self.0[i] $op o.0[i]))
+            fn $f(self, o: $t) -> $t {
+                $t(std::array::from_fn(|i| self.0[i] $op o.0[i]))
             }
         }
     };
 }
-binop!(Add, add, +);
-binop!(Sub, sub, -);
-binop!(Mul, mul, *);
-binop!(Div, div, /);
+elementwise!(W8, Add, add, +);
+elementwise!(W8, Sub, sub, -);
+elementwise!(W8, Mul, mul, *);
+elementwise!(W8, Div, div, /);
 impl Neg for W8 {
     type Output = W8;
     #[inline(always)]
@@ -52,19 +53,8 @@ impl Neg for W8 {
         W8(self.0.map(|x| -x))
     }
 }
-macro_rules! mop {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for M8 {
-            type Output = M8;
-            #[inline(always)]
-            fn $f(self, o: M8) -> M8 {
-                M8(std::array::from_fn(|i| self.0[i] $op o.0[i]))
-            }
-        }
-    };
-}
-mop!(BitAnd, bitand, &);
-mop!(BitOr, bitor, |);
+elementwise!(M8, BitAnd, bitand, &);
+elementwise!(M8, BitOr, bitor, |);
 impl Not for M8 {
     type Output = M8;
     #[inline(always)]
