@@ -1,7 +1,8 @@
 //! The AVX2 instance of the group kernels (`tcb_runtime::simd`) against
 //! the build's own, bit for bit: the CMU capture in both rotation modes,
 //! every bundled clip, and tangents beyond f32 (the out-of-range redo), at
-//! keys, between them and beyond them, with and without velocities. One
+//! keys, between them and beyond them, with and without velocities; and
+//! the packed decoder's instances on packed clips. One
 //! test in its own binary: it switches the process-wide choice.
 
 use std::sync::Arc;
@@ -13,8 +14,12 @@ mod common;
 /// Rows of `clip` at `times` with the instance `force_baseline` picks.
 fn rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> {
     tcb_runtime::force_baseline_simd(baseline);
-    let compiled = Arc::new(Clip::compile(clip));
-    let n = clip.channel_count();
+    compiled_rows(Arc::new(Clip::compile(clip)), times)
+}
+
+/// Rows of a compiled clip at `times`, without and with velocities.
+fn compiled_rows(compiled: Arc<Clip>, times: &[f64]) -> Vec<u32> {
+    let n = compiled.channel_count();
     let (mut v, mut dv) = (vec![0.0f32; n], vec![0.0f32; n]);
     let mut plain = Instance::new(compiled.clone());
     let mut with_v = Instance::new(compiled).with_velocities();
@@ -31,6 +36,10 @@ fn rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> 
 fn same_bits(name: &str, clip: &tcb_core::SourceClip, times: &[f64]) {
     let avx2 = rows(clip, times, false);
     let base = rows(clip, times, true);
+    compare(name, &avx2, &base);
+}
+
+fn compare(name: &str, avx2: &[u32], base: &[u32]) {
     if let Some(i) = (0..base.len()).find(|&i| avx2[i] != base[i]) {
         panic!(
             "{name}: value {i} is {} with AVX2 and {} without",
@@ -85,5 +94,56 @@ fn the_avx2_kernels_give_the_baselines_bits() {
     let clip = common::huge_tangent_rotations(9, 5);
     let times = [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0];
     same_bits("huge tangents", &clip, &times);
+    packed_clips_decode_to_the_same_bits();
     tcb_runtime::force_baseline_simd(false);
+}
+
+/// The packed decoder's instances: the CMU capture quantized (the AVX2
+/// instance gathers each key's residuals from the stream), and with the
+/// root translation's integers alternating between +-(2^24 - 1), whose
+/// residuals are 27 bits wide (too wide for the gather: that segment
+/// unpacks as the baseline does), forward, backward and with seeks.
+fn packed_clips_decode_to_the_same_bits() {
+    let bvh = include_str!("../../../data/cmu-01_01.bvh");
+    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
+    let clip = bvh
+        .to_clip_doc("cmu", RotationMode::Hermite)
+        .unwrap()
+        .build()
+        .unwrap();
+    let steps: Vec<f32> = (0..clip.tracks().len())
+        .map(|i| if i == 0 { 1.0 / 256.0 } else { 1.0 / 16384.0 })
+        .collect();
+    let mut source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();
+    let (t0, t1) = clip.time_range().unwrap();
+    let mut times: Vec<f64> = (0..)
+        .map(|f| t0 + f as f64 / 60.0)
+        .take_while(|t| *t <= t1)
+        .collect();
+    times.extend((0..200).map(|f| t1 - f as f64 / 60.0));
+    times.extend((0..300).map(|f| t0 + ((f * 7919) % 1000) as f64 / 1000.0 * (t1 - t0)));
+    for wide in [false, true] {
+        if wide {
+            let root = &mut source.tracks[0];
+            assert_eq!(root.name, "Hips.translation");
+            for (k, x) in root.values[1].iter_mut().enumerate().skip(100).take(40) {
+                *x = if k % 2 == 0 {
+                    (1 << 24) - 1
+                } else {
+                    1 - (1 << 24)
+                };
+            }
+        }
+        let packed = Arc::new(tcb_runtime::Packed::encode(&source).unwrap());
+        let clip = Arc::new(Clip::from_packed(packed).unwrap());
+        tcb_runtime::force_baseline_simd(false);
+        let avx2 = compiled_rows(clip.clone(), &times);
+        tcb_runtime::force_baseline_simd(true);
+        let base = compiled_rows(clip, &times);
+        compare(
+            &format!("packed cmu (wide residuals: {wide})"),
+            &avx2,
+            &base,
+        );
+    }
 }

@@ -257,4 +257,19 @@ mod tests {
         assert!(!(m & !m).any());
         assert!((m | !m).all());
     }
+
+    #[test]
+    fn i8_lanes_agree_with_wide() {
+        use crate::simd::w8::I8;
+        use wide::i32x8;
+        let xs = [i32::MAX, i32::MIN, -1, 0, 1, 1 << 24, (1 << 24) + 1, -77];
+        let ys = [1, -1, i32::MIN, 5, -5, 3, 0x0f0f_0f0f, 99];
+        let (ia, ib) = (I8(xs), I8(ys));
+        let (va, vb) = (i32x8::new(xs), i32x8::new(ys));
+        assert_eq!((ia + ib).0, (va + vb).to_array());
+        assert_eq!((ia - ib).0, (va - vb).to_array());
+        assert_eq!((ia & ib).0, (va & vb).to_array());
+        let (f, g) = (ia.to_float().0, va.round_float().to_array());
+        assert_eq!(f.map(f32::to_bits), g.map(f32::to_bits));
+    }
 }

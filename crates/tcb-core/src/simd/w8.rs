@@ -30,8 +30,43 @@ pub struct W8(pub [f32; 8]);
 #[repr(C, align(32))]
 pub struct M8(pub [u32; 8]);
 
-/// `$t`'s operator `$tr` lane by lane.
+/// Eight `i32` lanes, as [`W8`] is eight `f32`: what a decoder of
+/// integers runs on (wrapping arithmetic, as `wide::i32x8`'s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct I8(pub [i32; 8]);
+
+impl I8 {
+    /// Each lane as the nearest `f32` (`x as f32`, as
+    /// `wide::i32x8::round_float`).
+    #[inline(always)]
+    pub fn to_float(self) -> W8 {
+        let x = self.0;
+        // Written out: no closure (module docs).
+        W8([
+            x[0] as f32,
+            x[1] as f32,
+            x[2] as f32,
+            x[3] as f32,
+            x[4] as f32,
+            x[5] as f32,
+            x[6] as f32,
+            x[7] as f32,
+        ])
+    }
+}
+
+/// `$t`'s operator `$tr` lane by lane (`$op`, or the method `.$m`).
 macro_rules! elementwise {
+    ($t:ident, $tr:ident, $f:ident, .$m:ident) => {
+        impl $tr for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn $f(self, o: $t) -> $t {
+                $t(std::array::from_fn(|i| self.0[i].$m(o.0[i])))
+            }
+        }
+    };
     ($t:ident, $tr:ident, $f:ident, $op:tt) => {
         impl $tr for $t {
             type Output = $t;
@@ -53,6 +88,9 @@ impl Neg for W8 {
         W8(self.0.map(|x| -x))
     }
 }
+elementwise!(I8, Add, add, .wrapping_add);
+elementwise!(I8, Sub, sub, .wrapping_sub);
+elementwise!(I8, BitAnd, bitand, &);
 elementwise!(M8, BitAnd, bitand, &);
 elementwise!(M8, BitOr, bitor, |);
 impl Not for M8 {

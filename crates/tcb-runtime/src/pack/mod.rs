@@ -171,8 +171,32 @@ pub fn dequantize(x: i32, step: f32) -> f32 {
 
 /// [`dequantize`] on 8 lanes (the decoder's).
 #[inline(always)]
-pub(crate) fn dequantize_lanes(x: wide::i32x8, step: wide::f32x8) -> wide::f32x8 {
-    x.round_float() * step
+pub(crate) fn dequantize_lanes<I: IntLanes>(x: I, step: I::Float) -> I::Float {
+    x.to_float() * step
+}
+
+/// Eight `i32` lanes the decoder dequantizes: `wide::i32x8`, or the AVX2
+/// instance's `tcb_core::simd::w8::I8`.
+pub(crate) trait IntLanes {
+    type Float: std::ops::Mul<Output = Self::Float>;
+    /// Each lane as the nearest `f32`.
+    fn to_float(self) -> Self::Float;
+}
+
+impl IntLanes for wide::i32x8 {
+    type Float = wide::f32x8;
+    #[inline(always)]
+    fn to_float(self) -> wide::f32x8 {
+        self.round_float()
+    }
+}
+
+impl IntLanes for tcb_core::simd::w8::I8 {
+    type Float = tcb_core::simd::w8::W8;
+    #[inline(always)]
+    fn to_float(self) -> Self::Float {
+        tcb_core::simd::w8::I8::to_float(self)
+    }
 }
 
 /// Why a packed clip cannot be built or read: one line.

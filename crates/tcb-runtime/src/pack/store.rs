@@ -8,7 +8,11 @@
 //! that each run without a branch on the data: every lane's residuals
 //! unpacked by a function for its width (16 values, a mask and a shift
 //! each), then per plane of 8 lanes the prediction and dequantization, key
-//! by key, with the predictor in registers, then the rebuilt `w`s. Forward
+//! by key, with the predictor in registers, then the rebuilt `w`s. Where
+//! the AVX2 instance runs (`crate::isa`), the first two passes are one:
+//! each key's residuals of a plane come straight from the stream, 32 bits
+//! gathered at each lane's byte, shifted and masked per lane (segments
+//! whose widths are all at most 25 bits; wider ones unpack first). Forward
 //! playback decodes each key once; playing backwards re-decodes from the
 //! block's start only when it leaves a segment. Interior tangents are the
 //! tangent rule on the two chords,
@@ -26,7 +30,10 @@
 
 use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag};
 use crate::segment::Segment;
+use std::ops::{Add, BitAnd, Sub};
 use std::sync::Arc;
+use tcb_core::simd::basis::Real;
+use tcb_core::simd::lane::Lane;
 use wide::{f32x8, i32x8};
 
 /// Sections of a key: `P`, `TO`, `TI`.
@@ -122,15 +129,14 @@ impl PackedKeys {
         let (m0, m1) = m.split_at_mut(np);
         if a > 0 && b < n - 1 {
             // Both (all but the end segments): the chord P_b - P_a once.
-            let (v, x) = (c.ring(a - 1, np), c.ring(a, np));
-            let (y, z) = (c.ring(b, np), c.ring(b + 1, np));
-            let rows = v.iter().zip(x).zip(y.iter().zip(z));
-            let out = m0.iter_mut().zip(m1.iter_mut());
-            for (((m0, m1), ((v, x), (y, z))), w) in out.zip(rows).zip(&self.weights) {
-                let chord = *y - *x;
-                *m0 = tangent(*x - *v, chord, w[2], w[3]);
-                *m1 = tangent(chord, *z - *y, w[0], w[1]);
+            let keys = [a - 1, a, b, b + 1].map(|k| c.ring(k, np));
+            #[cfg(target_arch = "x86_64")]
+            if crate::isa::avx2() {
+                v3::interior_tangents_here(keys, &self.weights, m0, m1);
+                c.m = m;
+                return;
             }
+            interior_tangents::<f32x8>(keys, &self.weights, m0, m1);
         } else {
             if a > 0 {
                 let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
@@ -154,8 +160,104 @@ impl PackedKeys {
 /// The tangent rule on a key's two chords (`P_k - P_{k-1}`, `P_{k+1} -
 /// P_k`) with its weights, as `tcb_core::Track` computes it in f32.
 #[inline(always)]
-fn tangent(before: f32x8, after: f32x8, wa: f32x8, wb: f32x8) -> f32x8 {
+fn tangent<L: Real>(before: L, after: L, wa: L, wb: L) -> L {
     before * wa + after * wb
+}
+
+/// `TO_a` and `TI_b` of a segment whose four keys `a - 1 ..= b + 1`
+/// (`keys`) are decoded: each plane's chord `P_b - P_a` once.
+#[inline(always)]
+fn interior_tangents<L: Plane>(
+    keys: [&[f32x8]; 4],
+    weights: &[[f32x8; 4]],
+    m0: &mut [f32x8],
+    m1: &mut [f32x8],
+) {
+    let [v, x, y, z] = keys;
+    let rows = v.iter().zip(x).zip(y.iter().zip(z));
+    let out = m0.iter_mut().zip(m1.iter_mut());
+    for (((m0, m1), ((v, x), (y, z))), w) in out.zip(rows).zip(weights) {
+        let [v, x, y, z] = [L::load(v), L::load(x), L::load(y), L::load(z)];
+        let [in_a, in_b, out_a, out_b] = [
+            L::load(&w[0]),
+            L::load(&w[1]),
+            L::load(&w[2]),
+            L::load(&w[3]),
+        ];
+        let chord = y - x;
+        *m0 = tangent(x - v, chord, out_a, out_b).store();
+        *m1 = tangent(chord, z - y, in_a, in_b).store();
+    }
+}
+
+/// The key predicted from the last two (`a`, then `b`) and the residual `z`
+/// as stored, for a plane's coding `[trend, live, bias]` (module docs).
+#[inline(always)]
+fn predict<I>(a: I, b: I, z: I, [trend, live, bias]: [I; 3]) -> I
+where
+    I: Copy + Add<Output = I> + Sub<Output = I> + BitAnd<Output = I>,
+{
+    b + ((b - a) & trend) + ((z & live) - bias)
+}
+
+/// Rebuild `w` of the rotations that store three components, and turn
+/// the keys of rotations with a center by it (`PackTrack::value`), in the
+/// rows `rows` (`planes` vectors each).
+#[inline(always)]
+fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) {
+    for row in rows.chunks_exact_mut(g.planes) {
+        let rot = &mut row[g.rot_from..];
+        for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
+            let [x, y, z] = [L::load(&block[0]), L::load(&block[1]), L::load(&block[2])];
+            let w = L::load(&block[3]);
+            let rebuilt = tcb_core::quat::rebuild_w(x, y, z);
+            block[3] = L::blend(mask, rebuilt, w).store();
+        }
+        for (b, c) in &g.center {
+            if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
+                let c = [
+                    L::load(&c[0]),
+                    L::load(&c[1]),
+                    L::load(&c[2]),
+                    L::load(&c[3]),
+                ];
+                let q = [
+                    L::load(&block[0]),
+                    L::load(&block[1]),
+                    L::load(&block[2]),
+                    L::load(&block[3]),
+                ];
+                let q = tcb_core::quat::mul(&c, &q);
+                for (o, q) in block.iter_mut().zip(q) {
+                    *o = q.store();
+                }
+            }
+        }
+    }
+}
+
+/// Eight `f32` lanes the decoder computes on, kept as `f32x8` in the rows:
+/// `f32x8` itself, or the AVX2 instance's `W8`.
+trait Plane: Lane {
+    fn load(x: &f32x8) -> Self;
+    fn store(self) -> f32x8;
+    /// `a` in the lanes where `mask` has every bit set, else `b`.
+    fn blend(mask: &f32x8, a: Self, b: Self) -> Self;
+}
+
+impl Plane for f32x8 {
+    #[inline(always)]
+    fn load(x: &f32x8) -> Self {
+        *x
+    }
+    #[inline(always)]
+    fn store(self) -> f32x8 {
+        self
+    }
+    #[inline(always)]
+    fn blend(mask: &f32x8, a: Self, b: Self) -> Self {
+        (*mask & a) | (!*mask & b)
+    }
 }
 
 /// Rows of the decoded keys' window: the three keys before the current
@@ -276,16 +378,19 @@ impl PackCache {
             // A block's first headers code against the lanes' base widths.
             self.widths.copy_from_slice(&g.headed_base);
         }
+        let mut widest = 0;
         for (w, &slot) in self.widths.iter_mut().zip(&g.headed) {
             let (order, width, used) = read_header(words, pos, *w);
             pos += used;
             *w = width;
+            widest = widest.max(width);
             // One bounds check for the plane; the lane is below 8.
             let c = &mut self.coding[slot as usize / 8];
             let lane = slot as usize % 8;
             c.trend[lane] = if order == 2 { -1 } else { 0 };
             c.live[lane] = if width > 0 { -1 } else { 0 };
             c.bias[lane] = super::bias(width);
+            c.width[lane] = width as i32;
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         let first = if block {
@@ -293,33 +398,55 @@ impl PackCache {
         } else {
             0
         };
-        // Residuals: 16 of each lane of a width above 0 (those past the
-        // segment's keys land in spare rows, or in rows no key reads), into
-        // the rows as i32; `live` masks the rest.
+        // The AVX2 instance reads each key's residuals of a plane straight
+        // from the stream (a gather of 32 bits from each lane's byte), where
+        // every width has room in them and the segment's last bit lies 32
+        // bits before the stream's end.
+        let last = pos + widest as usize * (keys - first) * g.headed.len();
+        let gather = crate::isa::avx2()
+            && widest <= GATHER_WIDTH
+            && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
+        // Residuals: a gather's first bit of each lane, or 16 of each lane
+        // of a width above 0 (those past the segment's keys land in spare
+        // rows, or in rows no key reads) into the rows as i32; `live` masks
+        // the rest.
         let stride = 8 * np;
         let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
         let base = (BEFORE + first) * stride;
-        for (&w, &slot) in self.widths.iter().zip(&g.headed) {
-            if w > 0 {
-                UNPACK[w as usize](words, pos, &mut rows[base + slot as usize..], stride);
+        let lanes = self.widths.iter().zip(&g.headed);
+        if gather {
+            for (&w, &slot) in lanes {
+                self.coding[slot as usize / 8].start[slot as usize % 8] = pos as i32;
                 pos += w as usize * (keys - first);
             }
-        }
-        for &p in &g.stored_planes {
-            let p = p as usize;
-            let (mut a, mut b) = (self.x0[p], self.x1[p]);
-            let c = &self.coding[p];
-            let [trend, live, bias] = [c.trend, c.live, c.bias].map(i32x8::from);
-            let step = g.step[p];
-            let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
-            for row in rows.chunks_exact_mut(np) {
-                let v = &mut row[p];
-                let z: i32x8 = bytemuck::cast(*v);
-                let x = b + ((b - a) & trend) + ((z & live) - bias);
-                (a, b) = (b, x);
-                *v = super::dequantize_lanes(x, step);
+        } else {
+            for (&w, &slot) in lanes {
+                if w > 0 {
+                    UNPACK[w as usize](words, pos, &mut rows[base + slot as usize..], stride);
+                    pos += w as usize * (keys - first);
+                }
             }
-            (self.x0[p], self.x1[p]) = (a, b);
+        }
+        let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
+        #[cfg(target_arch = "x86_64")]
+        if gather {
+            v3::predict_gathered_here(g, &self.coding, &mut self.x0, &mut self.x1, rows);
+        }
+        if !gather {
+            for &p in &g.stored_planes {
+                let p = p as usize;
+                let (mut a, mut b) = (self.x0[p], self.x1[p]);
+                let c = &self.coding[p];
+                let coding = [c.trend, c.live, c.bias].map(i32x8::from);
+                let step = g.step[p];
+                for row in rows.chunks_exact_mut(np) {
+                    let v = &mut row[p];
+                    let x = predict(a, b, bytemuck::cast(*v), coding);
+                    (a, b) = (b, x);
+                    *v = super::dequantize_lanes(x, step);
+                }
+                (self.x0[p], self.x1[p]) = (a, b);
+            }
         }
         self.rebuild(g, first..keys);
         self.pos = pos;
@@ -358,25 +485,15 @@ impl PackCache {
         first
     }
 
-    /// Rebuild `w` of the rotations that store three components, and turn
-    /// the keys of rotations with a center by it (`PackTrack::value`), in
-    /// the segment's rows `rows`.
+    /// [`rebuild_rows`] on the segment's rows `rows`.
     fn rebuild(&mut self, g: &PackedKeys, rows: std::ops::Range<usize>) {
         let np = g.planes;
-        for r in rows {
-            let row = &mut self.rows[(BEFORE + r) * np..][..np];
-            let rot = &mut row[g.rot_from..];
-            for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
-                let w = tcb_core::quat::rebuild_w(block[0], block[1], block[2]);
-                block[3] = (*mask & w) | (!*mask & block[3]);
-            }
-            for (b, c) in &g.center {
-                if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
-                    let q = tcb_core::quat::mul(c, &[block[0], block[1], block[2], block[3]]);
-                    block.copy_from_slice(&q);
-                }
-            }
+        let rows = &mut self.rows[(BEFORE + rows.start) * np..(BEFORE + rows.end) * np];
+        #[cfg(target_arch = "x86_64")]
+        if crate::isa::avx2() {
+            return v3::rebuild_rows_here(g, rows);
         }
+        rebuild_rows::<f32x8>(g, rows);
     }
 }
 
@@ -392,6 +509,160 @@ struct PlaneCoding {
     /// What the residuals are stored above their value (`super::bias` of
     /// their width).
     bias: [i32; 8],
+    /// Their width.
+    width: [i32; 8],
+    /// For the AVX2 instance's gather: the bit of each lane's first
+    /// residual of the segment in the stream.
+    start: [i32; 8],
+}
+
+/// The widest residual a gather of 32 bits from its first byte holds.
+const GATHER_WIDTH: u32 = 25;
+
+/// The AVX2 + FMA instance of the decoder (see `crate::isa`): the same
+/// formulas ([`predict`], `dequantize_lanes`, [`rebuild_rows`],
+/// [`interior_tangents`]) on `tcb_core::simd::w8`'s `I8` and `W8`, and each
+/// key's residuals of a plane gathered straight from the stream.
+#[cfg(target_arch = "x86_64")]
+mod v3 {
+    use crate::pack::dequantize_lanes;
+    use crate::pack::store::{
+        PackedKeys, Plane, PlaneCoding, interior_tangents, predict, rebuild_rows,
+    };
+    use std::arch::x86_64::{
+        __m256, __m256i, _mm256_add_epi32, _mm256_and_si256, _mm256_i32gather_epi32,
+        _mm256_set1_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
+        _mm256_sub_epi32,
+    };
+    use tcb_core::simd::w8::{I8, W8};
+    use wide::{f32x8, i32x8};
+
+    impl Plane for W8 {
+        // As AVX vectors: a loop of them is not vectorized again across
+        // its iterations (LLVM's loop vectorizer would, on arrays).
+        #[inline(always)]
+        fn load(x: &f32x8) -> Self {
+            let v: __m256 = bytemuck::cast(*x);
+            W8(bytemuck::cast(v))
+        }
+        #[inline(always)]
+        fn store(self) -> f32x8 {
+            let v: __m256 = bytemuck::cast(self.0);
+            bytemuck::cast(v)
+        }
+        #[inline(always)]
+        fn blend(mask: &f32x8, a: Self, b: Self) -> Self {
+            let m: [u32; 8] = bytemuck::cast(*mask);
+            let (a, b): ([u32; 8], [u32; 8]) = (bytemuck::cast(a.0), bytemuck::cast(b.0));
+            let mut o = [0u32; 8];
+            for i in 0..8 {
+                o[i] = (m[i] & a[i]) | (!m[i] & b[i]);
+            }
+            W8(bytemuck::cast(o))
+        }
+    }
+
+    // SAFETY (every `_here`): `crate::isa::avx2` detected AVX2 and FMA on
+    // this CPU before the caller came here.
+
+    /// [`interior_tangents`] in AVX2.
+    #[inline(always)]
+    pub(super) fn interior_tangents_here(
+        keys: [&[f32x8]; 4],
+        weights: &[[f32x8; 4]],
+        m0: &mut [f32x8],
+        m1: &mut [f32x8],
+    ) {
+        debug_assert!(crate::isa::avx2());
+        #[allow(unsafe_code)]
+        unsafe {
+            tangents(keys, weights, m0, m1)
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn tangents(keys: [&[f32x8]; 4], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
+        interior_tangents::<W8>(keys, weights, m0, m1);
+    }
+
+    /// [`rebuild_rows`] in AVX2.
+    #[inline(always)]
+    pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) {
+        debug_assert!(crate::isa::avx2());
+        #[allow(unsafe_code)]
+        unsafe {
+            rebuild(g, rows)
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn rebuild(g: &PackedKeys, rows: &mut [f32x8]) {
+        rebuild_rows::<W8>(g, rows);
+    }
+
+    /// The prediction and dequantization of the rows `rows` (keys
+    /// `first..keys` of the segment, `planes` vectors each), the residuals
+    /// gathered from the stream at the bits `coding[p].start`: the caller
+    /// checked that every lane's width is at most `GATHER_WIDTH` and that
+    /// the segment ends 32 bits before the stream does.
+    #[inline(always)]
+    pub(super) fn predict_gathered_here(
+        g: &PackedKeys,
+        coding: &[PlaneCoding],
+        x0: &mut [i32x8],
+        x1: &mut [i32x8],
+        rows: &mut [f32x8],
+    ) {
+        debug_assert!(crate::isa::avx2());
+        #[allow(unsafe_code)]
+        unsafe {
+            predict_gathered(g, coding, x0, x1, rows)
+        }
+    }
+
+    #[inline(always)]
+    fn m(x: [i32; 8]) -> __m256i {
+        bytemuck::cast(x)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn predict_gathered(
+        g: &PackedKeys,
+        coding: &[PlaneCoding],
+        x0: &mut [i32x8],
+        x1: &mut [i32x8],
+        rows: &mut [f32x8],
+    ) {
+        let np = g.planes;
+        let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
+        let (one, seven) = (_mm256_set1_epi32(1), _mm256_set1_epi32(7));
+        for &p in &g.stored_planes {
+            let p = p as usize;
+            let c = &coding[p];
+            let code = [I8(c.trend), I8(c.live), I8(c.bias)];
+            let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
+            let step = W8(g.step[p].to_array());
+            let width = m(c.width);
+            let mask = _mm256_sub_epi32(_mm256_sllv_epi32(one, width), one);
+            let mut bit = m(c.start);
+            for row in rows.chunks_exact_mut(np) {
+                // SAFETY: every lane's bit is below the segment's last,
+                // which lies 32 bits before the end of `bytes` (the
+                // caller's check), so each 4-byte read is inside it.
+                #[allow(unsafe_code)]
+                let word = unsafe {
+                    _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
+                };
+                let z =
+                    _mm256_and_si256(_mm256_srlv_epi32(word, _mm256_and_si256(bit, seven)), mask);
+                let x = predict(a, b, I8(bytemuck::cast(z)), code);
+                (a, b) = (b, x);
+                row[p] = f32x8::new(dequantize_lanes(x, step).0);
+                bit = _mm256_add_epi32(bit, width);
+            }
+            (x0[p], x1[p]) = (i32x8::new(a.0), i32x8::new(b.0));
+        }
+    }
 }
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
