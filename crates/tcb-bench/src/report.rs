@@ -430,7 +430,12 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
         out,
         "kernels: {}",
         match tcb_runtime::simd() {
-            tcb_runtime::Simd::Avx2 => "the group kernels' AVX2 instance, chosen at run time",
+            tcb_runtime::Simd::Avx2 if cfg!(target_feature = "avx2") => {
+                "the build's (AVX2) group kernels, the decoder's AVX2 instance"
+            }
+            tcb_runtime::Simd::Avx2 => {
+                "the AVX2 instance of the group kernels and the decoder, chosen at run time"
+            }
             tcb_runtime::Simd::Baseline => "the build's own instructions",
         }
     );

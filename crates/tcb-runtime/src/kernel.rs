@@ -25,7 +25,7 @@ pub(crate) fn splat4(r: [f32; 4]) -> [f32x8; 4] {
 #[inline]
 pub(crate) fn vectors(c: Segment, h: [f32; 4], out: &mut [f32x8]) {
     #[cfg(target_arch = "x86_64")]
-    if crate::isa::avx2() {
+    if crate::isa::avx2_kernels() {
         return v3::vectors_here(c, h, out);
     }
     let h = &splat4(h);
@@ -70,7 +70,7 @@ pub(crate) fn hermite_quats(
     mut vel: Option<&mut [f32x8]>,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if vel.is_none() && crate::isa::avx2() {
+    if vel.is_none() && crate::isa::avx2_kernels() {
         if !v3::quats_here(c, rows, out) {
             rescale_quats(c, rows, rows_d, rate_s, out, vel);
         }
@@ -339,7 +339,7 @@ mod v3 {
     /// [`vectors`], where `crate::isa::avx2` said so.
     #[inline(always)]
     pub(super) fn vectors_here(c: Segment, h: [f32; 4], out: &mut [f32x8]) {
-        debug_assert!(crate::isa::avx2());
+        debug_assert!(crate::isa::avx2_kernels());
         // SAFETY: `crate::isa::avx2` detected AVX2 and FMA on this CPU
         // before the caller came here.
         #[allow(unsafe_code)]
@@ -351,7 +351,7 @@ mod v3 {
     /// [`quats`], where `crate::isa::avx2` said so.
     #[inline(always)]
     pub(super) fn quats_here(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
-        debug_assert!(crate::isa::avx2());
+        debug_assert!(crate::isa::avx2_kernels());
         // SAFETY: as in `vectors_here`.
         #[allow(unsafe_code)]
         unsafe {

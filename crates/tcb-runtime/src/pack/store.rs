@@ -538,8 +538,10 @@ mod v3 {
     use wide::{f32x8, i32x8};
 
     impl Plane for W8 {
-        // As AVX vectors: a loop of them is not vectorized again across
-        // its iterations (LLVM's loop vectorizer would, on arrays).
+        // Through AVX vectors: a loop of these is not vectorized again
+        // across its iterations (LLVM's loop vectorizer does, on arrays,
+        // with a gather per operand). The group kernels' loads are better
+        // as arrays (`kernel::v3`: fewer instructions on every scenario).
         #[inline(always)]
         fn load(x: &f32x8) -> Self {
             let v: __m256 = bytemuck::cast(*x);
