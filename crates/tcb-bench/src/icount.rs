@@ -144,8 +144,15 @@ pub struct Counts {
 
 /// Count scenario `name` by running `exe --icount-pass NAME --bvh BVH`
 /// under callgrind, or with `clip` the pass over that file
-/// (`--icount-pass NAME --clip FILE`, as `--clip` times it).
-pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<Counts, String> {
+/// (`--icount-pass NAME --clip FILE`, as `--clip` times it); the AVX2
+/// instance with `avx2` (`--icount-avx2`), else the baseline.
+pub fn count(
+    exe: &Path,
+    name: &str,
+    bvh: &Path,
+    clip: Option<&Path>,
+    avx2: bool,
+) -> Result<Counts, String> {
     let toggle = format!("--toggle-collect={}", toggle(name));
     let out = std::env::temp_dir().join(format!(
         "tcb-icount-{}-{name}.callgrind",
@@ -159,6 +166,7 @@ pub fn count(exe: &Path, name: &str, bvh: &Path, clip: Option<&Path>) -> Result<
         .arg(exe)
         .args(["--icount-pass", name, "--bvh"])
         .arg(bvh)
+        .args(avx2.then_some("--icount-avx2"))
         .args(
             clip.map(|c| [std::ffi::OsStr::new("--clip"), c.as_os_str()])
                 .into_iter()

@@ -92,9 +92,12 @@ struct Args {
     /// Run one scenario's pass and exit (what --icount runs under valgrind).
     #[arg(long, value_name = "NAME", hide = true)]
     icount_pass: Option<String>,
-    /// With --icount-pass: run the AVX2 kernels where the CPU has them,
-    /// instead of the baseline every count uses (to count them by hand).
-    #[arg(long, hide = true, requires = "icount_pass")]
+    /// With --icount: count the AVX2 instance of the kernels and the
+    /// decoder (`tcb_runtime::simd`) instead of the baseline the gate's
+    /// counts use everywhere; on a CPU without AVX2, say so and count
+    /// nothing (exit 0). Its counts go in a file of their own
+    /// (benches/icount-avx2.json)
+    #[arg(long)]
     icount_avx2: bool,
 }
 
@@ -151,6 +154,12 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     if args.icount_max_growth.is_nan() || args.icount_max_growth < 0.0 {
         return Err("--icount-max-growth must be a number >= 0".into());
     }
+    if args.icount_avx2 && tcb_runtime::simd() != tcb_runtime::Simd::Avx2 {
+        println!(
+            "tcb-bench --icount --icount-avx2: skipped, this CPU (or build) runs no AVX2 instance"
+        );
+        return Ok(true);
+    }
     let saved = read_json(args.icount_check.as_deref())?;
     let scratch = std::env::temp_dir().join(format!("tcb-icount-{}", std::process::id()));
     let jobs = icount_jobs(args, &scratch)?;
@@ -160,7 +169,7 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     println!("flags: {}", report::flags());
     for (name, clip) in &jobs {
         let name = name.as_str();
-        let c = icount::count(&exe, name, &args.bvh, clip.as_deref())?;
+        let c = icount::count(&exe, name, &args.bvh, clip.as_deref(), args.icount_avx2)?;
         println!(
             "  {name:<18} {:>12} instructions  {:>9} L1 misses  {:>7} LL misses  {:>9} bytes",
             c.instructions, c.l1_misses, c.ll_misses, c.bytes
@@ -170,9 +179,20 @@ fn run_icount(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
     let _ = std::fs::remove_dir_all(&scratch);
     if let Some(path) = &args.icount_save {
         let note = format!(
-            "tcb-bench --icount ({}, {}); regenerate with: cargo run --release -p tcb-bench -- --icount --icount-save {}",
+            "tcb-bench --icount ({}, {}{}); regenerate with: cargo run --release -p tcb-bench -- --icount{} --icount-save {}",
             report::flags(),
             env!("TCB_BENCH_RUSTC"),
+            if args.icount_avx2 {
+                ", the AVX2 instance"
+            } else {
+                ""
+            },
+            match (&args.only, args.icount_avx2) {
+                (Some(only), true) => format!(" --icount-avx2 --only {only}"),
+                (Some(only), false) => format!(" --only {only}"),
+                (None, true) => " --icount-avx2".into(),
+                (None, false) => String::new(),
+            },
             path.display()
         );
         tcb_io::write_atomically(path, icount::to_json(&counts, &note).as_bytes())?;
