@@ -1070,23 +1070,22 @@ fn put_header(w: &mut BitWriter, order: u32, width: u32, before: u32) {
 }
 
 /// [`put_header`]'s entry at bit `pos` of `words`: `(order, width, bits read)`.
+///
+/// Without a branch on the code (a jump on it mispredicted about every
+/// other lane, 6,516 of 12,040 in valgrind's model on the CMU clip): each
+/// of the four codes of the two bits after the order picks its width and
+/// length from a table.
 #[inline(always)]
 pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, usize) {
     let v = window(words, pos);
     let order = 2 - (v & 1) as u32;
-    match (v >> 1) & 3 {
-        0 | 2 => (order, before, 2),
-        1 => {
-            let down = (v >> 3) & 1 == 1;
-            let width = if down {
-                before.wrapping_sub(1)
-            } else {
-                before + 1
-            };
-            (order, width, 4)
-        }
-        _ => (order, ((v >> 3) & 31) as u32, 3 + WIDTH_BITS as usize),
-    }
+    let code = ((v >> 1) & 3) as usize;
+    let rest = (v >> 3) as u32;
+    // `10s`: one more (s = 0) or one less; `11wwwww`: any.
+    let step = before.wrapping_add(1).wrapping_sub(2 * (rest & 1));
+    let width = [before, step, before, rest & 31][code];
+    let used = [2, 4, 2, 3 + WIDTH_BITS as usize][code];
+    (order, width, used)
 }
 
 impl Packed {
