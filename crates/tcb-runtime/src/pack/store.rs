@@ -430,7 +430,15 @@ impl PackCache {
         let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
         #[cfg(target_arch = "x86_64")]
         if gather {
-            v3::predict_gathered_here(g, &self.coding, &mut self.x0, &mut self.x1, rows);
+            // SAFETY: `gather` holds only where AVX2 runs, and every lane's
+            // residuals end before `last` (each is at most `widest` bits a
+            // key, `keys - first` keys, after `pos` before the loop above;
+            // lanes without headers start at bit 0 with width 0), which is
+            // 32 bits before the stream's end and below i32::MAX.
+            #[allow(unsafe_code)]
+            unsafe {
+                v3::predict_gathered_here(g, &self.coding, &mut self.x0, &mut self.x1, rows);
+            }
         }
         if !gather {
             for &p in &g.stored_planes {
@@ -604,11 +612,17 @@ mod v3 {
 
     /// The prediction and dequantization of the rows `rows` (keys
     /// `first..keys` of the segment, `planes` vectors each), the residuals
-    /// gathered from the stream at the bits `coding[p].start`: the caller
-    /// checked that every lane's width is at most `GATHER_WIDTH` and that
-    /// the segment ends 32 bits before the stream does.
+    /// gathered from the stream at the bits `coding[p].start`.
+    ///
+    /// # Safety
+    ///
+    /// `crate::isa::avx2()` is true, and for every stored plane `p` and
+    /// lane `l`, `coding[p].start[l] + coding[p].width[l] * (rows.len() /
+    /// planes)` is at most `64 * g.packed.stream.len() - 32` and below
+    /// `i32::MAX` (each gather reads 4 bytes from the byte of a lane's bit).
     #[inline(always)]
-    pub(super) fn predict_gathered_here(
+    #[allow(unsafe_code)]
+    pub(super) unsafe fn predict_gathered_here(
         g: &PackedKeys,
         coding: &[PlaneCoding],
         x0: &mut [i32x8],
@@ -616,10 +630,8 @@ mod v3 {
         rows: &mut [f32x8],
     ) {
         debug_assert!(crate::isa::avx2());
-        #[allow(unsafe_code)]
-        unsafe {
-            predict_gathered(g, coding, x0, x1, rows)
-        }
+        // SAFETY: the caller's (above).
+        unsafe { predict_gathered(g, coding, x0, x1, rows) }
     }
 
     #[inline(always)]
@@ -648,9 +660,9 @@ mod v3 {
             let mask = _mm256_sub_epi32(_mm256_sllv_epi32(one, width), one);
             let mut bit = m(c.start);
             for row in rows.chunks_exact_mut(np) {
-                // SAFETY: every lane's bit is below the segment's last,
-                // which lies 32 bits before the end of `bytes` (the
-                // caller's check), so each 4-byte read is inside it.
+                // SAFETY: every lane's bit is below the bound of
+                // `predict_gathered_here`'s contract, 32 bits before the
+                // end of `bytes`, so each 4-byte read is inside it.
                 #[allow(unsafe_code)]
                 let word = unsafe {
                     _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
