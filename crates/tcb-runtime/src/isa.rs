@@ -7,8 +7,8 @@
 //! formulas, the same IEEE operations per lane in the same order, so the
 //! same bits (`tests/isa.rs` compares the two on every scenario shape).
 //! Builds with `-C target-cpu=x86-64-v3` or `native` have `wide` in AVX2
-//! already: their group kernels stay `wide`'s (11% fewer instructions on
-//! `character-hermite` than the `W8` instance in such a build), and their
+//! already: their group kernels stay `wide`'s (the `W8` instance took 11%
+//! more instructions on `character-hermite` in such a build), and their
 //! decoder runs the AVX2 instance, which gathers each key's residuals from
 //! the stream where the baseline unpacks them lane by lane.
 //!
