@@ -104,17 +104,7 @@ fn the_avx2_kernels_give_the_baselines_bits() {
 /// residuals are 27 bits wide (too wide for the gather: that segment
 /// unpacks as the baseline does), forward, backward and with seeks.
 fn packed_clips_decode_to_the_same_bits() {
-    let bvh = include_str!("../../../data/cmu-01_01.bvh");
-    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
-    let clip = bvh
-        .to_clip_doc("cmu", RotationMode::Hermite)
-        .unwrap()
-        .build()
-        .unwrap();
-    let steps: Vec<f32> = (0..clip.tracks().len())
-        .map(|i| if i == 0 { 1.0 / 256.0 } else { 1.0 / 16384.0 })
-        .collect();
-    let mut source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();
+    let (clip, mut source) = common::quantized_cmu();
     let (t0, t1) = clip.time_range().unwrap();
     let mut times: Vec<f64> = (0..)
         .map(|f| t0 + f as f64 / 60.0)

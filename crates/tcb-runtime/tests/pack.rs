@@ -5,29 +5,10 @@ use std::sync::Arc;
 use tcb_core::RotationMode;
 use tcb_runtime::{Clip, Instance, PackSource, Packed};
 
-/// The bundled CMU capture (hermite), quantized with steps of 2^-14
-/// (rotations) and 2^-8 (the root translation, in the clip's units).
+mod common;
+
 fn cmu() -> (tcb_core::SourceClip, PackSource) {
-    let bvh = include_str!("../../../data/cmu-01_01.bvh");
-    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
-    let clip = bvh
-        .to_clip_doc("cmu", RotationMode::Hermite)
-        .unwrap()
-        .build()
-        .unwrap();
-    let steps: Vec<f32> = clip
-        .tracks()
-        .iter()
-        .map(|t| {
-            if t.name.ends_with("translation") {
-                1.0 / 256.0
-            } else {
-                1.0 / 16384.0
-            }
-        })
-        .collect();
-    let source = PackSource::quantize(&clip, &steps).unwrap();
-    (clip, source)
+    common::quantized_cmu()
 }
 
 fn rows(inst: &mut Instance, t: f64, n: usize) -> Vec<f32> {

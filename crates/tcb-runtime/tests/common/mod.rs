@@ -1,4 +1,6 @@
-//! Clips more than one of tcb-runtime's test files build.
+//! Clips more than one of tcb-runtime's test files build (each file uses
+//! some of them).
+#![allow(dead_code)]
 
 use glam::Quat;
 use tcb_core::{KeyParams, NamedTrack, RotationMode, RotationTrack, TrackData, TrackSettings};
@@ -36,4 +38,29 @@ pub fn huge_tangent_rotations(tracks: usize, at: usize) -> tcb_core::SourceClip 
         })
         .collect();
     tcb_core::SourceClip::new("huge", named).expect("unique track names")
+}
+
+/// The bundled CMU capture (hermite), and it quantized with steps of 2^-14
+/// (rotations) and 2^-8 (the root translation, in the clip's units).
+pub fn quantized_cmu() -> (tcb_core::SourceClip, tcb_runtime::PackSource) {
+    let bvh = include_str!("../../../../data/cmu-01_01.bvh");
+    let bvh = tcb_io::bvh::Bvh::parse(bvh).unwrap();
+    let clip = bvh
+        .to_clip_doc("cmu", RotationMode::Hermite)
+        .unwrap()
+        .build()
+        .unwrap();
+    let steps: Vec<f32> = clip
+        .tracks()
+        .iter()
+        .map(|t| {
+            if t.name.ends_with("translation") {
+                1.0 / 256.0
+            } else {
+                1.0 / 16384.0
+            }
+        })
+        .collect();
+    let source = tcb_runtime::PackSource::quantize(&clip, &steps).unwrap();
+    (clip, source)
 }
