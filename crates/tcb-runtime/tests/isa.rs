@@ -124,16 +124,34 @@ fn packed_clips_decode_to_the_same_bits() {
                 };
             }
         }
-        let packed = Arc::new(tcb_runtime::Packed::encode(&source).unwrap());
-        let clip = Arc::new(Clip::from_packed(packed).unwrap());
-        tcb_runtime::force_baseline_simd(false);
-        let avx2 = compiled_rows(clip.clone(), &times);
-        tcb_runtime::force_baseline_simd(true);
-        let base = compiled_rows(clip, &times);
-        compare(
+        packed_same_bits(
             &format!("packed cmu (wide residuals: {wide})"),
-            &avx2,
-            &base,
+            &source,
+            &times,
         );
     }
+    // A last block of one key (2 blocks of 64 and key 128): its start
+    // value without the delta after it.
+    let (_, mut short) = common::quantized_cmu();
+    short.keys = 129;
+    for t in &mut short.tracks {
+        t.values.iter_mut().for_each(|v| v.truncate(short.keys));
+    }
+    // Every key and half-way, past the end, then backwards.
+    let mut times: Vec<f64> = (0..=260)
+        .map(|f| short.start + f as f64 * 0.5 * short.interval)
+        .collect();
+    times.extend(times.clone().into_iter().rev());
+    packed_same_bits("packed cmu, 129 keys", &short, &times);
+}
+
+/// Both decoder instances on `source`, packed, at `times`.
+fn packed_same_bits(name: &str, source: &tcb_runtime::PackSource, times: &[f64]) {
+    let packed = Arc::new(tcb_runtime::Packed::encode(source).unwrap());
+    let clip = Arc::new(Clip::from_packed(packed).unwrap());
+    tcb_runtime::force_baseline_simd(false);
+    let avx2 = compiled_rows(clip.clone(), times);
+    tcb_runtime::force_baseline_simd(true);
+    let base = compiled_rows(clip, times);
+    compare(name, &avx2, &base);
 }

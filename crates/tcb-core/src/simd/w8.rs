@@ -18,7 +18,7 @@
 //! generic function, which has none, so each element becomes a call.
 use crate::simd::basis::Real;
 use crate::simd::lane::{Lane, Mask};
-use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
 
 /// Eight `f32` lanes (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +37,13 @@ pub struct M8(pub [u32; 8]);
 pub struct I8(pub [i32; 8]);
 
 impl I8 {
+    /// Each lane shifted right by `N` bits as an unsigned integer (zeros
+    /// in from the left).
+    #[inline(always)]
+    pub fn shr_logical<const N: u32>(self) -> I8 {
+        I8(self.0.map(|x| ((x as u32) >> N) as i32))
+    }
+
     /// Each lane as the nearest `f32` (`x as f32`, as
     /// `wide::i32x8::round_float`).
     #[inline(always)]
@@ -91,6 +98,7 @@ impl Neg for W8 {
 elementwise!(I8, Add, add, .wrapping_add);
 elementwise!(I8, Sub, sub, .wrapping_sub);
 elementwise!(I8, BitAnd, bitand, &);
+elementwise!(I8, BitXor, bitxor, ^);
 elementwise!(M8, BitAnd, bitand, &);
 elementwise!(M8, BitOr, bitor, |);
 impl Not for M8 {

@@ -12,7 +12,7 @@
 use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
 use crate::grid::{KeyTimes, TimeGrid};
-use crate::pack::store::PackedKeys;
+use crate::pack::store::{GATHER_WIDTH, PackedKeys};
 use crate::pack::{PackError, Packed, err, key_weights};
 use std::sync::Arc;
 use tcb_core::TrackKind;
@@ -284,6 +284,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         .filter(|(_, base)| **base != crate::pack::FLAT)
         .map(|(slot, base)| (*slot, u32::from(*base)))
         .unzip();
+    let (start_gather, start_bits) = start_gather(packed, &lane_slot, np);
     let mut stored_planes: Vec<u32> = lane_slot.iter().map(|at| at / 8).collect();
     stored_planes.sort_unstable();
     stored_planes.dedup();
@@ -308,5 +309,30 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
             .filter_map(|(b, c)| c.map(|planes| (b, planes.map(f32x8::new))))
             .collect(),
         table,
+        start_gather,
+        start_bits,
     }
+}
+
+/// [`PackedKeys::start_gather`] and [`PackedKeys::start_bits`]: a
+/// block's start values (in the stream's lane order), then its deltas.
+fn start_gather(packed: &Packed, lane_slot: &[u32], np: usize) -> (Vec<[[i32; 8]; 4]>, usize) {
+    let widths = |b: &[u8]| b.iter().map(|&w| usize::from(w)).collect::<Vec<_>>();
+    let (abs, delta) = (widths(&packed.abs_bits), widths(&packed.delta_bits));
+    let mut at = [0, abs.iter().sum::<usize>()];
+    let mut planes = vec![[[0i32; 8]; 4]; np];
+    let mut fits = at[1] + delta.iter().sum::<usize>() < i32::MAX as usize;
+    for ((&slot, &wa), &wd) in lane_slot.iter().zip(&abs).zip(&delta) {
+        let (p, l) = (slot as usize / 8, slot as usize % 8);
+        for (j, w) in [wa, wd].into_iter().enumerate() {
+            fits &= w <= GATHER_WIDTH as usize;
+            planes[p][2 * j][l] = at[j] as i32;
+            planes[p][2 * j + 1][l] = w as i32;
+            at[j] += w;
+        }
+    }
+    if !fits {
+        planes.clear();
+    }
+    (planes, at[1])
 }

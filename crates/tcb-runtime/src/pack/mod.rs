@@ -864,7 +864,45 @@ fn zigzag(x: i32) -> u32 {
 
 #[inline(always)]
 pub(crate) fn unzigzag(z: u32) -> i32 {
-    ((z >> 1) as i32) ^ -((z & 1) as i32)
+    unzigzag_lanes(z as i32)
+}
+
+/// [`zigzag`] undone in each lane of `z` (the code's bits as `i32`).
+#[inline(always)]
+pub(crate) fn unzigzag_lanes<I: ZigZagLanes>(z: I) -> I {
+    z.half() ^ (I::ZERO - (z & I::ONE))
+}
+
+/// Integer lanes [`unzigzag_lanes`] runs on: `i32` and the AVX2
+/// instance's `I8`.
+pub(crate) trait ZigZagLanes:
+    Copy
+    + std::ops::BitAnd<Output = Self>
+    + std::ops::BitXor<Output = Self>
+    + std::ops::Sub<Output = Self>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    /// Each lane shifted right by one bit, as unsigned.
+    fn half(self) -> Self;
+}
+
+impl ZigZagLanes for i32 {
+    const ZERO: i32 = 0;
+    const ONE: i32 = 1;
+    #[inline(always)]
+    fn half(self) -> i32 {
+        ((self as u32) >> 1) as i32
+    }
+}
+
+impl ZigZagLanes for tcb_core::simd::w8::I8 {
+    const ZERO: Self = tcb_core::simd::w8::I8([0; 8]);
+    const ONE: Self = tcb_core::simd::w8::I8([1; 8]);
+    #[inline(always)]
+    fn half(self) -> Self {
+        self.shr_logical::<1>()
+    }
 }
 
 /// Bits written least significant first.
@@ -1072,20 +1110,25 @@ fn put_header(w: &mut BitWriter, order: u32, width: u32, before: u32) {
 /// [`put_header`]'s entry at bit `pos` of `words`: `(order, width, bits read)`.
 ///
 /// Without a branch on the code (a jump on it mispredicted about every
-/// other lane, 6,516 of 12,040 in valgrind's model on the CMU clip): each
-/// of the four codes of the two bits after the order picks its width and
-/// length from a table.
+/// other lane, 6,516 of 12,040 in valgrind's model on the CMU clip), and
+/// without a table in memory: the four codes of the two bits after the
+/// order pick their length from the bytes of one constant and their width
+/// by selects.
 #[inline(always)]
 pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, usize) {
     let v = window(words, pos);
     let order = 2 - (v & 1) as u32;
-    let code = ((v >> 1) & 3) as usize;
+    let code = ((v >> 1) & 3) as u32;
     let rest = (v >> 3) as u32;
-    // `10s`: one more (s = 0) or one less; `11wwwww`: any.
+    // `0`: the same; `10s`: one more (s = 0) or one less; `11wwwww`: any.
     let step = before.wrapping_add(1).wrapping_sub(2 * (rest & 1));
-    let width = [before, step, before, rest & 31][code];
-    let used = [2, 4, 2, 3 + WIDTH_BITS as usize][code];
-    (order, width, used)
+    // Selects (cmov), not a `match`: LLVM turns that into jumps.
+    let width = std::hint::select_unpredictable(code == 3, rest & 31, before);
+    let width = std::hint::select_unpredictable(code == 1, step, width);
+    // Lengths with the order bit: 2, 4, 2 and 3 + WIDTH_BITS.
+    const USED: u32 = u32::from_le_bytes([2, 4, 2, 3 + WIDTH_BITS as u8]);
+    let used = (USED >> (8 * code)) & 0xff;
+    (order, width, used as usize)
 }
 
 impl Packed {

@@ -72,6 +72,14 @@ pub(crate) struct PackedKeys {
     /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
     /// (`n ..= n+3`), `planes` vectors each.
     pub table: Vec<f32x8>,
+    /// Per plane, where the AVX2 instance gathers a block's first two keys
+    /// from: each lane's bit after the block's headers and its width, for
+    /// the start value, then for the delta (0 and 0 in lanes not stored).
+    /// Empty where a width is above [`GATHER_WIDTH`] (the baseline's reads
+    /// run then).
+    pub start_gather: Vec<[[i32; 8]; 4]>,
+    /// The bits of a block's start values and deltas.
+    pub start_bits: usize,
 }
 
 impl PackedKeys {
@@ -87,6 +95,7 @@ impl PackedKeys {
         self.packed.stream_bytes()
             + 4 * self.lane_slot.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
+            + 128 * self.start_gather.len()
             + 8 * self.rebuild.len()
             + std::mem::size_of::<(usize, [f32x8; 4])>() * self.center.len()
     }
@@ -129,7 +138,7 @@ impl PackedKeys {
         let (m0, m1) = m.split_at_mut(np);
         if a > 0 && b < n - 1 {
             // Both (all but the end segments): the chord P_b - P_a once.
-            let keys = [a - 1, a, b, b + 1].map(|k| c.ring(k, np));
+            let keys = c.ring4(a - 1, np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
                 v3::interior_tangents_here(keys, &self.weights, m0, m1);
@@ -330,6 +339,16 @@ impl PackCache {
         &self.rows[at..at + np]
     }
 
+    /// Rows of keys `k ..= k + 3` (decoded, as [`ring`](Self::ring)'s).
+    #[inline(always)]
+    fn ring4(&self, k: usize, np: usize) -> [&[f32x8]; 4] {
+        let at = (k + BEFORE - SEGMENT_KEYS * self.cur) * np;
+        let (v, rest) = self.rows[at..at + 4 * np].split_at(np);
+        let (x, rest) = rest.split_at(np);
+        let (y, z) = rest.split_at(np);
+        [v, x, y, z]
+    }
+
     /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
     /// `lo`'s at most) have rows: on from the segment decoded last, or
     /// from the start of `lo`'s block.
@@ -378,7 +397,12 @@ impl PackCache {
             // A block's first headers code against the lanes' base widths.
             self.widths.copy_from_slice(&g.headed_base);
         }
-        let mut widest = 0;
+        let keys = (s + SEGMENT_KEYS).min(n) - s;
+        // A block's first two keys come from its start values and deltas.
+        let first = if block { 2.min(keys) } else { 0 };
+        // Per lane: its coding, and the bit of its first residual after
+        // the residuals' start (for the AVX2 instance's gather).
+        let (mut widest, mut off) = (0, 0);
         for (w, &slot) in self.widths.iter_mut().zip(&g.headed) {
             let (order, width, used) = read_header(words, pos, *w);
             pos += used;
@@ -387,43 +411,37 @@ impl PackCache {
             // One bounds check for the plane; the lane is below 8.
             let c = &mut self.coding[slot as usize / 8];
             let lane = slot as usize % 8;
-            c.trend[lane] = if order == 2 { -1 } else { 0 };
-            c.live[lane] = if width > 0 { -1 } else { 0 };
+            c.trend[lane] = -i32::from(order == 2);
+            c.live[lane] = -i32::from(width > 0);
             c.bias[lane] = super::bias(width);
             c.width[lane] = width as i32;
+            c.start[lane] = off as i32;
+            off += width as usize * (keys - first);
         }
-        let keys = (s + SEGMENT_KEYS).min(n) - s;
-        let first = if block {
-            self.block_start(g, &mut pos, keys)
-        } else {
-            0
-        };
+        if block {
+            let written = self.block_start(g, &mut pos, keys);
+            debug_assert_eq!(written, first);
+        }
         // The AVX2 instance reads each key's residuals of a plane straight
         // from the stream (a gather of 32 bits from each lane's byte), where
         // every width has room in them and the segment's last bit lies 32
         // bits before the stream's end.
-        let last = pos + widest as usize * (keys - first) * g.headed.len();
+        let last = pos + off;
         let gather = crate::isa::avx2()
             && widest <= GATHER_WIDTH
             && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
-        // Residuals: a gather's first bit of each lane, or 16 of each lane
-        // of a width above 0 (those past the segment's keys land in spare
-        // rows, or in rows no key reads) into the rows as i32; `live` masks
-        // the rest.
-        let stride = 8 * np;
-        let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
-        let base = (BEFORE + first) * stride;
-        let lanes = self.widths.iter().zip(&g.headed);
-        if gather {
-            for (&w, &slot) in lanes {
-                self.coding[slot as usize / 8].start[slot as usize % 8] = pos as i32;
-                pos += w as usize * (keys - first);
-            }
-        } else {
-            for (&w, &slot) in lanes {
+        if !gather {
+            // Residuals: 16 of each lane of a width above 0 (those past
+            // the segment's keys land in spare rows, or in rows no key
+            // reads) into the rows as i32; `live` masks the rest.
+            let stride = 8 * np;
+            let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
+            let base = (BEFORE + first) * stride;
+            let mut at = pos;
+            for (&w, &slot) in self.widths.iter().zip(&g.headed) {
                 if w > 0 {
-                    UNPACK[w as usize](words, pos, &mut rows[base + slot as usize..], stride);
-                    pos += w as usize * (keys - first);
+                    UNPACK[w as usize](words, at, &mut rows[base + slot as usize..], stride);
+                    at += w as usize * (keys - first);
                 }
             }
         }
@@ -431,13 +449,14 @@ impl PackCache {
         #[cfg(target_arch = "x86_64")]
         if gather {
             // SAFETY: `gather` holds only where AVX2 runs, and every lane's
-            // residuals end before `last` (each is at most `widest` bits a
-            // key, `keys - first` keys, after `pos` before the loop above;
-            // lanes without headers start at bit 0 with width 0), which is
+            // residuals end at or before `last` (each lane's start is the
+            // sum of the lanes' before it, `width * (keys - first)` bits
+            // each, after `pos`, and `last` is `pos` plus the sum over all;
+            // lanes without headers start at `pos` with width 0), which is
             // 32 bits before the stream's end and below i32::MAX.
             #[allow(unsafe_code)]
             unsafe {
-                v3::predict_gathered_here(g, &self.coding, &mut self.x0, &mut self.x1, rows);
+                v3::predict_gathered_here(g, &self.coding, pos, &mut self.x0, &mut self.x1, rows);
             }
         }
         if !gather {
@@ -457,7 +476,7 @@ impl PackCache {
             }
         }
         self.rebuild(g, first..keys);
-        self.pos = pos;
+        self.pos = last;
     }
 
     /// A block's first two keys (its start values, then the deltas) into
@@ -466,6 +485,25 @@ impl PackCache {
     fn block_start(&mut self, g: &PackedKeys, pos: &mut usize, keys: usize) -> usize {
         let np = g.planes;
         let words: &[u64] = &g.packed.stream;
+        let first = 2.min(keys);
+        #[cfg(target_arch = "x86_64")]
+        if crate::isa::avx2()
+            && !g.start_gather.is_empty()
+            && *pos + g.start_bits + 32 <= (64 * words.len()).min(i32::MAX as usize)
+        {
+            let rows = &mut self.rows[BEFORE * np..(BEFORE + first) * np];
+            // SAFETY: AVX2 runs, and every lane's start value and delta end
+            // at or before `pos + start_bits` (`start_gather`'s bits are
+            // sums of the widths before them), which is 32 bits before the
+            // stream's end and below i32::MAX.
+            #[allow(unsafe_code)]
+            unsafe {
+                v3::block_start_gathered_here(g, *pos, &mut self.x0, &mut self.x1, rows);
+            }
+            *pos += g.start_bits;
+            self.rebuild(g, 0..first);
+            return first;
+        }
         for (j, bits) in [&g.packed.abs_bits, &g.packed.delta_bits]
             .into_iter()
             .enumerate()
@@ -488,7 +526,6 @@ impl PackCache {
                 *out = super::dequantize_lanes(x, *step);
             }
         }
-        let first = 2.min(keys);
         self.rebuild(g, 0..first);
         first
     }
@@ -525,7 +562,7 @@ struct PlaneCoding {
 }
 
 /// The widest residual a gather of 32 bits from its first byte holds.
-const GATHER_WIDTH: u32 = 25;
+pub(crate) const GATHER_WIDTH: u32 = 25;
 
 /// The AVX2 + FMA instance of the decoder (see `crate::isa`): the same
 /// formulas ([`predict`], `dequantize_lanes`, [`rebuild_rows`],
@@ -533,10 +570,10 @@ const GATHER_WIDTH: u32 = 25;
 /// key's residuals of a plane gathered straight from the stream.
 #[cfg(target_arch = "x86_64")]
 mod v3 {
-    use crate::pack::dequantize_lanes;
     use crate::pack::store::{
         PackedKeys, Plane, PlaneCoding, interior_tangents, predict, rebuild_rows,
     };
+    use crate::pack::{dequantize_lanes, unzigzag_lanes};
     use std::arch::x86_64::{
         __m256, __m256i, _mm256_add_epi32, _mm256_and_si256, _mm256_i32gather_epi32,
         _mm256_set1_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
@@ -612,26 +649,28 @@ mod v3 {
 
     /// The prediction and dequantization of the rows `rows` (keys
     /// `first..keys` of the segment, `planes` vectors each), the residuals
-    /// gathered from the stream at the bits `coding[p].start`.
+    /// gathered from the stream at the bits `base + coding[p].start`.
     ///
     /// # Safety
     ///
     /// `crate::isa::avx2()` is true, and for every stored plane `p` and
-    /// lane `l`, `coding[p].start[l] + coding[p].width[l] * (rows.len() /
-    /// planes)` is at most `64 * g.packed.stream.len() - 32` and below
-    /// `i32::MAX` (each gather reads 4 bytes from the byte of a lane's bit).
+    /// lane `l`, `base + coding[p].start[l] + coding[p].width[l] *
+    /// (rows.len() / planes)` is at most `64 * g.packed.stream.len() - 32`
+    /// and below `i32::MAX` (each gather reads 4 bytes from the byte of a
+    /// lane's bit).
     #[inline(always)]
     #[allow(unsafe_code)]
     pub(super) unsafe fn predict_gathered_here(
         g: &PackedKeys,
         coding: &[PlaneCoding],
+        base: usize,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
     ) {
         debug_assert!(crate::isa::avx2());
         // SAFETY: the caller's (above).
-        unsafe { predict_gathered(g, coding, x0, x1, rows) }
+        unsafe { predict_gathered(g, coding, base as i32, x0, x1, rows) }
     }
 
     #[inline(always)]
@@ -639,17 +678,108 @@ mod v3 {
         bytemuck::cast(x)
     }
 
+    /// The low `width` bits of each lane (`width` at most 31).
+    #[inline]
     #[target_feature(enable = "avx2,fma")]
-    fn predict_gathered(
+    fn low_bits(width: __m256i) -> __m256i {
+        let one = _mm256_set1_epi32(1);
+        _mm256_sub_epi32(_mm256_sllv_epi32(one, width), one)
+    }
+
+    /// The bits `mask` at each lane's bit `bit` of `bytes` (bit `p` is bit
+    /// `p % 8` of byte `p / 8`): 32 bits gathered from the lane's byte,
+    /// shifted by the rest.
+    ///
+    /// # Safety
+    ///
+    /// Each lane's `bit` is at least 0 and `bit / 8 + 4` at most
+    /// `bytes.len()`.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(unsafe_code)]
+    unsafe fn bits_at(bytes: &[u8], bit: __m256i, mask: __m256i) -> __m256i {
+        // SAFETY: the caller's: each 4-byte read is inside `bytes`.
+        #[allow(unsafe_code)]
+        let word = unsafe {
+            _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
+        };
+        let seven = _mm256_set1_epi32(7);
+        _mm256_and_si256(_mm256_srlv_epi32(word, _mm256_and_si256(bit, seven)), mask)
+    }
+
+    /// A block's first keys into `rows` (its first, and its second where
+    /// `rows` has two) and the predictor: each plane's start values and
+    /// deltas gathered from the bits `base + g.start_gather[p]`, as the
+    /// baseline's `block_start` reads them one lane at a time.
+    ///
+    /// # Safety
+    ///
+    /// `crate::isa::avx2()` is true, `g.start_gather` is not empty, and
+    /// `base + g.start_bits + 32` is at most `64 * g.packed.stream.len()`
+    /// and below `i32::MAX`.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(super) unsafe fn block_start_gathered_here(
         g: &PackedKeys,
-        coding: &[PlaneCoding],
+        base: usize,
+        x0: &mut [i32x8],
+        x1: &mut [i32x8],
+        rows: &mut [f32x8],
+    ) {
+        debug_assert!(crate::isa::avx2() && !g.start_gather.is_empty());
+        // SAFETY: the caller's (above).
+        unsafe { block_start_gathered(g, base as i32, x0, x1, rows) }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn block_start_gathered(
+        g: &PackedKeys,
+        base: i32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
     ) {
         let np = g.planes;
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
-        let (one, seven) = (_mm256_set1_epi32(1), _mm256_set1_epi32(7));
+        let base = _mm256_set1_epi32(base);
+        let (row0, row1) = rows.split_at_mut(np);
+        let planes = g.start_gather.iter().zip(&g.step);
+        for (p, ([abs_at, abs_w, delta_at, delta_w], step)) in planes.enumerate() {
+            let read = |at: &[i32; 8], w: &[i32; 8]| {
+                let bit = _mm256_add_epi32(base, m(*at));
+                // SAFETY: every lane's bit ends at or before `base +
+                // start_bits`, 32 bits before the stream's end
+                // (`block_start_gathered_here`).
+                #[allow(unsafe_code)]
+                let z = unsafe { bits_at(bytes, bit, low_bits(m(*w))) };
+                unzigzag_lanes(I8(bytemuck::cast(z)))
+            };
+            let (start, delta) = (read(abs_at, abs_w), read(delta_at, delta_w));
+            let step = W8(step.to_array());
+            // Key 0: the start value; key 1: key 0 plus the delta.
+            let second = start + delta;
+            row0[p] = f32x8::new(dequantize_lanes(start, step).0);
+            if let Some(row) = row1.get_mut(p) {
+                *row = f32x8::new(dequantize_lanes(second, step).0);
+                (x0[p], x1[p]) = (i32x8::new(start.0), i32x8::new(second.0));
+            } else {
+                (x0[p], x1[p]) = (i32x8::new(start.0), i32x8::new(start.0));
+            }
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn predict_gathered(
+        g: &PackedKeys,
+        coding: &[PlaneCoding],
+        base: i32,
+        x0: &mut [i32x8],
+        x1: &mut [i32x8],
+        rows: &mut [f32x8],
+    ) {
+        let np = g.planes;
+        let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
+        let base = _mm256_set1_epi32(base);
         for &p in &g.stored_planes {
             let p = p as usize;
             let c = &coding[p];
@@ -657,18 +787,14 @@ mod v3 {
             let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
             let step = W8(g.step[p].to_array());
             let width = m(c.width);
-            let mask = _mm256_sub_epi32(_mm256_sllv_epi32(one, width), one);
-            let mut bit = m(c.start);
+            let mask = low_bits(width);
+            let mut bit = _mm256_add_epi32(base, m(c.start));
             for row in rows.chunks_exact_mut(np) {
                 // SAFETY: every lane's bit is below the bound of
                 // `predict_gathered_here`'s contract, 32 bits before the
                 // end of `bytes`, so each 4-byte read is inside it.
                 #[allow(unsafe_code)]
-                let word = unsafe {
-                    _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
-                };
-                let z =
-                    _mm256_and_si256(_mm256_srlv_epi32(word, _mm256_and_si256(bit, seven)), mask);
+                let z = unsafe { bits_at(bytes, bit, mask) };
                 let x = predict(a, b, I8(bytemuck::cast(z)), code);
                 (a, b) = (b, x);
                 row[p] = f32x8::new(dequantize_lanes(x, step).0);
