@@ -12,7 +12,9 @@
 //! the AVX2 instance runs (`crate::isa`), the first two passes are one:
 //! each key's residuals of a plane come straight from the stream, 32 bits
 //! gathered at each lane's byte, shifted and masked per lane (segments
-//! whose widths are all at most 25 bits; wider ones unpack first). Forward
+//! whose widths are all at most 25 bits; wider ones unpack first), and a
+//! block's start values and deltas are gathered a plane at a time too
+//! (`PackedKeys::start_gather`). Forward
 //! playback decodes each key once; playing backwards re-decodes from the
 //! block's start only when it leaves a segment. Interior tangents are the
 //! tangent rule on the two chords,
