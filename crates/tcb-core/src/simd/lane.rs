@@ -269,6 +269,10 @@ mod tests {
         assert_eq!((ia + ib).0, (va + vb).to_array());
         assert_eq!((ia - ib).0, (va - vb).to_array());
         assert_eq!((ia & ib).0, (va & vb).to_array());
+        assert_eq!((ia ^ ib).0, (va ^ vb).to_array());
+        let logical: wide::u32x8 = wide::u32x8::new(xs.map(|x| x as u32)) >> 1_u32;
+        let want = logical.to_array().map(|x| x as i32);
+        assert_eq!(ia.shr_logical::<1>().0, want);
         let (f, g) = (ia.to_float().0, va.round_float().to_array());
         assert_eq!(f.map(f32::to_bits), g.map(f32::to_bits));
     }
