@@ -273,6 +273,12 @@ mod tests {
         let logical: wide::u32x8 = wide::u32x8::new(xs.map(|x| x as u32)) >> 1_u32;
         let want = logical.to_array().map(|x| x as i32);
         assert_eq!(ia.shr_logical::<1>().0, want);
+        // Per-lane shifts by the low 5 bits (32 is 0, 33 is 1).
+        let ns = [0, 1, 31, 5, 32, 33, 7, 30];
+        let each = wide::u32x8::new(xs.map(|x| x as u32)) << wide::u32x8::new(ns.map(|n| n as u32));
+        let want = each.to_array().map(|x| x as i32);
+        assert_eq!(ia.shl_each(I8(ns)).0, want);
+        assert_eq!(want[2], i32::MIN, "31 shifts a 1 to the sign bit");
         let (f, g) = (ia.to_float().0, va.round_float().to_array());
         assert_eq!(f.map(f32::to_bits), g.map(f32::to_bits));
     }

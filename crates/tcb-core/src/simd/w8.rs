@@ -44,6 +44,15 @@ impl I8 {
         I8(self.0.map(|x| ((x as u32) >> N) as i32))
     }
 
+    /// Each lane shifted left by the low 5 bits of the same lane of `n`
+    /// (as `wide::u32x8`'s `<<` by a vector).
+    #[inline(always)]
+    pub fn shl_each(self, n: I8) -> I8 {
+        I8(std::array::from_fn(|i| {
+            self.0[i].wrapping_shl(n.0[i] as u32)
+        }))
+    }
+
     /// Each lane as the nearest `f32` (`x as f32`, as
     /// `wide::i32x8::round_float`).
     #[inline(always)]

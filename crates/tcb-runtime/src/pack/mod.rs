@@ -839,18 +839,25 @@ fn key_params<V: Copy>(tcb: Tcb, n: usize) -> Vec<KeyParams<V>> {
     vec![key; n]
 }
 
-/// A residual `r` of width `w` is stored as `r + bias(w)`, in
-/// `0 .. 2^w` (the range of a zigzag code of `w` bits): the decoder
-/// subtracts it 8 lanes at a time, where undoing a zigzag code takes four
-/// operations. 0 for width 0 (nothing stored).
+/// A width's coding in each lane of `w` (widths 0 to 31): the low `w`
+/// bits, which hold a residual, and what the residual is stored above,
+/// `2^(w - 1)` (0 for width 0, nothing stored). A residual `r` of width
+/// `w` is stored as `r + bias` in `0 .. 2^w` (the range of a zigzag code
+/// of `w` bits): the decoder subtracts it 8 lanes at a time, where undoing
+/// a zigzag code takes four operations. The encoder runs this on `i32`,
+/// the decoder on a plane's widths (`wide::i32x8`, or the AVX2 instance's
+/// `I8`).
 #[inline(always)]
-pub(crate) fn bias(w: u32) -> i32 {
-    if w == 0 { 0 } else { 1i32.wrapping_shl(w - 1) }
+pub(crate) fn width_lanes<I: BitLanes>(w: I) -> (I, I) {
+    let bit = I::ONE.shl_each(w);
+    (bit.sub_wrapping(I::ONE), bit.half())
 }
 
-/// The low `w` bits.
-fn mask(w: u32) -> u32 {
-    ((1u64 << w) - 1) as u32
+/// [`width_lanes`]'s `bias` of one width.
+#[inline(always)]
+pub(crate) fn bias(w: u32) -> i32 {
+    debug_assert!(w < 32);
+    width_lanes(w as i32).1
 }
 
 /// Bits a zigzag-coded value takes.
@@ -869,13 +876,13 @@ pub(crate) fn unzigzag(z: u32) -> i32 {
 
 /// [`zigzag`] undone in each lane of `z` (the code's bits as `i32`).
 #[inline(always)]
-pub(crate) fn unzigzag_lanes<I: ZigZagLanes>(z: I) -> I {
+pub(crate) fn unzigzag_lanes<I: BitLanes>(z: I) -> I {
     z.half() ^ (I::ZERO - (z & I::ONE))
 }
 
-/// Integer lanes [`unzigzag_lanes`] runs on: `i32` and the AVX2
-/// instance's `I8`.
-pub(crate) trait ZigZagLanes:
+/// Integer lanes [`unzigzag_lanes`] and [`width_lanes`] run on: `i32`,
+/// `wide::i32x8` and the AVX2 instance's `I8` (wrapping arithmetic).
+pub(crate) trait BitLanes:
     Copy
     + std::ops::BitAnd<Output = Self>
     + std::ops::BitXor<Output = Self>
@@ -885,23 +892,63 @@ pub(crate) trait ZigZagLanes:
     const ONE: Self;
     /// Each lane shifted right by one bit, as unsigned.
     fn half(self) -> Self;
+    /// Each lane shifted left by the bits in the same lane of `n` (0 to
+    /// 31).
+    fn shl_each(self, n: Self) -> Self;
+    /// `self - o`, wrapping in every build (`i32`'s `-` checks in debug).
+    fn sub_wrapping(self, o: Self) -> Self;
 }
 
-impl ZigZagLanes for i32 {
+impl BitLanes for i32 {
     const ZERO: i32 = 0;
     const ONE: i32 = 1;
     #[inline(always)]
     fn half(self) -> i32 {
         ((self as u32) >> 1) as i32
     }
+    #[inline(always)]
+    fn shl_each(self, n: i32) -> i32 {
+        self.wrapping_shl(n as u32)
+    }
+    #[inline(always)]
+    fn sub_wrapping(self, o: i32) -> i32 {
+        self.wrapping_sub(o)
+    }
 }
 
-impl ZigZagLanes for tcb_core::simd::w8::I8 {
+impl BitLanes for wide::i32x8 {
+    const ZERO: Self = wide::i32x8::ZERO;
+    const ONE: Self = wide::i32x8::ONE;
+    #[inline(always)]
+    fn half(self) -> Self {
+        let u: wide::u32x8 = bytemuck::cast(self);
+        bytemuck::cast(u >> 1)
+    }
+    #[inline(always)]
+    fn shl_each(self, n: Self) -> Self {
+        let (u, n): (wide::u32x8, wide::u32x8) = (bytemuck::cast(self), bytemuck::cast(n));
+        bytemuck::cast(u << n)
+    }
+    #[inline(always)]
+    fn sub_wrapping(self, o: Self) -> Self {
+        self - o
+    }
+}
+
+impl BitLanes for tcb_core::simd::w8::I8 {
     const ZERO: Self = tcb_core::simd::w8::I8([0; 8]);
     const ONE: Self = tcb_core::simd::w8::I8([1; 8]);
     #[inline(always)]
     fn half(self) -> Self {
         self.shr_logical::<1>()
+    }
+    #[inline(always)]
+    fn shl_each(self, n: Self) -> Self {
+        self.shl_each(n)
+    }
+    #[inline(always)]
+    fn sub_wrapping(self, o: Self) -> Self {
+        self - o
     }
 }
 
@@ -1116,7 +1163,17 @@ fn put_header(w: &mut BitWriter, order: u32, width: u32, before: u32) {
 /// by selects.
 #[inline(always)]
 pub(crate) fn read_header(words: &[u64], pos: usize, before: u32) -> (u32, u32, usize) {
-    let v = window(words, pos);
+    header(window(words, pos), before)
+}
+
+/// Bits an entry of [`put_header`] takes at most: 8 entries fit in the
+/// 64 bits of a [`window`].
+pub(crate) const HEADER_MAX_BITS: usize = 3 + WIDTH_BITS as usize;
+const _: () = assert!(8 * HEADER_MAX_BITS <= 64);
+
+/// [`read_header`] of the entry in the low bits of `v`.
+#[inline(always)]
+pub(crate) fn header(v: u64, before: u32) -> (u32, u32, usize) {
     let order = 2 - (v & 1) as u32;
     let code = ((v >> 1) & 3) as u32;
     let rest = (v >> 3) as u32;
@@ -1194,7 +1251,7 @@ impl Packed {
             for (x, &(order, wd)) in lanes.iter().zip(chosen) {
                 for k in (s..end).filter(|k| k % block >= 2) {
                     let stored = code(x, k, order, block).wrapping_add(bias(wd)) as u32;
-                    w.put(stored & mask(wd), wd);
+                    w.put(stored & width_lanes(wd as i32).0 as u32, wd);
                 }
             }
         }
@@ -1517,3 +1574,32 @@ pub const VERSION: u32 = 6;
 mod file;
 mod loose;
 pub(crate) mod store;
+
+#[cfg(test)]
+mod tests {
+    use super::{BitLanes, bias, width_lanes};
+    use tcb_core::simd::w8::I8;
+
+    /// The low bits and the bias of every width, on each lane type.
+    #[test]
+    fn width_lanes_is_one_rule_on_every_lane_type() {
+        for w in 0..32u32 {
+            let (low, b) = width_lanes(w as i32);
+            assert_eq!(low as u32 as u64, (1u64 << w) - 1, "low bits of width {w}");
+            let want = if w == 0 { 0 } else { 1u64 << (w - 1) };
+            assert_eq!(b as u32 as u64, want, "bias of width {w}");
+            assert_eq!(bias(w), b);
+        }
+        let ws = [[0, 1, 2, 3, 4, 5, 6, 7], [31, 30, 25, 17, 16, 9, 8, 0]];
+        for w in ws {
+            let one = w.map(width_lanes::<i32>);
+            let (low, b) = width_lanes(wide::i32x8::new(w));
+            assert_eq!(low.to_array(), one.map(|x| x.0));
+            assert_eq!(b.to_array(), one.map(|x| x.1));
+            let (low, b) = width_lanes(I8(w));
+            assert_eq!(low.0, one.map(|x| x.0));
+            assert_eq!(b.0, one.map(|x| x.1));
+        }
+        assert_eq!(<I8 as BitLanes>::ONE.0, [1; 8]);
+    }
+}

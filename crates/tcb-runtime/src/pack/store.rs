@@ -30,7 +30,7 @@
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
 
-use super::{Packed, SEGMENT_KEYS, read_bits, read_header, unzigzag};
+use super::{Packed, SEGMENT_KEYS, header, read_bits, unzigzag, window};
 use crate::segment::Segment;
 use std::ops::{Add, BitAnd, Sub};
 use std::sync::Arc;
@@ -202,13 +202,23 @@ fn interior_tangents<L: Plane>(
 }
 
 /// The key predicted from the last two (`a`, then `b`) and the residual `z`
-/// as stored, for a plane's coding `[trend, live, bias]` (module docs).
+/// as stored (its low bits, whatever lies above them), for a plane's
+/// coding `[trend, low, bias]`: `trend` from the order, `low` and `bias`
+/// from the width (`super::width_lanes`).
 #[inline(always)]
-fn predict<I>(a: I, b: I, z: I, [trend, live, bias]: [I; 3]) -> I
+fn predict<I>(a: I, b: I, z: I, [trend, low, bias]: [I; 3]) -> I
 where
     I: Copy + Add<Output = I> + Sub<Output = I> + BitAnd<Output = I>,
 {
-    b + ((b - a) & trend) + ((z & live) - bias)
+    b + ((b - a) & trend) + ((z & low) - bias)
+}
+
+/// A block's first two keys (the predictor's state after them) from its
+/// start values and deltas: key 0 is the start value, key 1 key 0 plus
+/// the delta; a block of one key (`keys` 1) has the start value twice.
+#[inline(always)]
+fn block_start_keys<I: Copy + Add<Output = I>>(start: I, delta: I, keys: usize) -> [I; 2] {
+    [start, if keys > 1 { start + delta } else { start }]
 }
 
 /// Rebuild `w` of the rotations that store three components, and turn
@@ -294,9 +304,6 @@ pub(crate) struct PackCache {
     widths: Vec<u32>,
     /// Per plane, how its lanes code the segment `cur`.
     coding: Vec<PlaneCoding>,
-    /// Integers of one key in the group's planes (scratch; zero where no
-    /// lane is stored).
-    flat: Vec<i32x8>,
     /// The predictor: the last two keys' integers, per plane.
     x0: Vec<i32x8>,
     x1: Vec<i32x8>,
@@ -324,7 +331,6 @@ impl PackedKeys {
             pos: 0,
             widths: vec![0; self.headed.len()],
             coding,
-            flat: vec![i32x8::ZERO; np],
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
             rows: vec![f32x8::ZERO; ROWS * np],
@@ -402,23 +408,28 @@ impl PackCache {
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         // A block's first two keys come from its start values and deltas.
         let first = if block { 2.min(keys) } else { 0 };
-        // Per lane: its coding, and the bit of its first residual after
-        // the residuals' start (for the AVX2 instance's gather).
-        let (mut widest, mut off) = (0, 0);
-        for (w, &slot) in self.widths.iter_mut().zip(&g.headed) {
-            let (order, width, used) = read_header(words, pos, *w);
-            pos += used;
-            *w = width;
-            widest = widest.max(width);
-            // One bounds check for the plane; the lane is below 8.
-            let c = &mut self.coding[slot as usize / 8];
-            let lane = slot as usize % 8;
-            c.trend[lane] = -i32::from(order == 2);
-            c.live[lane] = -i32::from(width > 0);
-            c.bias[lane] = super::bias(width);
-            c.width[lane] = width as i32;
-            c.start[lane] = off as i32;
-            off += width as usize * (keys - first);
+        // Per lane: its coding, and the sum of the widths before it (its
+        // first residual lies that many times `keys - first` bits after the
+        // residuals' start: the AVX2 instance's gather).
+        let (mut widest, mut before) = (0, 0);
+        // Eight headers at most fill one 64-bit window.
+        let per = 64 / super::HEADER_MAX_BITS;
+        for (ws, slots) in self.widths.chunks_mut(per).zip(g.headed.chunks(per)) {
+            let mut v = window(words, pos);
+            for (w, &slot) in ws.iter_mut().zip(slots) {
+                let (order, width, used) = header(v, *w);
+                v >>= used;
+                pos += used;
+                *w = width;
+                widest = widest.max(width);
+                // One bounds check for the plane; the lane is below 8.
+                let c = &mut self.coding[slot as usize / 8];
+                let lane = slot as usize % 8;
+                c.trend[lane] = -i32::from(order == 2);
+                c.width[lane] = width as i32;
+                c.start[lane] = before as i32;
+                before += width as usize;
+            }
         }
         if block {
             let written = self.block_start(g, &mut pos, keys);
@@ -428,14 +439,15 @@ impl PackCache {
         // from the stream (a gather of 32 bits from each lane's byte), where
         // every width has room in them and the segment's last bit lies 32
         // bits before the stream's end.
-        let last = pos + off;
+        let last = pos + before * (keys - first);
         let gather = crate::isa::avx2()
             && widest <= GATHER_WIDTH
             && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
         if !gather {
             // Residuals: 16 of each lane of a width above 0 (those past
             // the segment's keys land in spare rows, or in rows no key
-            // reads) into the rows as i32; `live` masks the rest.
+            // reads) into the rows as i32; the width's low bits mask the
+            // rest.
             let stride = 8 * np;
             let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
             let base = (BEFORE + first) * stride;
@@ -452,10 +464,10 @@ impl PackCache {
         if gather {
             // SAFETY: `gather` holds only where AVX2 runs, and every lane's
             // residuals end at or before `last` (each lane's start is the
-            // sum of the lanes' before it, `width * (keys - first)` bits
-            // each, after `pos`, and `last` is `pos` plus the sum over all;
-            // lanes without headers start at `pos` with width 0), which is
-            // 32 bits before the stream's end and below i32::MAX.
+            // sum of the widths before it times `keys - first` bits after
+            // `pos`, and `last` is `pos` plus the sum over all; lanes
+            // without headers start at `pos` with width 0), which is 32
+            // bits before the stream's end and below i32::MAX.
             #[allow(unsafe_code)]
             unsafe {
                 v3::predict_gathered_here(g, &self.coding, pos, &mut self.x0, &mut self.x1, rows);
@@ -466,7 +478,8 @@ impl PackCache {
                 let p = p as usize;
                 let (mut a, mut b) = (self.x0[p], self.x1[p]);
                 let c = &self.coding[p];
-                let coding = [c.trend, c.live, c.bias].map(i32x8::from);
+                let (low, bias) = super::width_lanes(i32x8::from(c.width));
+                let coding = [i32x8::from(c.trend), low, bias];
                 let step = g.step[p];
                 for row in rows.chunks_exact_mut(np) {
                     let v = &mut row[p];
@@ -506,27 +519,27 @@ impl PackCache {
             self.rebuild(g, 0..first);
             return first;
         }
-        for (j, bits) in [&g.packed.abs_bits, &g.packed.delta_bits]
-            .into_iter()
-            .enumerate()
-        {
-            let flat: &mut [i32] = bytemuck::cast_slice_mut(&mut self.flat);
+        // Every lane's start value into `x0`, then its delta into `x1`.
+        for (bits, out) in [
+            (&g.packed.abs_bits, &mut self.x0),
+            (&g.packed.delta_bits, &mut self.x1),
+        ] {
+            out.fill(i32x8::ZERO);
+            let flat: &mut [i32] = bytemuck::cast_slice_mut(out);
             for (&w, &slot) in bits.iter().zip(&g.lane_slot) {
                 flat[slot as usize] = unzigzag(read_bits(words, *pos, u32::from(w)));
                 *pos += usize::from(w);
             }
-            if j == keys {
-                break;
+        }
+        let (row0, row1) = self.rows[BEFORE * np..(BEFORE + first) * np].split_at_mut(np);
+        let state = self.x0.iter_mut().zip(&mut self.x1).zip(&g.step);
+        for (p, ((x0, x1), step)) in state.enumerate() {
+            let [k0, k1] = block_start_keys(*x0, *x1, first);
+            row0[p] = super::dequantize_lanes(k0, *step);
+            if let Some(row) = row1.get_mut(p) {
+                *row = super::dequantize_lanes(k1, *step);
             }
-            let row = &mut self.rows[(BEFORE + j) * np..][..np];
-            let state = self.x0.iter_mut().zip(&mut self.x1).zip(&self.flat);
-            for ((out, ((x0, x1), v)), step) in row.iter_mut().zip(state).zip(&g.step) {
-                // Key 0: the start value; key 1: key 0 plus the delta.
-                let x = if j == 0 { *v } else { *x1 + *v };
-                *x0 = if j == 0 { x } else { *x1 };
-                *x1 = x;
-                *out = super::dequantize_lanes(x, *step);
-            }
+            (*x0, *x1) = (k0, k1);
         }
         self.rebuild(g, 0..first);
         first
@@ -550,16 +563,11 @@ struct PlaneCoding {
     /// -1 in lanes predicted by the line through their last two values
     /// (order 2), 0 in lanes predicted by the last.
     trend: [i32; 8],
-    /// -1 in lanes whose residuals have a width above 0 (stored and not on
-    /// the prediction).
-    live: [i32; 8],
-    /// What the residuals are stored above their value (`super::bias` of
-    /// their width).
-    bias: [i32; 8],
-    /// Their width.
+    /// The residuals' width (0: none stored, the lane on its prediction).
     width: [i32; 8],
-    /// For the AVX2 instance's gather: the bit of each lane's first
-    /// residual of the segment in the stream.
+    /// For the AVX2 instance's gather: the sum of the widths of the
+    /// stream's lanes before it (its first residual of the segment lies
+    /// this many times the keys decoded bits after the residuals' start).
     start: [i32; 8],
 }
 
@@ -573,13 +581,12 @@ pub(crate) const GATHER_WIDTH: u32 = 25;
 #[cfg(target_arch = "x86_64")]
 mod v3 {
     use crate::pack::store::{
-        PackedKeys, Plane, PlaneCoding, interior_tangents, predict, rebuild_rows,
+        PackedKeys, Plane, PlaneCoding, block_start_keys, interior_tangents, predict, rebuild_rows,
     };
-    use crate::pack::{dequantize_lanes, unzigzag_lanes};
+    use crate::pack::{dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
         __m256, __m256i, _mm256_add_epi32, _mm256_and_si256, _mm256_i32gather_epi32,
-        _mm256_set1_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
-        _mm256_sub_epi32,
+        _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
     };
     use tcb_core::simd::w8::{I8, W8};
     use wide::{f32x8, i32x8};
@@ -651,15 +658,15 @@ mod v3 {
 
     /// The prediction and dequantization of the rows `rows` (keys
     /// `first..keys` of the segment, `planes` vectors each), the residuals
-    /// gathered from the stream at the bits `base + coding[p].start`.
+    /// gathered from the stream at the bits `base + coding[p].start * k`
+    /// (`k = rows.len() / planes` keys).
     ///
     /// # Safety
     ///
     /// `crate::isa::avx2()` is true, and for every stored plane `p` and
-    /// lane `l`, `base + coding[p].start[l] + coding[p].width[l] *
-    /// (rows.len() / planes)` is at most `64 * g.packed.stream.len() - 32`
-    /// and below `i32::MAX` (each gather reads 4 bytes from the byte of a
-    /// lane's bit).
+    /// lane `l`, `base + (coding[p].start[l] + coding[p].width[l]) * k` is
+    /// at most `64 * g.packed.stream.len() - 32` and below `i32::MAX`
+    /// (each gather reads 4 bytes from the byte of a lane's bit).
     #[inline(always)]
     #[allow(unsafe_code)]
     pub(super) unsafe fn predict_gathered_here(
@@ -680,17 +687,10 @@ mod v3 {
         bytemuck::cast(x)
     }
 
-    /// The low `width` bits of each lane (`width` at most 31).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn low_bits(width: __m256i) -> __m256i {
-        let one = _mm256_set1_epi32(1);
-        _mm256_sub_epi32(_mm256_sllv_epi32(one, width), one)
-    }
-
-    /// The bits `mask` at each lane's bit `bit` of `bytes` (bit `p` is bit
-    /// `p % 8` of byte `p / 8`): 32 bits gathered from the lane's byte,
-    /// shifted by the rest.
+    /// The 32 bits from each lane's bit `bit` of `bytes` (bit `p` is bit
+    /// `p % 8` of byte `p / 8`; fewer where they pass a byte's top, the
+    /// caller masks what it reads): gathered from the lane's byte, shifted
+    /// by the rest.
     ///
     /// # Safety
     ///
@@ -699,14 +699,17 @@ mod v3 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     #[allow(unsafe_code)]
-    unsafe fn bits_at(bytes: &[u8], bit: __m256i, mask: __m256i) -> __m256i {
+    unsafe fn bits_at(bytes: &[u8], bit: __m256i) -> I8 {
         // SAFETY: the caller's: each 4-byte read is inside `bytes`.
         #[allow(unsafe_code)]
         let word = unsafe {
             _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
         };
         let seven = _mm256_set1_epi32(7);
-        _mm256_and_si256(_mm256_srlv_epi32(word, _mm256_and_si256(bit, seven)), mask)
+        I8(bytemuck::cast(_mm256_srlv_epi32(
+            word,
+            _mm256_and_si256(bit, seven),
+        )))
     }
 
     /// A block's first keys into `rows` (its first, and its second where
@@ -744,6 +747,7 @@ mod v3 {
         let np = g.planes;
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
         let base = _mm256_set1_epi32(base);
+        let keys = rows.len() / np;
         let (row0, row1) = rows.split_at_mut(np);
         let planes = g.start_gather.iter().zip(&g.step);
         for (p, ([abs_at, abs_w, delta_at, delta_w], step)) in planes.enumerate() {
@@ -753,20 +757,17 @@ mod v3 {
                 // start_bits`, 32 bits before the stream's end
                 // (`block_start_gathered_here`).
                 #[allow(unsafe_code)]
-                let z = unsafe { bits_at(bytes, bit, low_bits(m(*w))) };
-                unzigzag_lanes(I8(bytemuck::cast(z)))
+                let z = unsafe { bits_at(bytes, bit) };
+                unzigzag_lanes(z & width_lanes(I8(*w)).0)
             };
             let (start, delta) = (read(abs_at, abs_w), read(delta_at, delta_w));
             let step = W8(step.to_array());
-            // Key 0: the start value; key 1: key 0 plus the delta.
-            let second = start + delta;
-            row0[p] = f32x8::new(dequantize_lanes(start, step).0);
+            let [k0, k1] = block_start_keys(start, delta, keys);
+            row0[p] = f32x8::new(dequantize_lanes(k0, step).0);
             if let Some(row) = row1.get_mut(p) {
-                *row = f32x8::new(dequantize_lanes(second, step).0);
-                (x0[p], x1[p]) = (i32x8::new(start.0), i32x8::new(second.0));
-            } else {
-                (x0[p], x1[p]) = (i32x8::new(start.0), i32x8::new(start.0));
+                *row = f32x8::new(dequantize_lanes(k1, step).0);
             }
+            (x0[p], x1[p]) = (i32x8::new(k0.0), i32x8::new(k1.0));
         }
     }
 
@@ -782,22 +783,23 @@ mod v3 {
         let np = g.planes;
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
         let base = _mm256_set1_epi32(base);
+        let keys = _mm256_set1_epi32((rows.len() / np) as i32);
         for &p in &g.stored_planes {
             let p = p as usize;
             let c = &coding[p];
-            let code = [I8(c.trend), I8(c.live), I8(c.bias)];
+            let (low, bias) = width_lanes(I8(c.width));
+            let code = [I8(c.trend), low, bias];
             let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
             let step = W8(g.step[p].to_array());
             let width = m(c.width);
-            let mask = low_bits(width);
-            let mut bit = _mm256_add_epi32(base, m(c.start));
+            let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(c.start), keys));
             for row in rows.chunks_exact_mut(np) {
                 // SAFETY: every lane's bit is below the bound of
                 // `predict_gathered_here`'s contract, 32 bits before the
                 // end of `bytes`, so each 4-byte read is inside it.
                 #[allow(unsafe_code)]
-                let z = unsafe { bits_at(bytes, bit, mask) };
-                let x = predict(a, b, I8(bytemuck::cast(z)), code);
+                let z = unsafe { bits_at(bytes, bit) };
+                let x = predict(a, b, z, code);
                 (a, b) = (b, x);
                 row[p] = f32x8::new(dequantize_lanes(x, step).0);
                 bit = _mm256_add_epi32(bit, width);
