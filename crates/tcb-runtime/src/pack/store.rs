@@ -414,21 +414,27 @@ impl PackCache {
         let (mut widest, mut before) = (0, 0);
         // Eight headers at most fill one 64-bit window.
         let per = 64 / super::HEADER_MAX_BITS;
-        for (ws, slots) in self.widths.chunks_mut(per).zip(g.headed.chunks(per)) {
+        let headed = &g.headed[..];
+        let widths = &mut self.widths[..headed.len()];
+        let mut i = 0;
+        while i < headed.len() {
             let mut v = window(words, pos);
-            for (w, &slot) in ws.iter_mut().zip(slots) {
-                let (order, width, used) = header(v, *w);
+            let end = (i + per).min(headed.len());
+            while i < end {
+                let (order, width, used) = header(v, widths[i]);
                 v >>= used;
                 pos += used;
-                *w = width;
+                widths[i] = width;
                 widest = widest.max(width);
                 // One bounds check for the plane; the lane is below 8.
-                let c = &mut self.coding[slot as usize / 8];
-                let lane = slot as usize % 8;
+                let slot = headed[i] as usize;
+                let c = &mut self.coding[slot >> 3];
+                let lane = slot & 7;
                 c.trend[lane] = -i32::from(order == 2);
                 c.width[lane] = width as i32;
                 c.start[lane] = before as i32;
                 before += width as usize;
+                i += 1;
             }
         }
         if block {
