@@ -853,13 +853,6 @@ pub(crate) fn width_lanes<I: BitLanes>(w: I) -> (I, I) {
     (bit.sub_wrapping(I::ONE), bit.half())
 }
 
-/// [`width_lanes`]'s `bias` of one width.
-#[inline(always)]
-pub(crate) fn bias(w: u32) -> i32 {
-    debug_assert!(w < 32);
-    width_lanes(w as i32).1
-}
-
 /// Bits a zigzag-coded value takes.
 fn bits_of(z: u32) -> u32 {
     32 - z.leading_zeros()
@@ -1249,9 +1242,10 @@ impl Packed {
             // Lane by lane: a lane's residuals of the segment are contiguous.
             let end = (s + SEGMENT_KEYS).min(n);
             for (x, &(order, wd)) in lanes.iter().zip(chosen) {
+                let (low, bias) = width_lanes(wd as i32);
                 for k in (s..end).filter(|k| k % block >= 2) {
-                    let stored = code(x, k, order, block).wrapping_add(bias(wd)) as u32;
-                    w.put(stored & width_lanes(wd as i32).0 as u32, wd);
+                    let stored = code(x, k, order, block).wrapping_add(bias);
+                    w.put((stored & low) as u32, wd);
                 }
             }
         }
@@ -1527,7 +1521,7 @@ impl Packed {
         }
         for (l, xl) in x.iter_mut().enumerate() {
             for k in keys.clone().filter(|k| k % self.block >= 2) {
-                let r = (take(widths[l])? as i32).wrapping_sub(bias(widths[l]));
+                let r = (take(widths[l])? as i32).wrapping_sub(width_lanes(widths[l] as i32).1);
                 let i = k - first_key;
                 let trend = if orders[l] == 2 {
                     xl[i - 1].wrapping_sub(xl[i - 2])
@@ -1577,7 +1571,7 @@ pub(crate) mod store;
 
 #[cfg(test)]
 mod tests {
-    use super::{BitLanes, bias, width_lanes};
+    use super::width_lanes;
     use tcb_core::simd::w8::I8;
 
     /// The low bits and the bias of every width, on each lane type.
@@ -1588,7 +1582,6 @@ mod tests {
             assert_eq!(low as u32 as u64, (1u64 << w) - 1, "low bits of width {w}");
             let want = if w == 0 { 0 } else { 1u64 << (w - 1) };
             assert_eq!(b as u32 as u64, want, "bias of width {w}");
-            assert_eq!(bias(w), b);
         }
         let ws = [[0, 1, 2, 3, 4, 5, 6, 7], [31, 30, 25, 17, 16, 9, 8, 0]];
         for w in ws {
@@ -1600,6 +1593,5 @@ mod tests {
             assert_eq!(low.0, one.map(|x| x.0));
             assert_eq!(b.0, one.map(|x| x.1));
         }
-        assert_eq!(<I8 as BitLanes>::ONE.0, [1; 8]);
     }
 }

@@ -816,7 +816,7 @@ mod v3 {
 }
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
-/// stream into `out[i * stride]`, as stored (`super::bias` above their
+/// stream into `out[i * stride]`, as stored (`super::width_lanes`' bias above their
 /// value).
 type Unpack = fn(&[u64], usize, &mut [i32], usize);
 
