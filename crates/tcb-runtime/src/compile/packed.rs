@@ -13,7 +13,7 @@ use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
 use crate::grid::{KeyTimes, TimeGrid};
 use crate::pack::store::{GATHER_WIDTH, PackedKeys};
-use crate::pack::{PackError, Packed, err, key_weights};
+use crate::pack::{GROUP, PackError, Packed, err, key_weights};
 use std::sync::Arc;
 use tcb_core::TrackKind;
 use wide::f32x8;
@@ -278,12 +278,28 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
             table.extend_from_slice(section);
         }
     }
-    let (headed, headed_base) = lane_slot
+    let (headed, mut headed_base): (Vec<u32>, Vec<u8>) = lane_slot
         .iter()
         .zip(&packed.base_width)
         .filter(|(_, base)| **base != crate::pack::FLAT)
-        .map(|(slot, base)| (*slot, u32::from(*base)))
+        .map(|(slot, base)| (*slot, *base))
         .unzip();
+    // Groups of 8, then the entries of a stored lane without headers
+    // (width 0, order 2) and of a lane not stored (order 1: as the decoder
+    // had it), then 3 bytes for a 4-byte gather at the last (`store::Headers`).
+    let (flat, none) = {
+        let padded = headed.len().next_multiple_of(GROUP);
+        headed_base.resize(padded, 0);
+        headed_base.extend([0, 32, 0, 0, 0]);
+        (padded as i32, padded as i32 + 1)
+    };
+    let mut plane_index = vec![[none; 8]; np];
+    for &slot in &lane_slot {
+        plane_index[slot as usize / 8][slot as usize % 8] = flat;
+    }
+    for (i, &slot) in headed.iter().enumerate() {
+        plane_index[slot as usize / 8][slot as usize % 8] = i as i32;
+    }
     let (start_gather, start_bits) = start_gather(packed, &lane_slot, np);
     let mut stored_planes: Vec<u32> = lane_slot.iter().map(|at| at / 8).collect();
     stored_planes.sort_unstable();
@@ -296,6 +312,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         lane_slot,
         headed,
         headed_base,
+        plane_index,
         step: step.into_iter().map(f32x8::new).collect(),
         weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
         rot_from,

@@ -164,10 +164,10 @@ impl<'a> Reader<'a> {
             ));
         }
         let len = self.u32("the stream length")? as usize;
-        // Every segment spends at least 2 bits per lane with headers on
-        // them: a file cannot describe more keys than that (checked before
-        // the stream is copied).
-        if keys < 2 || segments.saturating_mul(lanes).saturating_mul(2) > 8 * len {
+        // Every segment spends 3 bits at least per lane with headers on
+        // them (an order bit and a width code): a file cannot describe more
+        // keys than that (checked before the stream is copied).
+        if keys < 2 || segments.saturating_mul(lanes).saturating_mul(3) > 8 * len {
             return err(format!(
                 "{keys} keys of {lanes} lanes with headers claimed in a stream of {len} bytes"
             ));

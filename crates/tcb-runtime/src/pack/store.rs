@@ -4,8 +4,10 @@
 //! An instance keeps the decoded keys (`P`, in the group's planes) of one
 //! 16-key segment and the three keys before it, and the predictor's state;
 //! a segment from key `a` to `a + 1` needs keys `a - 1 ..= a + 2`. Playback
-//! decodes a segment when it first needs one of its keys, in three passes
-//! that each run without a branch on the data: every lane's residuals
+//! decodes a segment when it first needs one of its keys: its headers, 8
+//! lanes at a time in the bytes of a `u64` (`super::header_group`; each
+//! plane's lanes then find theirs through `PackedKeys::plane_index`), then
+//! three passes that each run without a branch on the data: every lane's residuals
 //! unpacked by a function for its width (16 values, a mask and a shift
 //! each), then per plane of 8 lanes the prediction and dequantization, key
 //! by key, with the predictor in registers, then the rebuilt `w`s. Where
@@ -30,7 +32,7 @@
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
 
-use super::{Packed, SEGMENT_KEYS, header, read_bits, unzigzag, window};
+use super::{BYTES, GROUP, Packed, SEGMENT_KEYS, header_group, read_bits, unzigzag, window};
 use crate::segment::Segment;
 use std::ops::{Add, BitAnd, Sub};
 use std::sync::Arc;
@@ -53,9 +55,15 @@ pub(crate) struct PackedKeys {
     /// Per stream lane, its plane and lane in the group (`8 plane + lane`).
     pub lane_slot: Vec<u32>,
     /// The slots of the stream lanes with headers (not
-    /// [`FLAT`](super::FLAT)), in the stream's order, and their base widths.
+    /// [`FLAT`](super::FLAT)), in the stream's order.
     pub headed: Vec<u32>,
-    pub headed_base: Vec<u32>,
+    /// Their base widths, then 0 to a multiple of [`GROUP`], then the two
+    /// entries of [`Headers::code`] no header writes (a stored lane without
+    /// headers, and a lane not stored) and 3 bytes of padding.
+    pub headed_base: Vec<u8>,
+    /// Per plane, the entry of [`Headers`] each lane's coding is: its
+    /// index in `headed`, or one of the two last entries.
+    pub plane_index: Vec<[i32; 8]>,
     /// Per plane: the quantization step of each lane (0 where not stored).
     pub step: Vec<f32x8>,
     /// Per plane: `in_a, in_b, out_a, out_b` of each lane.
@@ -95,7 +103,8 @@ impl PackedKeys {
     /// Heap bytes: the stream and its tables (once per clip) and the rest.
     pub fn heap_bytes(&self) -> usize {
         self.packed.stream_bytes()
-            + 4 * self.lane_slot.len()
+            + 4 * (self.lane_slot.len() + self.headed.len() + self.headed_base.len())
+            + 32 * self.plane_index.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
             + 128 * self.start_gather.len()
             + 8 * self.rebuild.len()
@@ -299,9 +308,9 @@ pub(crate) struct PackCache {
     seg: usize,
     /// The stream's bit after segment `cur` (where the next one starts).
     pos: usize,
-    /// Per stream lane with headers (`PackedKeys::headed`): its width in
-    /// the segment `cur`.
-    widths: Vec<u32>,
+    /// Per stream lane with headers (`PackedKeys::headed`), as the
+    /// segment `cur`'s headers give them.
+    headers: Headers,
     /// Per plane, how its lanes code the segment `cur`.
     coding: Vec<PlaneCoding>,
     /// The predictor: the last two keys' integers, per plane.
@@ -324,12 +333,17 @@ impl PackedKeys {
         for &slot in &self.lane_slot {
             coding[slot as usize / 8].trend[slot as usize % 8] = -1;
         }
+        let groups = self.headed.len().div_ceil(GROUP);
         PackCache {
             cur: usize::MAX,
             valid: 0,
             seg: usize::MAX,
             pos: 0,
-            widths: vec![0; self.headed.len()],
+            headers: Headers {
+                code: self.headed_base.clone(),
+                start: vec![0; self.headed_base.len()],
+                carry: vec![0; groups + 1],
+            },
             coding,
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
@@ -403,40 +417,16 @@ impl PackCache {
         };
         if block {
             // A block's first headers code against the lanes' base widths.
-            self.widths.copy_from_slice(&g.headed_base);
+            self.headers.code.copy_from_slice(&g.headed_base);
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         // A block's first two keys come from its start values and deltas.
         let first = if block { 2.min(keys) } else { 0 };
-        // Per lane: its coding, and the sum of the widths before it (its
-        // first residual lies that many times `keys - first` bits after the
-        // residuals' start: the AVX2 instance's gather).
-        let (mut widest, mut before) = (0, 0);
-        // Eight headers at most fill one 64-bit window.
-        let per = 64 / super::HEADER_MAX_BITS;
-        let headed = &g.headed[..];
-        let widths = &mut self.widths[..headed.len()];
-        let mut i = 0;
-        while i < headed.len() {
-            let mut v = window(words, pos);
-            let end = (i + per).min(headed.len());
-            while i < end {
-                let (order, width, used) = header(v, widths[i]);
-                v >>= used;
-                pos += used;
-                widths[i] = width;
-                widest = widest.max(width);
-                // One bounds check for the plane; the lane is below 8.
-                let slot = headed[i] as usize;
-                let c = &mut self.coding[slot >> 3];
-                let lane = slot & 7;
-                c.trend[lane] = -i32::from(order == 2);
-                c.width[lane] = width as i32;
-                c.start[lane] = before as i32;
-                before += width as usize;
-                i += 1;
-            }
-        }
+        // Per lane: its width, trend, and the sum of the widths before it
+        // (its first residual lies that many times `keys - first` bits
+        // after the residuals' start: the AVX2 instance's gather).
+        let (before, narrow);
+        (pos, before, narrow) = self.headers.read(words, pos, g.headed.len());
         if block {
             let written = self.block_start(g, &mut pos, keys);
             debug_assert_eq!(written, first);
@@ -446,9 +436,8 @@ impl PackCache {
         // every width has room in them and the segment's last bit lies 32
         // bits before the stream's end.
         let last = pos + before * (keys - first);
-        let gather = crate::isa::avx2()
-            && widest <= GATHER_WIDTH
-            && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
+        let gather =
+            crate::isa::avx2() && narrow && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
         if !gather {
             // Residuals: 16 of each lane of a width above 0 (those past
             // the segment's keys land in spare rows, or in rows no key
@@ -458,12 +447,16 @@ impl PackCache {
             let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
             let base = (BEFORE + first) * stride;
             let mut at = pos;
-            for (&w, &slot) in self.widths.iter().zip(&g.headed) {
+            for (&c, &slot) in self.headers.code.iter().zip(&g.headed) {
+                let w = c & 31;
                 if w > 0 {
                     UNPACK[w as usize](words, at, &mut rows[base + slot as usize..], stride);
                     at += w as usize * (keys - first);
                 }
             }
+        }
+        if !gather {
+            self.plane_codings(g);
         }
         let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
         #[cfg(target_arch = "x86_64")]
@@ -473,10 +466,13 @@ impl PackCache {
             // sum of the widths before it times `keys - first` bits after
             // `pos`, and `last` is `pos` plus the sum over all; lanes
             // without headers start at `pos` with width 0), which is 32
-            // bits before the stream's end and below i32::MAX.
+            // bits before the stream's end and below i32::MAX; every
+            // index of `plane_index` is below `headed_base`'s length less
+            // 3, the length of `headers.code` and `headers.start`, and its
+            // eighth below `headers.carry`'s (`compile::packed`).
             #[allow(unsafe_code)]
             unsafe {
-                v3::predict_gathered_here(g, &self.coding, pos, &mut self.x0, &mut self.x1, rows);
+                v3::predict_gathered_here(g, &self.headers, pos, &mut self.x0, &mut self.x1, rows);
             }
         }
         if !gather {
@@ -498,6 +494,21 @@ impl PackCache {
         }
         self.rebuild(g, first..keys);
         self.pos = last;
+    }
+
+    /// Each stored plane's coding from the headers.
+    fn plane_codings(&mut self, g: &PackedKeys) {
+        let h = &self.headers;
+        for &p in &g.stored_planes {
+            let c = &mut self.coding[p as usize];
+            for (l, &i) in g.plane_index[p as usize].iter().enumerate() {
+                let i = i as usize;
+                let code = i32::from(h.code[i]);
+                c.width[l] = code & 31;
+                c.trend[l] = (code >> 5) - 1;
+                c.start[l] = h.carry[i / GROUP] + i32::from(h.start[i]);
+            }
+        }
     }
 
     /// A block's first two keys (its start values, then the deltas) into
@@ -563,6 +574,48 @@ impl PackCache {
     }
 }
 
+/// What a segment's headers say of the stream's lanes with headers
+/// (`PackedKeys::headed`, in groups of [`GROUP`]), a byte each (then the
+/// entries of `PackedKeys::headed_base`).
+#[derive(Clone, Debug)]
+pub(crate) struct Headers {
+    /// The residuals' width, plus 32 where the prediction order is 1 (the
+    /// last value) rather than 2 (the line through the last two).
+    code: Vec<u8>,
+    /// The sum of the widths before it in its group.
+    start: Vec<u8>,
+    /// Per group, the sum of the widths before it (then a 0).
+    carry: Vec<i32>,
+}
+
+impl Headers {
+    /// A segment's headers of `headed` lanes from bit `pos` of `words`,
+    /// coded against the widths here ([`header_group`]): the bit after
+    /// them, the sum of the widths, and whether each is at most
+    /// [`GATHER_WIDTH`].
+    #[inline(always)]
+    fn read(&mut self, words: &[u64], mut pos: usize, headed: usize) -> (usize, usize, bool) {
+        let (mut sum, mut wide) = (0usize, 0u64);
+        for (group, at) in (0..headed).step_by(GROUP).enumerate() {
+            let k = (headed - at).min(GROUP);
+            let lanes = at..at + GROUP;
+            let code = &mut self.code[lanes.clone()];
+            let before = u64::from_le_bytes(code.try_into().expect("8 lanes")) & (31 * BYTES);
+            let read = header_group(window(words, pos), k, before);
+            pos += read.bits;
+            code.copy_from_slice(&(read.width | (read.order1 << 5)).to_le_bytes());
+            // The sums of the widths up to each byte (at most 248).
+            let sums = read.width.wrapping_mul(BYTES);
+            self.start[lanes].copy_from_slice(&(sums << 8).to_le_bytes());
+            self.carry[group] = sum as i32;
+            sum += (sums >> 56) as usize;
+            // A top bit where a width is above GATHER_WIDTH.
+            wide |= read.width + (0x80 - 1 - u64::from(GATHER_WIDTH)) * BYTES;
+        }
+        (pos, sum, wide & (0x80 * BYTES) == 0)
+    }
+}
+
 /// How the 8 lanes of a plane code a segment.
 #[derive(Clone, Copy, Debug, Default)]
 struct PlaneCoding {
@@ -587,7 +640,7 @@ pub(crate) const GATHER_WIDTH: u32 = 25;
 #[cfg(target_arch = "x86_64")]
 mod v3 {
     use crate::pack::store::{
-        PackedKeys, Plane, PlaneCoding, block_start_keys, interior_tangents, predict, rebuild_rows,
+        Headers, PackedKeys, Plane, block_start_keys, interior_tangents, predict, rebuild_rows,
     };
     use crate::pack::{dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
@@ -664,20 +717,23 @@ mod v3 {
 
     /// The prediction and dequantization of the rows `rows` (keys
     /// `first..keys` of the segment, `planes` vectors each), the residuals
-    /// gathered from the stream at the bits `base + coding[p].start * k`
-    /// (`k = rows.len() / planes` keys).
+    /// gathered from the stream at the bits `base + start * k` (`k =
+    /// rows.len() / planes` keys), each plane's coding gathered from the
+    /// headers `h` at `g.plane_index`.
     ///
     /// # Safety
     ///
-    /// `crate::isa::avx2()` is true, and for every stored plane `p` and
-    /// lane `l`, `base + (coding[p].start[l] + coding[p].width[l]) * k` is
+    /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
+    /// has `i + 4` at most the length of `h.code` and of `h.start` and `i /
+    /// 8` below the length of `h.carry`, and for every lane the sum of the
+    /// widths before it and its own, times `k`, plus `base` is
     /// at most `64 * g.packed.stream.len() - 32` and below `i32::MAX`
     /// (each gather reads 4 bytes from the byte of a lane's bit).
     #[inline(always)]
     #[allow(unsafe_code)]
     pub(super) unsafe fn predict_gathered_here(
         g: &PackedKeys,
-        coding: &[PlaneCoding],
+        h: &Headers,
         base: usize,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
@@ -685,7 +741,7 @@ mod v3 {
     ) {
         debug_assert!(crate::isa::avx2());
         // SAFETY: the caller's (above).
-        unsafe { predict_gathered(g, coding, base as i32, x0, x1, rows) }
+        unsafe { predict_gathered(g, h, base as i32, x0, x1, rows) }
     }
 
     #[inline(always)]
@@ -780,7 +836,7 @@ mod v3 {
     #[target_feature(enable = "avx2,fma")]
     fn predict_gathered(
         g: &PackedKeys,
-        coding: &[PlaneCoding],
+        h: &Headers,
         base: i32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
@@ -790,15 +846,29 @@ mod v3 {
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
         let base = _mm256_set1_epi32(base);
         let keys = _mm256_set1_epi32((rows.len() / np) as i32);
+        let byte = _mm256_set1_epi32(0xff);
+        // SAFETY (the gathers): the caller's, every index inside.
+        let at = |v: &[u8], index: __m256i| {
+            #[allow(unsafe_code)]
+            let x = unsafe { _mm256_i32gather_epi32::<1>(v.as_ptr().cast(), index) };
+            I8(bytemuck::cast(_mm256_and_si256(x, byte)))
+        };
         for &p in &g.stored_planes {
             let p = p as usize;
-            let c = &coding[p];
-            let (low, bias) = width_lanes(I8(c.width));
-            let code = [I8(c.trend), low, bias];
+            let index = m(g.plane_index[p]);
+            let code = at(&h.code, index);
+            let width = code & I8([31; 8]);
+            let trend = code.shr_logical::<5>() - I8([1; 8]);
+            let group = _mm256_srli_epi32::<3>(index);
+            #[allow(unsafe_code)]
+            let carry = unsafe { _mm256_i32gather_epi32::<4>(h.carry.as_ptr(), group) };
+            let start = _mm256_add_epi32(carry, m(at(&h.start, index).0));
+            let (low, bias) = width_lanes(width);
+            let code = [trend, low, bias];
+            let width = m(width.0);
             let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
             let step = W8(g.step[p].to_array());
-            let width = m(c.width);
-            let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(c.start), keys));
+            let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(start, keys));
             for row in rows.chunks_exact_mut(np) {
                 // SAFETY: every lane's bit is below the bound of
                 // `predict_gathered_here`'s contract, 32 bits before the
