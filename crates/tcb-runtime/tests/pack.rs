@@ -272,6 +272,25 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
     source.tracks.clear();
     let e = Packed::encode(&source).unwrap_err().to_string();
     assert!(e.contains("no tracks"), "{e}");
+
+    // One component more than a packed clip holds (the decoder keeps a
+    // component's first bit in 25 bits): refused in one line.
+    let four = tcb_runtime::PackTrack {
+        kind: TrackKind::Vec4,
+        values: vec![vec![1, 1]; 4],
+        ..track(0)
+    };
+    let lanes = tcb_runtime::pack::MAX_LANES;
+    source.tracks = vec![four; lanes / 4];
+    source.tracks.push(track(0));
+    for (i, t) in source.tracks.iter_mut().enumerate() {
+        t.name = format!("{i}");
+    }
+    let e = Packed::encode(&source).unwrap_err().to_string();
+    assert!(
+        e.contains(&format!("{} stored components", lanes + 1)) && !e.contains('\n'),
+        "{e}"
+    );
 }
 
 /// A component whose every segment is on the line (a constant track) has

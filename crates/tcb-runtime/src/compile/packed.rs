@@ -285,12 +285,12 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         .map(|(slot, base)| (*slot, *base))
         .unzip();
     // Groups of 8, then the entries of a stored lane without headers
-    // (width 0, order 2) and of a lane not stored (order 1: as the decoder
-    // had it), then 3 bytes for a 4-byte gather at the last (`store::Headers`).
+    // (width 0, order 2) and of a lane not stored (order 1, as the decoder
+    // has always had it; its values are not read) (`store::Headers`).
     let (flat, none) = {
         let padded = headed.len().next_multiple_of(GROUP);
         headed_base.resize(padded, 0);
-        headed_base.extend([0, 32, 0, 0, 0]);
+        headed_base.extend([0, 32]);
         (padded as i32, padded as i32 + 1)
     };
     let mut plane_index = vec![[none; 8]; np];

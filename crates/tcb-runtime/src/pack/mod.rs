@@ -50,9 +50,13 @@ pub const MAX_BLOCK_KEYS: usize = 1024;
 /// Keys per segment: a segment has one residual width per component.
 pub const SEGMENT_KEYS: usize = 16;
 /// Bits of a width field.
-const WIDTH_BITS: u32 = 5;
+pub(crate) const WIDTH_BITS: u32 = 5;
 /// The largest integer magnitude (f32 holds every integer below 2^24).
 pub const MAX_INT: i32 = 1 << 24;
+/// The most stored components on the grid a packed clip may hold: the
+/// decoder keeps, per component, the sum of the residual widths (at most
+/// 31 each) before it beside 6 bits of its own, in an `i32`.
+pub const MAX_LANES: usize = 1 << 20;
 /// The most keys over all tracks a packed clip may hold: decoding in full
 /// ([`Packed::from_bytes`], `Clip::verify_packed`, about 50 bytes a key and
 /// component with the reference compiled) allocates in proportion to them,
@@ -311,6 +315,12 @@ impl PackSource {
                 "{} keys of {} tracks on the grid and {loose_keys} of tracks on their own: a packed clip holds at most {MAX_TRACK_KEYS} track keys (loading compiles them in full)",
                 self.keys,
                 self.tracks.len()
+            ));
+        }
+        if self.lanes() > MAX_LANES {
+            return err(format!(
+                "{} stored components on the grid: a packed clip holds at most {MAX_LANES}",
+                self.lanes()
             ));
         }
         let total = self.tracks.len() + self.loose.len();
@@ -1126,33 +1136,37 @@ fn width_code_bits(width: u32, before: u32) -> usize {
 }
 
 /// Components per header group: a segment's headers come 8 components at
-/// a time, each group read with one 64-bit window.
+/// a time, each group's fixed part read with one 64-bit window.
 pub(crate) const GROUP: usize = 8;
 
-/// A segment's headers for one group of `k` (1 to [`GROUP`]) components
-/// with headers, in the stream's order: `k` bits of prediction orders
-/// (bit `i` is component `i`'s, 0 for order 2, 1 for order 1), then `k`
-/// 2-bit width codes against the component's width in the segment before
-/// (at a block's start, where a seek starts, its base width): 0 the same,
-/// 1 one more, 2 one less, 3 another, given after the codes in
-/// [`WIDTH_BITS`] bits, one per code 3 in component order. `3k + 5e` bits
-/// for `e` codes 3: at most 64.
-fn put_header_group(w: &mut BitWriter, group: &[(u32, u32, u32)]) {
-    debug_assert!((1..=GROUP).contains(&group.len()));
-    for &(order, _, _) in group {
-        w.put(2 - order, 1);
+/// A segment's headers ([`Packed::encode_with`]): `headers` holds per
+/// component with headers, in the stream's order, `(order, width, width
+/// before)`. In groups of 8 (the last maybe fewer, `k`), each group's
+/// fixed part: `k` bits of prediction orders (bit `i` is component `i`'s,
+/// 0 for order 2, 1 for order 1), then `k` 2-bit width codes against the
+/// component's width in the segment before (at a block's start, where a
+/// seek starts, its base width): 0 the same, 1 one more, 2 one less, 3
+/// another. Then, after every group's fixed part, the widths of the codes
+/// 3 in [`WIDTH_BITS`] bits each, in component order. A group's fixed part
+/// lies `3 x` the components before it after the first, so that the groups
+/// read without waiting for each other.
+fn put_headers(w: &mut BitWriter, headers: &[(u32, u32, u32)]) {
+    let code = |width: u32, before: u32| match width.abs_diff(before) {
+        0 => 0,
+        1 if width > before => 1,
+        1 => 2,
+        _ => 3,
+    };
+    for group in headers.chunks(GROUP) {
+        for &(order, _, _) in group {
+            w.put(2 - order, 1);
+        }
+        for &(_, width, before) in group {
+            w.put(code(width, before), 2);
+        }
     }
-    for &(_, width, before) in group {
-        let code = match width.abs_diff(before) {
-            0 => 0,
-            1 if width > before => 1,
-            1 => 2,
-            _ => 3,
-        };
-        w.put(code, 2);
-    }
-    for &(_, width, before) in group {
-        if width.abs_diff(before) > 1 {
+    for &(_, width, before) in headers {
+        if code(width, before) == 3 {
             w.put(width, WIDTH_BITS);
         }
     }
@@ -1184,28 +1198,30 @@ pub(crate) struct HeaderGroup {
     pub width: u64,
     /// 1 where the prediction order is 1, 0 where it is 2.
     pub order1: u64,
-    /// Bits of the group.
-    pub bits: usize,
+    /// The widths it took from the widths coded whole.
+    pub whole: usize,
 }
 
-/// [`put_header_group`]'s group of `k` components in the low bits of `v`,
-/// with the components' widths before in the bytes of `before` (each at
-/// most 63; 0 in bytes `k..`, which stay 0): eight lanes at a time in the
-/// bytes of a `u64`, by shifts, masks and adds, and a step per width coded
-/// whole. The one rule of the reference reader and of both decoders.
+/// The headers of a group of `k` components ([`put_headers`]): its fixed
+/// part in the low bits of `fixed`, the widths coded whole from the low
+/// bits of `tails` on, the components' widths before in the bytes of
+/// `before` (each at most 63; 0 in bytes `k..`, which stay 0). Eight
+/// lanes at a time in the bytes of a `u64`, by shifts, masks and adds, and
+/// a step per width coded whole: the one rule of the reference reader and
+/// of both decoders.
 #[inline(always)]
-pub(crate) fn header_group(v: u64, k: usize, before: u64) -> HeaderGroup {
+pub(crate) fn header_group(fixed: u64, tails: u64, k: usize, before: u64) -> HeaderGroup {
     debug_assert!((1..=GROUP).contains(&k));
-    let order1 = spread1(v & ((1 << k) - 1));
-    let code = spread2((v >> k) & ((1 << (2 * k)) - 1));
+    let order1 = spread1(fixed & ((1 << k) - 1));
+    let code = spread2((fixed >> k) & ((1 << (2 * k)) - 1));
     let (lo, hi) = (code & BYTES, (code >> 1) & BYTES);
     let whole = lo & hi;
     // Codes 1 and 2 (one more, one less), each byte kept from its
     // neighbours by a top bit set before and cleared after.
     let top = 0x80 * BYTES;
     let near = (((before | top) + (lo ^ whole)) - (hi ^ whole)) ^ top;
-    // Code 3: the widths after the codes, one per such lane in order.
-    let (mut given, mut tails, mut lanes) = (0, v >> (3 * k), whole);
+    // Code 3: the widths coded whole, one per such lane in order.
+    let (mut given, mut tails, mut lanes) = (0, tails, whole);
     while lanes != 0 {
         given |= (tails & ((1 << WIDTH_BITS) - 1)) << lanes.trailing_zeros();
         tails >>= WIDTH_BITS;
@@ -1214,7 +1230,7 @@ pub(crate) fn header_group(v: u64, k: usize, before: u64) -> HeaderGroup {
     HeaderGroup {
         width: (near & !(0xff * whole)) | given,
         order1,
-        bits: 3 * k + WIDTH_BITS as usize * whole.count_ones() as usize,
+        whole: whole.count_ones() as usize,
     }
 }
 
@@ -1248,8 +1264,7 @@ impl Packed {
             if s % block == 0 {
                 block_at.push(bit_offset(w.bits)?);
             }
-            // Headers in groups of 8 components with headers.
-            let mut group = Vec::with_capacity(GROUP);
+            let mut headers = Vec::with_capacity(chosen.len());
             for (l, &(order, wd)) in chosen.iter().enumerate() {
                 if wd >= 1 << WIDTH_BITS {
                     return err("a residual needs more than 31 bits");
@@ -1262,16 +1277,10 @@ impl Packed {
                 } else {
                     widths[l]
                 };
-                group.push((order, wd, before));
+                headers.push((order, wd, before));
                 widths[l] = wd;
-                if group.len() == GROUP {
-                    put_header_group(&mut w, &group);
-                    group.clear();
-                }
             }
-            if !group.is_empty() {
-                put_header_group(&mut w, &group);
-            }
+            put_headers(&mut w, &headers);
             if s % block == 0 {
                 for (l, x) in lanes.iter().enumerate() {
                     w.put(zigzag(code(x, s, 2, block)), u32::from(abs_bits[l]));
@@ -1479,6 +1488,9 @@ impl Packed {
         orders: &mut [u32],
     ) -> Result<(), PackError> {
         let block_start = (j * SEGMENT_KEYS).is_multiple_of(self.block);
+        let headed = self.base_width.iter().filter(|&&b| b != FLAT).count();
+        // The groups' fixed parts, then the widths coded whole.
+        let mut at = [*pos, pos.saturating_add(3 * headed)];
         let mut group = [0usize; GROUP];
         let mut k = 0;
         for (l, &base) in self.base_width.iter().enumerate() {
@@ -1492,29 +1504,34 @@ impl Packed {
             group[k] = l;
             k += 1;
             if k == GROUP {
-                self.header_group_at(j, &group, pos, widths, orders)?;
+                self.header_group_at(j, &group, &mut at, widths, orders)?;
                 k = 0;
             }
         }
         if k > 0 {
-            self.header_group_at(j, &group[..k], pos, widths, orders)?;
+            self.header_group_at(j, &group[..k], &mut at, widths, orders)?;
+        }
+        *pos = at[1];
+        if *pos > self.stream_len * 8 {
+            return ends_early();
         }
         Ok(())
     }
 
     /// The headers of the components `group` (lanes, at most [`GROUP`]) of
-    /// segment `j` at bit `pos`, coded against `widths`: their orders and
-    /// widths, checked.
+    /// segment `j`, its fixed part at bit `at[0]` and its widths coded
+    /// whole from `at[1]` on (both advanced), coded against `widths`: their
+    /// orders and widths, checked.
     fn header_group_at(
         &self,
         j: usize,
         group: &[usize],
-        pos: &mut usize,
+        at: &mut [usize; 2],
         widths: &mut [u32],
         orders: &mut [u32],
     ) -> Result<(), PackError> {
         let bits = self.stream_len * 8;
-        if *pos > bits {
+        if at[1] > bits {
             return ends_early();
         }
         let mut before = [0u8; GROUP];
@@ -1523,8 +1540,8 @@ impl Packed {
             // out of range below.
             *b = widths[l].min(63) as u8;
         }
-        let v = window(&self.stream, *pos);
-        let read = header_group(v, group.len(), u64::from_le_bytes(before));
+        let (fixed, tails) = (window(&self.stream, at[0]), window(&self.stream, at[1]));
+        let read = header_group(fixed, tails, group.len(), u64::from_le_bytes(before));
         let (width, order1) = (read.width.to_le_bytes(), read.order1.to_le_bytes());
         for (i, &l) in group.iter().enumerate() {
             if width[i] >= 1 << WIDTH_BITS {
@@ -1532,11 +1549,8 @@ impl Packed {
             }
             (orders[l], widths[l]) = (2 - u32::from(order1[i]), u32::from(width[i]));
         }
-        let used = read.bits;
-        *pos += used;
-        if *pos > bits {
-            return ends_early();
-        }
+        at[0] += 3 * group.len();
+        at[1] += WIDTH_BITS as usize * read.whole;
         Ok(())
     }
 
@@ -1652,11 +1666,12 @@ pub(crate) mod store;
 
 #[cfg(test)]
 mod tests {
-    use super::{BitWriter, GROUP, header_group, put_header_group, width_lanes};
+    use super::{BitWriter, GROUP, WIDTH_BITS, header_group, put_headers, width_lanes};
     use tcb_core::simd::w8::I8;
 
-    /// Groups of 1 to 8 headers, as written, read back on both lane types:
-    /// every code, up to 8 widths coded whole (their tails past bit 32).
+    /// Headers of 1 to 24 components (up to 3 groups), as written, read
+    /// back group by group: every code, up to 8 widths coded whole in a
+    /// group (their tails past bit 32).
     #[test]
     fn a_header_group_reads_back_as_written() {
         let mut seed = 0x9e37_79b9_u32;
@@ -1667,8 +1682,8 @@ mod tests {
             seed % m
         };
         for case in 0..4000 {
-            let k = 1 + case % GROUP;
-            let group: Vec<(u32, u32, u32)> = (0..k)
+            let n = 1 + case % (3 * GROUP);
+            let headers: Vec<(u32, u32, u32)> = (0..n)
                 .map(|_| {
                     let before = next(32);
                     let width = match next(4) {
@@ -1686,22 +1701,28 @@ mod tests {
                 bits: 0,
             };
             w.put(next(1 << 9), 9);
-            put_header_group(&mut w, &group);
+            put_headers(&mut w, &headers);
             let written = w.bits - 9;
             w.put(u32::MAX, 32);
             let words = super::to_words(&w.bytes);
-            let v = super::window(&words, 9);
-            let mut before = [0; 8];
-            for (b, h) in before.iter_mut().zip(&group) {
-                *b = h.2 as u8;
+            let mut at = [9, 9 + 3 * n];
+            for group in headers.chunks(GROUP) {
+                let k = group.len();
+                let mut before = [0; 8];
+                for (b, h) in before.iter_mut().zip(group) {
+                    *b = h.2 as u8;
+                }
+                let (fixed, tails) = (super::window(&words, at[0]), super::window(&words, at[1]));
+                let read = header_group(fixed, tails, k, u64::from_le_bytes(before));
+                let (o, wd) = (read.order1.to_le_bytes(), read.width.to_le_bytes());
+                for (i, h) in group.iter().enumerate() {
+                    assert_eq!((o[i], wd[i]), ((2 - h.0) as u8, h.1 as u8), "{headers:?}");
+                }
+                assert!(wd[k..].iter().all(|&x| x == 0), "padding of {headers:?}");
+                at[0] += 3 * k;
+                at[1] += WIDTH_BITS as usize * read.whole;
             }
-            let read = header_group(v, k, u64::from_le_bytes(before));
-            assert_eq!(read.bits, written, "bits of {group:?}");
-            let (o, wd) = (read.order1.to_le_bytes(), read.width.to_le_bytes());
-            for (i, h) in group.iter().enumerate() {
-                assert_eq!((o[i], wd[i]), ((2 - h.0) as u8, h.1 as u8), "{group:?}");
-            }
-            assert!(wd[k..].iter().all(|&x| x == 0), "padding of {group:?}");
+            assert_eq!(at[1] - 9, written, "bits of {headers:?}");
         }
     }
 
@@ -1711,11 +1732,11 @@ mod tests {
     fn a_header_group_out_of_range_shows() {
         // Three lanes: one less than 0, one more than 31, the same 5.
         let v = (2 << 3) | (1 << 5);
-        let read = header_group(v, 3, u64::from_le_bytes([0, 31, 5, 0, 0, 0, 0, 0]));
+        let read = header_group(v, 0, 3, u64::from_le_bytes([0, 31, 5, 0, 0, 0, 0, 0]));
         let wd = read.width.to_le_bytes();
         assert!(wd[0] > 31 && wd[1] > 31, "{wd:?}");
         assert_eq!(wd[2..], [5, 0, 0, 0, 0, 0]);
-        assert_eq!(read.bits, 9);
+        assert_eq!(read.whole, 0);
     }
 
     /// The low bits and the bias of every width, on each lane type.

@@ -58,8 +58,8 @@ pub(crate) struct PackedKeys {
     /// [`FLAT`](super::FLAT)), in the stream's order.
     pub headed: Vec<u32>,
     /// Their base widths, then 0 to a multiple of [`GROUP`], then the two
-    /// entries of [`Headers::code`] no header writes (a stored lane without
-    /// headers, and a lane not stored) and 3 bytes of padding.
+    /// entries of [`Headers`] no header writes (a stored lane without
+    /// headers, and a lane not stored).
     pub headed_base: Vec<u8>,
     /// Per plane, the entry of [`Headers`] each lane's coding is: its
     /// index in `headed`, or one of the two last entries.
@@ -103,7 +103,8 @@ impl PackedKeys {
     /// Heap bytes: the stream and its tables (once per clip) and the rest.
     pub fn heap_bytes(&self) -> usize {
         self.packed.stream_bytes()
-            + 4 * (self.lane_slot.len() + self.headed.len() + self.headed_base.len())
+            + 4 * (self.lane_slot.len() + self.headed.len())
+            + self.headed_base.len()
             + 32 * self.plane_index.len()
             + 32 * (self.step.len() + 4 * self.weights.len() + self.table.len())
             + 128 * self.start_gather.len()
@@ -333,7 +334,6 @@ impl PackedKeys {
         for &slot in &self.lane_slot {
             coding[slot as usize / 8].trend[slot as usize % 8] = -1;
         }
-        let groups = self.headed.len().div_ceil(GROUP);
         PackCache {
             cur: usize::MAX,
             valid: 0,
@@ -341,8 +341,7 @@ impl PackedKeys {
             pos: 0,
             headers: Headers {
                 code: self.headed_base.clone(),
-                start: vec![0; self.headed_base.len()],
-                carry: vec![0; groups + 1],
+                entry: self.headed_base.iter().map(|&b| i32::from(b)).collect(),
             },
             coding,
             x0: vec![i32x8::ZERO; np],
@@ -467,9 +466,8 @@ impl PackCache {
             // `pos`, and `last` is `pos` plus the sum over all; lanes
             // without headers start at `pos` with width 0), which is 32
             // bits before the stream's end and below i32::MAX; every
-            // index of `plane_index` is below `headed_base`'s length less
-            // 3, the length of `headers.code` and `headers.start`, and its
-            // eighth below `headers.carry`'s (`compile::packed`).
+            // index of `plane_index` is below the length of `headed_base`
+            // (`compile::packed`), which `headers.entry` has.
             #[allow(unsafe_code)]
             unsafe {
                 v3::predict_gathered_here(g, &self.headers, pos, &mut self.x0, &mut self.x1, rows);
@@ -502,11 +500,8 @@ impl PackCache {
         for &p in &g.stored_planes {
             let c = &mut self.coding[p as usize];
             for (l, &i) in g.plane_index[p as usize].iter().enumerate() {
-                let i = i as usize;
-                let code = i32::from(h.code[i]);
-                c.width[l] = code & 31;
-                c.trend[l] = (code >> 5) - 1;
-                c.start[l] = h.carry[i / GROUP] + i32::from(h.start[i]);
+                let e = h.entry[i as usize];
+                (c.width[l], c.trend[l], c.start[l]) = (e & 31, ((e >> 5) & 1) - 1, e >> 6);
             }
         }
     }
@@ -579,13 +574,13 @@ impl PackCache {
 /// entries of `PackedKeys::headed_base`).
 #[derive(Clone, Debug)]
 pub(crate) struct Headers {
-    /// The residuals' width, plus 32 where the prediction order is 1 (the
-    /// last value) rather than 2 (the line through the last two).
+    /// The residuals' width (what the next segment's codes are against).
     code: Vec<u8>,
-    /// The sum of the widths before it in its group.
-    start: Vec<u8>,
-    /// Per group, the sum of the widths before it (then a 0).
-    carry: Vec<i32>,
+    /// The width, plus 32 where the prediction order is 1 (the last value)
+    /// rather than 2 (the line through the last two), plus 64 times the sum
+    /// of the widths before it: what a plane's lane finds at its
+    /// `PackedKeys::plane_index`.
+    entry: Vec<i32>,
 }
 
 impl Headers {
@@ -594,24 +589,32 @@ impl Headers {
     /// them, the sum of the widths, and whether each is at most
     /// [`GATHER_WIDTH`].
     #[inline(always)]
-    fn read(&mut self, words: &[u64], mut pos: usize, headed: usize) -> (usize, usize, bool) {
+    fn read(&mut self, words: &[u64], pos: usize, headed: usize) -> (usize, usize, bool) {
         let (mut sum, mut wide) = (0usize, 0u64);
-        for (group, at) in (0..headed).step_by(GROUP).enumerate() {
+        // The groups' fixed parts, then the widths coded whole.
+        let mut tail = pos + 3 * headed;
+        for at in (0..headed).step_by(GROUP) {
             let k = (headed - at).min(GROUP);
             let lanes = at..at + GROUP;
             let code = &mut self.code[lanes.clone()];
-            let before = u64::from_le_bytes(code.try_into().expect("8 lanes")) & (31 * BYTES);
-            let read = header_group(window(words, pos), k, before);
-            pos += read.bits;
-            code.copy_from_slice(&(read.width | (read.order1 << 5)).to_le_bytes());
+            let before = u64::from_le_bytes(code.try_into().expect("8 lanes"));
+            let fixed = window(words, pos + 3 * at);
+            let read = header_group(fixed, window(words, tail), k, before);
+            tail += super::WIDTH_BITS as usize * read.whole;
+            code.copy_from_slice(&read.width.to_le_bytes());
             // The sums of the widths up to each byte (at most 248).
             let sums = read.width.wrapping_mul(BYTES);
-            self.start[lanes].copy_from_slice(&(sums << 8).to_le_bytes());
-            self.carry[group] = sum as i32;
+            let (code, start) = ((read.width | (read.order1 << 5)), sums << 8);
+            let entries: &mut [i32; GROUP] = (&mut self.entry[lanes]).try_into().expect("8 lanes");
+            for (i, e) in entries.iter_mut().enumerate() {
+                let byte = |x: u64| ((x >> (8 * i)) & 0xff) as i32;
+                *e = byte(code) | ((sum as i32 + byte(start)) << 6);
+            }
             sum += (sums >> 56) as usize;
             // A top bit where a width is above GATHER_WIDTH.
             wide |= read.width + (0x80 - 1 - u64::from(GATHER_WIDTH)) * BYTES;
         }
+        let pos = tail;
         (pos, sum, wide & (0x80 * BYTES) == 0)
     }
 }
@@ -724,8 +727,7 @@ mod v3 {
     /// # Safety
     ///
     /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
-    /// has `i + 4` at most the length of `h.code` and of `h.start` and `i /
-    /// 8` below the length of `h.carry`, and for every lane the sum of the
+    /// is below the length of `h.entry`, and for every lane the sum of the
     /// widths before it and its own, times `k`, plus `base` is
     /// at most `64 * g.packed.stream.len() - 32` and below `i32::MAX`
     /// (each gather reads 4 bytes from the byte of a lane's bit).
@@ -846,23 +848,15 @@ mod v3 {
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
         let base = _mm256_set1_epi32(base);
         let keys = _mm256_set1_epi32((rows.len() / np) as i32);
-        let byte = _mm256_set1_epi32(0xff);
-        // SAFETY (the gathers): the caller's, every index inside.
-        let at = |v: &[u8], index: __m256i| {
-            #[allow(unsafe_code)]
-            let x = unsafe { _mm256_i32gather_epi32::<1>(v.as_ptr().cast(), index) };
-            I8(bytemuck::cast(_mm256_and_si256(x, byte)))
-        };
         for &p in &g.stored_planes {
             let p = p as usize;
-            let index = m(g.plane_index[p]);
-            let code = at(&h.code, index);
-            let width = code & I8([31; 8]);
-            let trend = code.shr_logical::<5>() - I8([1; 8]);
-            let group = _mm256_srli_epi32::<3>(index);
+            // SAFETY: the caller's, every index inside `h.entry`.
             #[allow(unsafe_code)]
-            let carry = unsafe { _mm256_i32gather_epi32::<4>(h.carry.as_ptr(), group) };
-            let start = _mm256_add_epi32(carry, m(at(&h.start, index).0));
+            let e = unsafe { _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p])) };
+            let e = I8(bytemuck::cast(e));
+            let start = m(e.shr_logical::<6>().0);
+            let width = e & I8([31; 8]);
+            let trend = (e.shr_logical::<5>() & I8([1; 8])) - I8([1; 8]);
             let (low, bias) = width_lanes(width);
             let code = [trend, low, bias];
             let width = m(width.0);
