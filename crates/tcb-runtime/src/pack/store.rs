@@ -340,7 +340,7 @@ impl PackedKeys {
             seg: usize::MAX,
             pos: 0,
             headers: Headers {
-                code: self.headed_base.clone(),
+                width: self.headed_base.clone(),
                 entry: self.headed_base.iter().map(|&b| i32::from(b)).collect(),
             },
             coding,
@@ -416,7 +416,7 @@ impl PackCache {
         };
         if block {
             // A block's first headers code against the lanes' base widths.
-            self.headers.code.copy_from_slice(&g.headed_base);
+            self.headers.width.copy_from_slice(&g.headed_base);
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         // A block's first two keys come from its start values and deltas.
@@ -446,15 +446,12 @@ impl PackCache {
             let rows: &mut [i32] = bytemuck::cast_slice_mut(&mut self.rows);
             let base = (BEFORE + first) * stride;
             let mut at = pos;
-            for (&c, &slot) in self.headers.code.iter().zip(&g.headed) {
-                let w = c & 31;
+            for (&w, &slot) in self.headers.width.iter().zip(&g.headed) {
                 if w > 0 {
                     UNPACK[w as usize](words, at, &mut rows[base + slot as usize..], stride);
                     at += w as usize * (keys - first);
                 }
             }
-        }
-        if !gather {
             self.plane_codings(g);
         }
         let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
@@ -570,12 +567,12 @@ impl PackCache {
 }
 
 /// What a segment's headers say of the stream's lanes with headers
-/// (`PackedKeys::headed`, in groups of [`GROUP`]), a byte each (then the
-/// entries of `PackedKeys::headed_base`).
+/// (`PackedKeys::headed`, in groups of [`GROUP`]; then the two entries of
+/// `PackedKeys::headed_base` no header writes).
 #[derive(Clone, Debug)]
 pub(crate) struct Headers {
     /// The residuals' width (what the next segment's codes are against).
-    code: Vec<u8>,
+    width: Vec<u8>,
     /// The width, plus 32 where the prediction order is 1 (the last value)
     /// rather than 2 (the line through the last two), plus 64 times the sum
     /// of the widths before it: what a plane's lane finds at its
@@ -596,12 +593,12 @@ impl Headers {
         for at in (0..headed).step_by(GROUP) {
             let k = (headed - at).min(GROUP);
             let lanes = at..at + GROUP;
-            let code = &mut self.code[lanes.clone()];
-            let before = u64::from_le_bytes(code.try_into().expect("8 lanes"));
+            let width = &mut self.width[lanes.clone()];
+            let before = u64::from_le_bytes(width.try_into().expect("8 lanes"));
             let fixed = window(words, pos + 3 * at);
             let read = header_group(fixed, window(words, tail), k, before);
             tail += super::WIDTH_BITS as usize * read.whole;
-            code.copy_from_slice(&read.width.to_le_bytes());
+            width.copy_from_slice(&read.width.to_le_bytes());
             // The sums of the widths up to each byte (at most 248).
             let sums = read.width.wrapping_mul(BYTES);
             let (code, start) = ((read.width | (read.order1 << 5)), sums << 8);
@@ -614,8 +611,7 @@ impl Headers {
             // A top bit where a width is above GATHER_WIDTH.
             wide |= read.width + (0x80 - 1 - u64::from(GATHER_WIDTH)) * BYTES;
         }
-        let pos = tail;
-        (pos, sum, wide & (0x80 * BYTES) == 0)
+        (tail, sum, wide & (0x80 * BYTES) == 0)
     }
 }
 
