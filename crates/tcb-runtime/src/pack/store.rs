@@ -425,7 +425,15 @@ impl PackCache {
         // (its first residual lies that many times `keys - first` bits
         // after the residuals' start: the AVX2 instance's gather).
         let (before, narrow);
-        (pos, before, narrow) = self.headers.read(words, pos, g.headed.len());
+        #[cfg(target_arch = "x86_64")]
+        let read = if crate::isa::avx2() {
+            v3::headers_here(&mut self.headers, words, pos, g.headed.len())
+        } else {
+            self.headers.read(words, pos, g.headed.len())
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let read = self.headers.read(words, pos, g.headed.len());
+        (pos, before, narrow) = read;
         if block {
             let written = self.block_start(g, &mut pos, keys);
             debug_assert_eq!(written, first);
@@ -697,6 +705,26 @@ mod v3 {
     #[target_feature(enable = "avx2,fma")]
     fn tangents(keys: [&[f32x8]; 4], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
         interior_tangents::<W8>(keys, weights, m0, m1);
+    }
+
+    /// [`Headers::read`] compiled for AVX2.
+    #[inline(always)]
+    pub(super) fn headers_here(
+        h: &mut Headers,
+        words: &[u64],
+        pos: usize,
+        headed: usize,
+    ) -> (usize, usize, bool) {
+        debug_assert!(crate::isa::avx2());
+        #[allow(unsafe_code)]
+        unsafe {
+            headers(h, words, pos, headed)
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn headers(h: &mut Headers, words: &[u64], pos: usize, headed: usize) -> (usize, usize, bool) {
+        h.read(words, pos, headed)
     }
 
     /// [`rebuild_rows`] in AVX2.
