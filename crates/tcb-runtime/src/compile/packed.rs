@@ -284,19 +284,10 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         .filter(|(_, base)| **base != crate::pack::FLAT)
         .map(|(slot, base)| (*slot, *base))
         .unzip();
-    // Groups of 8, then the entries of a stored lane without headers
-    // (width 0, order 2) and of a lane not stored (order 1, as the decoder
-    // has always had it; its values are not read) (`store::Headers`).
-    let (flat, none) = {
-        let padded = headed.len().next_multiple_of(GROUP);
-        headed_base.resize(padded, 0);
-        headed_base.extend([0, 32]);
-        (padded as i32, padded as i32 + 1)
-    };
-    let mut plane_index = vec![[none; 8]; np];
-    for &slot in &lane_slot {
-        plane_index[slot as usize / 8][slot as usize % 8] = flat;
-    }
+    // Groups of 8; the entry after them stays 0 (`store::Headers`): where
+    // lanes without headers, and lanes not stored, find their coding.
+    headed_base.resize(headed.len().next_multiple_of(GROUP), 0);
+    let mut plane_index = vec![[headed_base.len() as i32; 8]; np];
     for (i, &slot) in headed.iter().enumerate() {
         plane_index[slot as usize / 8][slot as usize % 8] = i as i32;
     }

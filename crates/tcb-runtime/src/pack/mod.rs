@@ -893,6 +893,10 @@ pub(crate) trait BitLanes:
 {
     const ZERO: Self;
     const ONE: Self;
+    /// `x` in every lane.
+    fn splat(x: i32) -> Self;
+    /// Each lane shifted right by `N` bits, as unsigned.
+    fn shr<const N: u32>(self) -> Self;
     /// Each lane shifted right by one bit, as unsigned.
     fn half(self) -> Self;
     /// Each lane shifted left by the bits in the same lane of `n` (0 to
@@ -906,8 +910,16 @@ impl BitLanes for i32 {
     const ZERO: i32 = 0;
     const ONE: i32 = 1;
     #[inline(always)]
+    fn splat(x: i32) -> i32 {
+        x
+    }
+    #[inline(always)]
+    fn shr<const N: u32>(self) -> i32 {
+        ((self as u32) >> N) as i32
+    }
+    #[inline(always)]
     fn half(self) -> i32 {
-        ((self as u32) >> 1) as i32
+        self.shr::<1>()
     }
     #[inline(always)]
     fn shl_each(self, n: i32) -> i32 {
@@ -923,9 +935,17 @@ impl BitLanes for wide::i32x8 {
     const ZERO: Self = wide::i32x8::ZERO;
     const ONE: Self = wide::i32x8::ONE;
     #[inline(always)]
-    fn half(self) -> Self {
+    fn splat(x: i32) -> Self {
+        wide::i32x8::splat(x)
+    }
+    #[inline(always)]
+    fn shr<const N: u32>(self) -> Self {
         let u: wide::u32x8 = bytemuck::cast(self);
-        bytemuck::cast(u >> 1)
+        bytemuck::cast(u >> N)
+    }
+    #[inline(always)]
+    fn half(self) -> Self {
+        self.shr::<1>()
     }
     #[inline(always)]
     fn shl_each(self, n: Self) -> Self {
@@ -941,6 +961,14 @@ impl BitLanes for wide::i32x8 {
 impl BitLanes for tcb_core::simd::w8::I8 {
     const ZERO: Self = tcb_core::simd::w8::I8([0; 8]);
     const ONE: Self = tcb_core::simd::w8::I8([1; 8]);
+    #[inline(always)]
+    fn splat(x: i32) -> Self {
+        tcb_core::simd::w8::I8([x; 8])
+    }
+    #[inline(always)]
+    fn shr<const N: u32>(self) -> Self {
+        self.shr_logical::<N>()
+    }
     #[inline(always)]
     fn half(self) -> Self {
         self.shr_logical::<1>()
@@ -1126,12 +1154,24 @@ fn base_widths(chosen: &[Vec<(u32, u32)>], every: usize, lanes: usize) -> Vec<u8
         .collect()
 }
 
-/// Bits of a lane's width code in a header group ([`put_header_group`])
-/// for `width` after `before` (the order bit aside).
-fn width_code_bits(width: u32, before: u32) -> usize {
+/// A component's width code ([`put_headers`]) for `width` after `before`:
+/// 0 the same, 1 one more, 2 one less, 3 another (given whole).
+fn width_code(width: u32, before: u32) -> u32 {
     match width.abs_diff(before) {
-        0 | 1 => 2,
-        _ => 2 + WIDTH_BITS as usize,
+        0 => 0,
+        1 if width > before => 1,
+        1 => 2,
+        _ => 3,
+    }
+}
+
+/// Bits of [`width_code`] for `width` after `before`, with the width
+/// given whole (the order bit aside).
+fn width_code_bits(width: u32, before: u32) -> usize {
+    2 + if width_code(width, before) == 3 {
+        WIDTH_BITS as usize
+    } else {
+        0
     }
 }
 
@@ -1151,22 +1191,16 @@ pub(crate) const GROUP: usize = 8;
 /// lies `3 x` the components before it after the first, so that the groups
 /// read without waiting for each other.
 fn put_headers(w: &mut BitWriter, headers: &[(u32, u32, u32)]) {
-    let code = |width: u32, before: u32| match width.abs_diff(before) {
-        0 => 0,
-        1 if width > before => 1,
-        1 => 2,
-        _ => 3,
-    };
     for group in headers.chunks(GROUP) {
         for &(order, _, _) in group {
             w.put(2 - order, 1);
         }
         for &(_, width, before) in group {
-            w.put(code(width, before), 2);
+            w.put(width_code(width, before), 2);
         }
     }
     for &(_, width, before) in headers {
-        if code(width, before) == 3 {
+        if width_code(width, before) == 3 {
             w.put(width, WIDTH_BITS);
         }
     }
@@ -1671,7 +1705,7 @@ mod tests {
 
     /// Headers of 1 to 24 components (up to 3 groups), as written, read
     /// back group by group: every code, up to 8 widths coded whole in a
-    /// group (their tails past bit 32).
+    /// group (40 bits of them).
     #[test]
     fn a_header_group_reads_back_as_written() {
         let mut seed = 0x9e37_79b9_u32;

@@ -32,7 +32,9 @@
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
 
-use super::{BYTES, GROUP, Packed, SEGMENT_KEYS, header_group, read_bits, unzigzag, window};
+use super::{
+    BYTES, BitLanes, GROUP, Packed, SEGMENT_KEYS, header_group, read_bits, unzigzag, window,
+};
 use crate::segment::Segment;
 use std::ops::{Add, BitAnd, Sub};
 use std::sync::Arc;
@@ -57,12 +59,11 @@ pub(crate) struct PackedKeys {
     /// The slots of the stream lanes with headers (not
     /// [`FLAT`](super::FLAT)), in the stream's order.
     pub headed: Vec<u32>,
-    /// Their base widths, then 0 to a multiple of [`GROUP`], then the two
-    /// entries of [`Headers`] no header writes (a stored lane without
-    /// headers, and a lane not stored).
+    /// Their base widths, then 0 to a multiple of [`GROUP`].
     pub headed_base: Vec<u8>,
-    /// Per plane, the entry of [`Headers`] each lane's coding is: its
-    /// index in `headed`, or one of the two last entries.
+    /// Per plane, the entry of [`Headers::entry`] each lane's coding is:
+    /// its index in `headed`, or `headed_base.len()`, an entry that stays 0
+    /// (width 0, order 2: a lane without headers, or not stored).
     pub plane_index: Vec<[i32; 8]>,
     /// Per plane: the quantization step of each lane (0 where not stored).
     pub step: Vec<f32x8>,
@@ -329,11 +330,6 @@ impl PackedKeys {
     /// A cache for [`segment`](Self::segment), per instance.
     pub fn cache(&self) -> PackCache {
         let np = self.planes;
-        // Lanes without headers keep width 0 on the line (order 2).
-        let mut coding = vec![PlaneCoding::default(); np];
-        for &slot in &self.lane_slot {
-            coding[slot as usize / 8].trend[slot as usize % 8] = -1;
-        }
         PackCache {
             cur: usize::MAX,
             valid: 0,
@@ -341,9 +337,9 @@ impl PackedKeys {
             pos: 0,
             headers: Headers {
                 width: self.headed_base.clone(),
-                entry: self.headed_base.iter().map(|&b| i32::from(b)).collect(),
+                entry: vec![0; self.headed_base.len() + 1],
             },
-            coding,
+            coding: vec![PlaneCoding::default(); np],
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
             rows: vec![f32x8::ZERO; ROWS * np],
@@ -471,8 +467,8 @@ impl PackCache {
             // `pos`, and `last` is `pos` plus the sum over all; lanes
             // without headers start at `pos` with width 0), which is 32
             // bits before the stream's end and below i32::MAX; every
-            // index of `plane_index` is below the length of `headed_base`
-            // (`compile::packed`), which `headers.entry` has.
+            // index of `plane_index` is at most the length of
+            // `headed_base` (`compile::packed`), below `headers.entry`'s.
             #[allow(unsafe_code)]
             unsafe {
                 v3::predict_gathered_here(g, &self.headers, pos, &mut self.x0, &mut self.x1, rows);
@@ -499,15 +495,19 @@ impl PackCache {
         self.pos = last;
     }
 
-    /// Each stored plane's coding from the headers.
+    /// Each stored plane's coding from the headers ([`entry_fields`]).
     fn plane_codings(&mut self, g: &PackedKeys) {
         let h = &self.headers;
         for &p in &g.stored_planes {
-            let c = &mut self.coding[p as usize];
-            for (l, &i) in g.plane_index[p as usize].iter().enumerate() {
-                let e = h.entry[i as usize];
-                (c.width[l], c.trend[l], c.start[l]) = (e & 31, ((e >> 5) & 1) - 1, e >> 6);
+            let mut e = [0; 8];
+            for (e, &i) in e.iter_mut().zip(&g.plane_index[p as usize]) {
+                *e = h.entry[i as usize];
             }
+            let [width, trend, _] = entry_fields(i32x8::new(e));
+            self.coding[p as usize] = PlaneCoding {
+                trend: trend.to_array(),
+                width: width.to_array(),
+            };
         }
     }
 
@@ -581,11 +581,29 @@ impl PackCache {
 pub(crate) struct Headers {
     /// The residuals' width (what the next segment's codes are against).
     width: Vec<u8>,
-    /// The width, plus 32 where the prediction order is 1 (the last value)
-    /// rather than 2 (the line through the last two), plus 64 times the sum
-    /// of the widths before it: what a plane's lane finds at its
-    /// `PackedKeys::plane_index`.
+    /// [`entry`]: what a plane's lane finds at its
+    /// `PackedKeys::plane_index` (then one entry that stays 0).
     entry: Vec<i32>,
+}
+
+/// A lane's entry in [`Headers::entry`]: its width (at most 31), `order1`
+/// (1 where the prediction order is 1, the last value; 0 for 2, the line
+/// through the last two) and its first bit in the segment (the sum of the
+/// widths before it, below 2^25: `pack::MAX_LANES`).
+#[inline(always)]
+fn entry(width: i32, order1: i32, start: i32) -> i32 {
+    width | (order1 << 5) | (start << 6)
+}
+
+/// [`entry`] undone in each lane: `[width, trend, start]`, `trend` -1 for
+/// order 2 and 0 for order 1 (as [`predict`] takes it).
+#[inline(always)]
+fn entry_fields<I: BitLanes>(e: I) -> [I; 3] {
+    [
+        e & I::splat(31),
+        (e.shr::<5>() & I::ONE) - I::ONE,
+        e.shr::<6>(),
+    ]
 }
 
 impl Headers {
@@ -609,11 +627,15 @@ impl Headers {
             width.copy_from_slice(&read.width.to_le_bytes());
             // The sums of the widths up to each byte (at most 248).
             let sums = read.width.wrapping_mul(BYTES);
-            let (code, start) = ((read.width | (read.order1 << 5)), sums << 8);
+            let start = sums << 8;
             let entries: &mut [i32; GROUP] = (&mut self.entry[lanes]).try_into().expect("8 lanes");
             for (i, e) in entries.iter_mut().enumerate() {
                 let byte = |x: u64| ((x >> (8 * i)) & 0xff) as i32;
-                *e = byte(code) | ((sum as i32 + byte(start)) << 6);
+                *e = entry(
+                    byte(read.width),
+                    byte(read.order1),
+                    sum as i32 + byte(start),
+                );
             }
             sum += (sums >> 56) as usize;
             // A top bit where a width is above GATHER_WIDTH.
@@ -631,10 +653,6 @@ struct PlaneCoding {
     trend: [i32; 8],
     /// The residuals' width (0: none stored, the lane on its prediction).
     width: [i32; 8],
-    /// For the AVX2 instance's gather: the sum of the widths of the
-    /// stream's lanes before it (its first residual of the segment lies
-    /// this many times the keys decoded bits after the residuals' start).
-    start: [i32; 8],
 }
 
 /// The widest residual a gather of 32 bits from its first byte holds.
@@ -647,7 +665,8 @@ pub(crate) const GATHER_WIDTH: u32 = 25;
 #[cfg(target_arch = "x86_64")]
 mod v3 {
     use crate::pack::store::{
-        Headers, PackedKeys, Plane, block_start_keys, interior_tangents, predict, rebuild_rows,
+        Headers, PackedKeys, Plane, block_start_keys, entry_fields, interior_tangents, predict,
+        rebuild_rows,
     };
     use crate::pack::{dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
@@ -877,10 +896,8 @@ mod v3 {
             // SAFETY: the caller's, every index inside `h.entry`.
             #[allow(unsafe_code)]
             let e = unsafe { _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p])) };
-            let e = I8(bytemuck::cast(e));
-            let start = m(e.shr_logical::<6>().0);
-            let width = e & I8([31; 8]);
-            let trend = (e.shr_logical::<5>() & I8([1; 8])) - I8([1; 8]);
+            let [width, trend, start] = entry_fields(I8(bytemuck::cast(e)));
+            let start = m(start.0);
             let (low, bias) = width_lanes(width);
             let code = [trend, low, bias];
             let width = m(width.0);
