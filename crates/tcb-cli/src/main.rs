@@ -962,6 +962,19 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
         None => writeln!(out, "skeleton: none")?,
     }
     write_packed_tracks(&mut out, head)?;
+    let blocks = head.keys.div_ceil(packed.block_keys());
+    let factors: Vec<f32> = (0..blocks)
+        .map(|b| head.scales.factor(b * packed.block_keys()))
+        .collect();
+    let (least, most) = factors
+        .iter()
+        .fold((f32::INFINITY, 0.0f32), |(a, b), &f| (a.min(f), b.max(f)));
+    writeln!(
+        out,
+        "blocks: {blocks} of {} keys, the steps times {least} to {most} (mean {:.4})",
+        packed.block_keys(),
+        factors.iter().map(|&f| f64::from(f)).sum::<f64>() / blocks as f64
+    )?;
     writeln!(
         out,
         "stored: {values} values, {} of them in {} bits of stream ({:.2} bits per value; {:.2} for the whole file)",

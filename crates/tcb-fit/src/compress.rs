@@ -15,6 +15,11 @@
 //!    the joints it moves (`(1 / r)^0.5`, r the largest error ratio in its
 //!    subtree), and `kappa` bisected again; the smallest file that holds is
 //!    kept.
+//! 4. Per block of keys, a factor on every step of the grid
+//!    ([`tcb_runtime::BlockScales`]), bisected in all blocks at once on the
+//!    error at the check times each block's keys reach: the steps of step
+//!    3 hold in the block where the error is largest, and the others have
+//!    room.
 //!
 //! Nothing is returned that was not measured within the tolerance.
 
@@ -25,7 +30,7 @@ use crate::reduce::{
 use std::sync::Arc;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{SourceClip, TrackKind};
-use tcb_runtime::{KeyValues, Packed};
+use tcb_runtime::{BlockScales, KeyValues, Packed};
 
 /// Options of [`compress`]; `None` takes the contract's default.
 ///
@@ -174,17 +179,27 @@ pub fn compress(
         .collect();
     let reference = Reference::new(clip, skeleton, &times);
     let budget = Budget::new(clip, skeleton, &settings, &largest);
-    let total = 40;
+    let total = 50;
     let mut evaluations = 0usize;
-    let mut measure = |steps: &[f32]| -> Result<Trial, ReduceError> {
+    let mut measure = |steps: &[f32], scales: &BlockScales| -> Result<Trial, ReduceError> {
         evaluations += 1;
         progress(evaluations.min(total - 1), total);
-        let packed = encode(&keys, steps, block)?;
+        let packed = encode(&keys, steps, scales, block)?;
         let compiled = tcb_runtime::Clip::from_packed(Arc::new(packed.clone()))
             .map_err(|e| ReduceError::Build(e.to_string()))?;
         Ok((reference.measure(&settings, &Arc::new(compiled)), packed))
     };
-    let (measured, mut packed) = search(&budget, &mut measure)?;
+    let (trial, steps) = search(&budget, &mut |steps| {
+        measure(steps, &BlockScales::default())
+    })?;
+    // Tracks the shell metric does not see keep their fixed steps: no
+    // factors where there are any.
+    let (measured, mut packed) = if budget.fixed.iter().any(Option::is_some) {
+        trial
+    } else {
+        let blocks = BlockSearch::new(&trial.1, block, &times);
+        blocks.search(trial, &mut |scales| measure(&steps, scales))?
+    };
     progress(total, total);
     packed.note = format!(
         "tcb compress: metric {}, tolerance {:e}, shell {:e}, seek keys {block}, max error {:e} at {} time {}",
@@ -211,11 +226,16 @@ pub fn compress(
 /// A packed clip and its error as measured.
 type Trial = (Measured, Packed);
 
-/// The clip's keys quantized at `steps` (per track) and packed in blocks of
-/// `block` keys.
-fn encode(keys: &KeyValues, steps: &[f32], block: usize) -> Result<Packed, ReduceError> {
+/// The clip's keys quantized at `steps` (per track, the grid's times the
+/// blocks' `scales`) and packed in blocks of `block` keys.
+fn encode(
+    keys: &KeyValues,
+    steps: &[f32],
+    scales: &BlockScales,
+    block: usize,
+) -> Result<Packed, ReduceError> {
     let source = keys
-        .quantize(steps)
+        .quantize_scaled(steps, scales)
         .map_err(|e| ReduceError::Option(e.to_string()))?;
     Packed::encode_with(&source, block)
         .map_err(|e| ReduceError::Option(format!("--seek-keys: {e}")))
@@ -223,20 +243,20 @@ fn encode(keys: &KeyValues, steps: &[f32], block: usize) -> Result<Packed, Reduc
 
 /// Steps 2 and 3: rounds of bisecting kappa, then rebalancing the tracks'
 /// weights by their slack; the smallest file that held, with what was
-/// measured on it. `measure` packs and measures the clip at per-track
-/// steps.
+/// measured on it, and its steps. `measure` packs and measures the clip at
+/// per-track steps.
 fn search(
     budget: &Budget,
     measure: &mut dyn FnMut(&[f32]) -> Result<Trial, ReduceError>,
-) -> Result<Trial, ReduceError> {
+) -> Result<(Trial, Vec<f32>), ReduceError> {
     // Per track a relative weight (rebalanced below) times kappa.
     let mut weight = vec![1.0f64; budget.unit.len()];
-    let mut best: Option<(usize, Measured, Packed)> = None;
+    let mut best: Option<(usize, Measured, Packed, Vec<f32>)> = None;
     for round in 0..ROUNDS {
         // Every round bisects the whole range (later rounds, with weights
         // rebalanced, fewer times).
         let iterations = if round == 0 { 9 } else { 6 };
-        let (m, p) = bisect_kappa(iterations, &|k| budget.steps(k, &weight), measure)?;
+        let (m, p, steps) = bisect_kappa(iterations, &|k| budget.steps(k, &weight), measure)?;
         if m.worst.ratio > 1.0 {
             // Nothing at this round's weights holds: keep the best.
             if best.is_some() {
@@ -249,7 +269,7 @@ fn search(
         }
         let bytes = p.to_bytes().len();
         if best.as_ref().is_none_or(|b| bytes < b.0) {
-            best = Some((bytes, m.clone(), p));
+            best = Some((bytes, m.clone(), p, steps));
         }
         // Rebalance: tracks whose joints have slack get coarser.
         for (t, w) in weight.iter_mut().enumerate() {
@@ -257,8 +277,8 @@ fn search(
             *w *= (1.0 / r.max(0.05)).sqrt().min(4.0);
         }
     }
-    let (_, measured, packed) = best.expect("a round that holds, or an error above");
-    Ok((measured, packed))
+    let (_, measured, packed, steps) = best.expect("a round that holds, or an error above");
+    Ok(((measured, packed), steps))
 }
 
 /// Rounds of bisecting kappa: on CMU 01_01 at ACL's target the file takes
@@ -269,27 +289,124 @@ const ROUNDS: usize = 12;
 
 /// Bisect kappa (log scale, `iterations` times) between one that holds
 /// (0.25 is taken to) and one that does not (64): the last kappa that
-/// held, or, if none did, the clip at 0.25, measured (which may not hold).
+/// held, or, if none did, the clip at 0.25, measured (which may not hold);
+/// with its steps.
 fn bisect_kappa(
     iterations: usize,
     steps_at: &dyn Fn(f64) -> Vec<f32>,
     measure: &mut dyn FnMut(&[f32]) -> Result<Trial, ReduceError>,
-) -> Result<Trial, ReduceError> {
+) -> Result<(Measured, Packed, Vec<f32>), ReduceError> {
     let (mut lo, mut hi) = (0.25f64, 64.0f64);
-    let mut last_ok: Option<Trial> = None;
+    let mut last_ok = None;
     for _ in 0..iterations {
         let mid = (lo * hi).sqrt();
-        let (m, p) = measure(&steps_at(mid))?;
+        let steps = steps_at(mid);
+        let (m, p) = measure(&steps)?;
         if m.worst.ratio <= 1.0 {
             lo = mid;
-            last_ok = Some((m, p));
+            last_ok = Some((m, p, steps));
         } else {
             hi = mid;
         }
     }
     match last_ok {
         Some(x) => Ok(x),
-        None => measure(&steps_at(lo)),
+        None => {
+            let steps = steps_at(lo);
+            let (m, p) = measure(&steps)?;
+            Ok((m, p, steps))
+        }
+    }
+}
+
+/// Step 4: per block of keys a factor on the grid's steps.
+struct BlockSearch {
+    /// Keys per block, and blocks of the grid.
+    block: usize,
+    blocks: usize,
+    /// Per check time, the blocks whose keys it depends on (a time between
+    /// keys `k` and `k + 1` those of keys `k - 1 ..= k + 2`, which make
+    /// the interval's tangents): `first ..= last`.
+    reach: Vec<(usize, usize)>,
+}
+
+/// Rounds of step 4: enough to bisect a code of 8 bits.
+const BLOCK_ROUNDS: usize = 8;
+
+impl BlockSearch {
+    fn new(packed: &Packed, block: usize, times: &[f64]) -> Self {
+        let head = packed.head();
+        let n = head.keys;
+        let reach = times
+            .iter()
+            .map(|&t| {
+                let at = ((t - head.start) / head.interval).floor();
+                // (Clamped: before the first key and after the last, and NaN, at the ends.)
+                let k = if at >= 0.0 {
+                    (at as usize).min(n - 1)
+                } else {
+                    0
+                };
+                (k.saturating_sub(1) / block, (k + 2).min(n - 1) / block)
+            })
+            .collect();
+        BlockSearch {
+            block,
+            blocks: n.div_ceil(block),
+            reach,
+        }
+    }
+
+    /// From `start` (every factor 1, within the tolerance): each block's
+    /// code bisected between one that held (0) and one taken not to (256),
+    /// all blocks in each measured clip, a block failing where a check time
+    /// it reaches is over the tolerance. The smallest clip measured within
+    /// the tolerance is returned.
+    fn search(
+        &self,
+        start: Trial,
+        measure: &mut dyn FnMut(&BlockScales) -> Result<Trial, ReduceError>,
+    ) -> Result<Trial, ReduceError> {
+        let bytes = |t: &Trial| t.1.to_bytes().len();
+        let mut best = (bytes(&start), start);
+        let (mut lo, mut hi) = (vec![0u16; self.blocks], vec![256u16; self.blocks]);
+        let scales = |codes: &[u16]| BlockScales {
+            keys: self.block,
+            codes: codes.iter().map(|&c| c as u8).collect(),
+        };
+        for round in 0..=BLOCK_ROUNDS {
+            // The last round measures what held in every block.
+            let last = round == BLOCK_ROUNDS;
+            let mid: Vec<u16> = if last {
+                lo.clone()
+            } else {
+                lo.iter().zip(&hi).map(|(a, b)| (a + b) / 2).collect()
+            };
+            if mid.iter().all(|c| *c == 0) {
+                break;
+            }
+            let trial = measure(&scales(&mid))?;
+            let mut failed = vec![false; self.blocks];
+            for (&r, &(a, b)) in trial.0.at_time.iter().zip(&self.reach) {
+                if r > 1.0 {
+                    failed[a..=b].fill(true);
+                }
+            }
+            if trial.0.worst.ratio <= 1.0 && bytes(&trial) < best.0 {
+                best = (bytes(&trial), trial);
+            }
+            if last {
+                break;
+            }
+            for b in 0..self.blocks {
+                if failed[b] {
+                    hi[b] = mid[b];
+                } else {
+                    lo[b] = mid[b];
+                }
+            }
+        }
+        Ok(best.1)
     }
 }
 

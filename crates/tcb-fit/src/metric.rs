@@ -80,6 +80,8 @@ pub struct Measured {
     /// Per joint (`shell`) or per track (`value`): the largest error over
     /// the tolerance.
     pub each: Vec<f64>,
+    /// Per check time: the largest error over the tolerance.
+    pub at_time: Vec<f64>,
 }
 
 /// The rest-pose height H of `docs/reduce.md`: the largest distance of any
@@ -117,7 +119,8 @@ pub fn shell_error(
     let (mut ma, mut mb) = (vec![DAffine3::IDENTITY; n], vec![DAffine3::IDENTITY; n]);
     let mut worst = Worst::none();
     let mut each = vec![0.0f64; n];
-    for &t in times {
+    let mut at_time = vec![0.0f64; times.len()];
+    for (&t, at) in times.iter().zip(&mut at_time) {
         // Both bindings were made for their instance's clip, and `local`
         // has a transform per joint.
         bind_a
@@ -132,9 +135,14 @@ pub fn shell_error(
             let e = point_error(&ma[j], &mb[j], radius);
             worst.take(e, e / tolerance, &joint.name, t);
             each[j] = each[j].max(e / tolerance);
+            *at = at.max(e / tolerance);
         }
     }
-    Measured { worst, each }
+    Measured {
+        worst,
+        each,
+        at_time,
+    }
 }
 
 /// `max over v in {0, R e_x, R e_y, R e_z} of |a v - b v|`.
@@ -166,6 +174,7 @@ pub fn value_error(
     let (ra, rb) = (reference_rows, play(reduced, times));
     let mut worst = Worst::none();
     let mut each = vec![0.0f64; reference.tracks().len()];
+    let mut at_time = vec![0.0f64; times.len()];
     for (i, &t) in times.iter().enumerate() {
         let (ya, yb) = (
             &ra[i * channels..(i + 1) * channels],
@@ -183,10 +192,15 @@ pub fn value_error(
             };
             worst.take(e, e / limit, &track.name, t);
             each[k] = each[k].max(e / limit);
+            at_time[i] = at_time[i].max(e / limit);
             at += dim;
         }
     }
-    Measured { worst, each }
+    Measured {
+        worst,
+        each,
+        at_time,
+    }
 }
 
 /// `2 acos(|q . q'|)` in degrees, for quaternions as `[x, y, z, w]`

@@ -239,9 +239,36 @@ pub fn pack(data: &[u8]) {
     let Ok(clip) = input.doc.build() else {
         return;
     };
-    let Ok(mut source) = PackSource::quantize(&clip, &input.steps) else {
+    let Ok(keys) = tcb_runtime::KeyValues::sample(&clip) else {
         return;
     };
+    // Blocks of 16 or 64 keys, with a factor on the steps per block (every
+    // code 0, the one `quantize` gives, is kept as none).
+    let block = if u.arbitrary().unwrap_or(false) {
+        16
+    } else {
+        64
+    };
+    let Ok(plain) = keys.quantize(&input.steps) else {
+        return;
+    };
+    let scales = match u.arbitrary::<bool>() {
+        Ok(true) => {
+            let blocks = plain.keys.div_ceil(block);
+            let codes = (0..blocks).map(|_| u.arbitrary::<u8>().unwrap_or(0));
+            tcb_runtime::BlockScales {
+                keys: block,
+                codes: codes.collect(),
+            }
+        }
+        _ => tcb_runtime::BlockScales::default(),
+    };
+    let Ok(mut source) = keys.quantize_scaled(&input.steps, &scales) else {
+        return;
+    };
+    if source.scales.codes.iter().all(|c| *c == 0) {
+        source.scales = tcb_runtime::BlockScales::default();
+    }
     for (t, tcb) in source.tracks.iter_mut().zip(&input.tcb) {
         t.tcb = *tcb;
     }
@@ -254,12 +281,12 @@ pub fn pack(data: &[u8]) {
             _ => t.settings.match_speed = true,
         }
         assert!(
-            Packed::encode(&source).is_err(),
+            Packed::encode_with(&source, block).is_err(),
             "encoded a track the format cannot hold"
         );
         return;
     }
-    let Ok(packed) = Packed::encode(&source) else {
+    let Ok(packed) = Packed::encode_with(&source, block) else {
         return;
     };
     assert_eq!(

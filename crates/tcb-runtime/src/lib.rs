@@ -77,7 +77,7 @@ pub use compile::CompileOptions;
 pub use instance::{Instance, OutputLength, Playback, PlaybackError};
 pub use isa::{Simd, force_baseline_simd, simd};
 pub use layout::{PoseLayout, TrackId, TrackSlot};
-pub use pack::{KeyValues, PackError, PackSource, PackTrack, Packed};
+pub use pack::{BlockScales, KeyValues, PackError, PackSource, PackTrack, Packed};
 
 /// The `mint` crate (feature `mint`): poses' glam values convert with
 /// `.into()`, so an engine on another glam version, nalgebra or cgmath

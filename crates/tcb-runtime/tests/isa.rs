@@ -130,6 +130,21 @@ fn packed_clips_decode_to_the_same_bits() {
             &times,
         );
     }
+    // Blocks with step factors (every third block at 1 + 40 / 64).
+    let (clip, plain) = common::quantized_cmu();
+    let steps: Vec<f32> = plain.tracks.iter().map(|t| t.step).collect();
+    let blocks = plain.keys.div_ceil(64);
+    let scales = tcb_runtime::BlockScales {
+        keys: 64,
+        codes: (0..blocks)
+            .map(|b| if b % 3 == 1 { 40 } else { 0 })
+            .collect(),
+    };
+    let scaled = tcb_runtime::KeyValues::sample(&clip)
+        .unwrap()
+        .quantize_scaled(&steps, &scales)
+        .unwrap();
+    packed_same_bits("packed cmu, step factors", &scaled, &times);
     // A last block of one key (2 blocks of 64 and key 128): its start
     // value without the delta after it.
     let (_, mut short) = common::quantized_cmu();

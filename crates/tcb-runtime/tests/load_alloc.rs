@@ -53,6 +53,7 @@ fn a_long_constant_clip_loads_in_less_than_its_file() {
         interval: 1.0 / 120.0,
         keys,
         tracks: vec![track],
+        scales: Default::default(),
         loose: Vec::new(),
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();
@@ -107,6 +108,7 @@ fn tracks_on_their_own_key_times_load_in_a_bounded_multiple_of_their_file() {
         interval: 1.0,
         keys: 2,
         tracks: vec![grid],
+        scales: Default::default(),
         loose: vec![own],
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();

@@ -37,6 +37,56 @@ fn packed_cmu_plays_its_reference() {
     assert!(Packed::encode_with(&source, 2048).is_err());
 }
 
+#[test]
+fn blocks_with_step_factors_play_their_reference() {
+    let (clip, _) = cmu();
+    let keys = tcb_runtime::KeyValues::sample(&clip).unwrap();
+    let steps: Vec<f32> = clip
+        .tracks()
+        .iter()
+        .map(|t| {
+            if t.name.ends_with("translation") {
+                1.0 / 256.0
+            } else {
+                1.0 / 16384.0
+            }
+        })
+        .collect();
+    for block in [16, 64] {
+        // Every code somewhere (0 and 255 too), in no order.
+        let blocks = clip.key_times().len().div_ceil(block);
+        let scales = tcb_runtime::BlockScales {
+            keys: block,
+            codes: (0..blocks).map(|b| (b * 97 % 256) as u8).collect(),
+        };
+        assert!(scales.codes.contains(&0) && scales.codes.iter().any(|c| *c > 200));
+        let source = keys.quantize_scaled(&steps, &scales).unwrap();
+        assert_eq!(source.scales, scales);
+        plays_its_reference(&source, block);
+        // The factors are in the file, and blocks of another size refuse them.
+        let packed = Packed::encode_with(&source, block).unwrap();
+        assert_eq!(Packed::from_bytes(&packed.to_bytes()).unwrap(), packed);
+        assert_eq!(packed.decode().unwrap().scales, scales);
+        let e = Packed::encode_with(&source, 2 * block).unwrap_err();
+        assert!(e.to_string().contains("step factors per"), "{e}");
+    }
+    // Coarser steps where the factor is larger: fewer bytes than without.
+    let plain = Packed::encode(&keys.quantize(&steps).unwrap()).unwrap();
+    let coarse = tcb_runtime::BlockScales {
+        keys: 64,
+        codes: vec![64; clip.key_times().len().div_ceil(64)],
+    };
+    let scaled = Packed::encode(&keys.quantize_scaled(&steps, &coarse).unwrap()).unwrap();
+    assert!(scaled.to_bytes().len() < plain.to_bytes().len());
+    // Factors that do not match the keys are refused.
+    let wrong = tcb_runtime::BlockScales {
+        keys: 64,
+        codes: vec![1; 3],
+    };
+    let e = keys.quantize_scaled(&steps, &wrong).unwrap_err();
+    assert!(e.to_string().contains("3 step factors for"), "{e}");
+}
+
 /// The packed clip in blocks of `block` keys against its reference, bit for bit.
 fn plays_its_reference(source: &PackSource, block: usize) {
     let packed = Arc::new(Packed::encode_with(source, block).unwrap());
@@ -152,14 +202,15 @@ fn skeleton_round_trip_and_other_versions() {
         (4, "older"),
         (5, "older"),
         (6, "older"),
-        (8, "newer"),
+        (7, "older"),
+        (9, "newer"),
     ] {
         let mut b = packed.to_bytes();
         b[8..12].copy_from_slice(&version.to_le_bytes());
         let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
         assert!(
             msg.starts_with(&format!(
-                ".tcbc version {version}; this build reads version 7"
+                ".tcbc version {version}; this build reads version 8"
             )) && msg.contains(says)
                 && !msg.contains('\n'),
             "{msg}"
@@ -264,6 +315,7 @@ fn small_tracks_read_back_and_no_tracks_is_refused() {
         interval: 1.0,
         keys: 2,
         tracks: (0..7).map(track).collect(),
+        scales: Default::default(),
         loose: Vec::new(),
     };
     let bytes = Packed::encode(&source).unwrap().to_bytes();
@@ -319,6 +371,7 @@ fn constant_tracks_have_no_headers_and_centers_are_unit() {
             track("a", TrackKind::Vec3, 0),
             track("b", TrackKind::Scalar, 0),
         ],
+        scales: Default::default(),
         loose: Vec::new(),
     };
     let packed = Packed::encode(&zeros).unwrap();

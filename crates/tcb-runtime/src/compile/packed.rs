@@ -185,8 +185,7 @@ fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
     for t in &mut ends.tracks {
         t.values = lanes.by_ref().take(t.stored()).collect();
     }
-    let end_times: Vec<f64> = at.iter().map(|&k| head.time(k)).collect();
-    let reference = ends.reference(&end_times)?;
+    let reference = ends.reference(&at)?;
     let clip = compile_impl(&reference, &CompileOptions::default(), Some(head.place(0)));
     grid_group(&clip, head)?;
     let g = &clip.groups[0];

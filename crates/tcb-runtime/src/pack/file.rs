@@ -9,8 +9,8 @@
 //! key times are not listed, and the block table is read from the file).
 
 use super::{
-    LooseTangents, LooseTrack, MAGIC, PackError, PackSource, PackTrack, Packed, SEGMENT_KEYS,
-    VERSION, check_block, err,
+    BlockScales, LooseTangents, LooseTrack, MAGIC, PackError, PackSource, PackTrack, Packed,
+    SEGMENT_KEYS, VERSION, check_block, err,
 };
 use glam::{Quat, Vec3};
 use tcb_core::params::{Ends, Extrapolation, Hemisphere, RotationMode, TangentRule, Tcb};
@@ -142,15 +142,15 @@ impl<'a> Reader<'a> {
 
     /// The stream of `keys` keys of `lanes` lanes with headers in blocks
     /// of `block` keys: the block table (where each block starts, a `u32`
-    /// each), the stream as words, and its length in bytes. (Where the
-    /// other segments start is not stored: playback reads on from the
-    /// segment before.)
+    /// each), the blocks' step factors, the stream as words, and its length
+    /// in bytes. (Where the other segments start is not stored: playback
+    /// reads on from the segment before.)
     fn stream(
         &mut self,
         keys: usize,
         block: usize,
         lanes: usize,
-    ) -> Result<(Vec<u32>, Vec<u64>, usize), PackError> {
+    ) -> Result<(Vec<u32>, BlockScales, Vec<u64>, usize), PackError> {
         let segments = keys.div_ceil(SEGMENT_KEYS);
         let blocks = keys.div_ceil(block);
         let table = self.take(blocks.saturating_mul(4), "the block table")?;
@@ -163,6 +163,15 @@ impl<'a> Reader<'a> {
                 "{keys} keys in blocks of {block}: the block table's offsets do not start at 0 and increase (the key count or the table is wrong)"
             ));
         }
+        let codes = self.take(blocks, "the blocks' step factors")?;
+        let scales = if codes.iter().all(|c| *c == 0) {
+            BlockScales::default()
+        } else {
+            BlockScales {
+                keys: block,
+                codes: codes.to_vec(),
+            }
+        };
         let len = self.u32("the stream length")? as usize;
         // Every segment spends 3 bits at least per lane with headers on
         // them (an order bit and a width code): a file cannot describe more
@@ -173,7 +182,7 @@ impl<'a> Reader<'a> {
             ));
         }
         let stream = super::to_words(self.take(len, "the stream")?);
-        Ok((block_at, stream, len))
+        Ok((block_at, scales, stream, len))
     }
 
     /// The skeleton section (since version 2): a joint count (0: none), then per
@@ -462,6 +471,10 @@ impl Packed {
         for at in &self.block_at {
             w.u32(*at);
         }
+        // Per block its step factor's code (0s where it has none).
+        for b in 0..self.block_at.len() {
+            w.0.push(h.scales.codes.get(b).copied().unwrap_or(0));
+        }
         let bytes: Vec<u8> = self.stream.iter().flat_map(|x| x.to_le_bytes()).collect();
         w.len(self.stream_len);
         w.0.extend_from_slice(&bytes[..self.stream_len]);
@@ -550,7 +563,7 @@ impl Packed {
         let stored: usize = tracks.iter().map(PackTrack::stored).sum();
         let [abs_bits, delta_bits, base_width] = r.block_widths(stored)?;
         let headed = base_width.iter().filter(|b| **b != super::FLAT).count();
-        let (block_at, stream, len) = r.stream(keys, block, headed)?;
+        let (block_at, scales, stream, len) = r.stream(keys, block, headed)?;
         let loose = r.loose()?;
         let skeleton = r.skeleton()?;
         if r.at != body.len() {
@@ -564,6 +577,7 @@ impl Packed {
                 interval,
                 keys,
                 tracks,
+                scales,
                 loose,
             },
             abs_bits,

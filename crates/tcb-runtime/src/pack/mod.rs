@@ -5,7 +5,8 @@
 //! continuity and bias needs only its values: every interior key's
 //! tangents follow from its two neighbours with constant chord weights
 //! (`tcb_core::tangent::ChordWeights`). A packed clip stores, per track,
-//! one quantization step and the integers `x_k = round(v_k / step)` of each
+//! one quantization step (times a factor per block of keys,
+//! [`BlockScales`]) and the integers `x_k = round(v_k / step)` of each
 //! stored component (rotations: `x y z` with `w >= 0` rebuilt, or all four
 //! where `w` changes sign), coded as
 //!
@@ -79,10 +80,51 @@ pub struct PackSource {
     pub keys: usize,
     /// The tracks on the grid (the stream's), in file order.
     pub tracks: Vec<PackTrack>,
+    /// Per block of keys, a factor on the steps of the grid's tracks.
+    pub scales: BlockScales,
     /// The tracks on key times of their own ([`LooseTrack`]), each at its
     /// place among all the clip's tracks (`at`, increasing); the grid's
     /// tracks fill the other places in order.
     pub loose: Vec<LooseTrack>,
+}
+
+/// Per block of keys, a factor on the step of every track on the grid:
+/// where a block's motion leaves the error room, its keys take coarser
+/// steps (a block starts from absolute values, so its integers need
+/// nothing from the block before). `tcb compress` searches them.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BlockScales {
+    /// Keys per block: the packed clip's blocks ([`Packed::encode_with`]'s
+    /// `block`). Unused with no codes.
+    pub keys: usize,
+    /// Per block its code `c`: the steps times [`scale_factor`]`(c)`.
+    /// Empty: every factor is 1 (a packed clip keeps them empty when every
+    /// code is 0).
+    pub codes: Vec<u8>,
+}
+
+impl BlockScales {
+    /// The factor on the steps of key `k`.
+    pub fn factor(&self, k: usize) -> f32 {
+        let code = match self.keys {
+            0 => 0,
+            keys => self.codes.get(k / keys).copied().unwrap_or(0),
+        };
+        scale_factor(code)
+    }
+}
+
+/// The factor of a block's code: `1 + c / 64` (exact in f32: 1 to 4.98 in
+/// steps of 1/64).
+pub fn scale_factor(code: u8) -> f32 {
+    1.0 + f32::from(code) / 64.0
+}
+
+/// A track's step in a block whose factor is `factor` (f32, one rounding;
+/// the decoder's on 8 lanes).
+#[inline(always)]
+pub fn block_step<F: std::ops::Mul<Output = F>>(step: F, factor: F) -> F {
+    step * factor
 }
 
 /// One track of a [`PackSource`].
@@ -150,12 +192,15 @@ impl PackTrack {
         self.kind.dim() - usize::from(self.rebuild_w)
     }
 
-    /// Key `k`'s components as the reference clip is given them (rotations
-    /// as given, not normalized: `RotationTrack::new_as_given`).
-    pub fn value(&self, k: usize) -> [f32; 4] {
+    /// Its `k`-th integers' components as the reference clip is given them
+    /// (rotations as given, not normalized: `RotationTrack::new_as_given`),
+    /// where the block's factor on the step is `factor`
+    /// ([`BlockScales::factor`]).
+    pub fn value(&self, k: usize, factor: f32) -> [f32; 4] {
+        let step = block_step(self.step, factor);
         let mut v = [0.0f32; 4];
         for (c, x) in self.values.iter().enumerate() {
-            v[c] = dequantize(x[k], self.step);
+            v[c] = dequantize(x[k], step);
         }
         if self.rebuild_w {
             v[3] = tcb_core::quat::rebuild_w(v[0], v[1], v[2]);
@@ -323,6 +368,18 @@ impl PackSource {
                 self.lanes()
             ));
         }
+        let s = &self.scales;
+        if !s.codes.is_empty() {
+            check_block(s.keys)?;
+            if s.codes.len() != self.keys.div_ceil(s.keys) {
+                return err(format!(
+                    "{} step factors for {} keys in blocks of {}",
+                    s.codes.len(),
+                    self.keys,
+                    s.keys
+                ));
+            }
+        }
         let total = self.tracks.len() + self.loose.len();
         let ends = self
             .tracks
@@ -418,13 +475,14 @@ impl PackSource {
     /// decoded keys are checked against).
     pub fn to_clip(&self) -> Result<SourceClip, PackError> {
         self.validate()?;
-        self.reference(&self.times())
+        self.reference(&(0..self.keys).collect::<Vec<_>>())
     }
 
-    /// The reference on keys at `times` (the values' keys, in order): all
+    /// The reference on the keys `keys` (the values' keys, in order): all
     /// of them for [`to_clip`](Self::to_clip), or a few (a loader's, see
     /// `crate::compile`).
-    pub(crate) fn reference(&self, times: &[f64]) -> Result<SourceClip, PackError> {
+    pub(crate) fn reference(&self, keys: &[usize]) -> Result<SourceClip, PackError> {
+        let times: Vec<f64> = keys.iter().map(|&k| self.time(k)).collect();
         let mut tracks = Vec::with_capacity(self.tracks.len() + self.loose.len());
         let mut loose = self.loose.iter().peekable();
         for t in &self.tracks {
@@ -432,7 +490,9 @@ impl PackSource {
                 tracks.push(l.reference()?);
             }
             let (s, n) = (&t.settings, times.len());
-            let vals: Vec<[f32; 4]> = (0..n).map(|k| t.value(k)).collect();
+            let vals: Vec<[f32; 4]> = (keys.iter().enumerate())
+                .map(|(i, &k)| t.value(i, self.scales.factor(k)))
+                .collect();
             let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", t.name));
             let times = times.to_vec();
             let data = match t.kind {
@@ -639,6 +699,16 @@ impl KeyValues {
     /// keeps one sign stores `x y z` unless its rounded keys would leave one
     /// hemisphere.
     pub fn quantize(&self, steps: &[f32]) -> Result<PackSource, PackError> {
+        self.quantize_scaled(steps, &BlockScales::default())
+    }
+
+    /// [`quantize`](Self::quantize), the grid's steps in each block times
+    /// its factor in `scales`.
+    pub fn quantize_scaled(
+        &self,
+        steps: &[f32],
+        scales: &BlockScales,
+    ) -> Result<PackSource, PackError> {
         if steps.len() != self.track_count() {
             return err(format!(
                 "{} steps for {} tracks",
@@ -656,7 +726,8 @@ impl KeyValues {
                     continue;
                 }
             };
-            let q = |x: f32| {
+            let q = |k: usize, x: f32| {
+                let step = block_step(step, scales.factor(k));
                 let v = (f64::from(x) / f64::from(step)).round();
                 if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
                     Err(PackError(format!(
@@ -672,14 +743,15 @@ impl KeyValues {
                     .map(|c| {
                         t.values
                             .iter()
-                            .map(|v| q(v[c]))
+                            .enumerate()
+                            .map(|(k, v)| q(k, v[c]))
                             .collect::<Result<Vec<i32>, _>>()
                     })
                     .collect::<Result<Vec<_>, _>>()
             };
             let xyz = if t.one_sign { Some(ints(3)?) } else { None };
             let (rebuild_w, values) = match xyz {
-                Some(xyz) if one_hemisphere(&xyz, step) => (true, xyz),
+                Some(xyz) if one_hemisphere(&xyz, step, scales) => (true, xyz),
                 _ => (false, ints(t.kind.dim())?),
             };
             tracks.push(PackTrack {
@@ -693,14 +765,17 @@ impl KeyValues {
                 values,
             });
         }
-        Ok(PackSource {
+        let source = PackSource {
             name: self.name.clone(),
             start: self.start,
             interval: self.interval,
             keys: self.keys,
             tracks,
+            scales: scales.clone(),
             loose,
-        })
+        };
+        source.validate_head()?;
+        Ok(source)
     }
 }
 
@@ -753,8 +828,9 @@ fn relative_to_center(values: &mut [[f32; 4]]) -> Option<[f32; 4]> {
 /// rebuilt) keeps one hemisphere from key to key, as the track keeps its
 /// keys (dot products in f64): else the track would flip a key, and it
 /// stores all four components.
-fn one_hemisphere(xyz: &[Vec<i32>], step: f32) -> bool {
+fn one_hemisphere(xyz: &[Vec<i32>], step: f32, scales: &BlockScales) -> bool {
     let key = |k: usize| {
+        let step = block_step(step, scales.factor(k));
         let [x, y, z] = [0, 1, 2].map(|c| dequantize(xyz[c][k], step));
         [x, y, z, tcb_core::quat::rebuild_w(x, y, z)].map(f64::from)
     };
@@ -1280,6 +1356,12 @@ impl Packed {
     pub fn encode_with(source: &PackSource, block: usize) -> Result<Packed, PackError> {
         check_block(block)?;
         source.validate()?;
+        if !source.scales.codes.is_empty() && source.scales.keys != block {
+            return err(format!(
+                "step factors per {} keys for blocks of {block}",
+                source.scales.keys
+            ));
+        }
         let n = source.keys;
         let lanes: Vec<&Vec<i32>> = source.tracks.iter().flat_map(|t| t.values.iter()).collect();
         let (abs_bits, delta_bits) = block_start_widths(&lanes, n, block);
@@ -1345,6 +1427,10 @@ impl Packed {
         let mut head = source.clone();
         for t in &mut head.tracks {
             t.values = Vec::new();
+        }
+        // Every factor 1 is no factors.
+        if head.scales.codes.iter().all(|c| *c == 0) {
+            head.scales = BlockScales::default();
         }
         Ok(Packed {
             head,
@@ -1692,7 +1778,7 @@ pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
 /// where each block starts; version 4: rotations whose `w` changes sign
 /// kept relative to a center, constant components without headers; older
 /// versions are refused with a one-line error).
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 
 mod file;
 mod loose;

@@ -33,7 +33,8 @@
 //! kernel normalizes the curve it plays).
 
 use super::{
-    BYTES, BitLanes, GROUP, Packed, SEGMENT_KEYS, header_group, read_bits, unzigzag, window,
+    BYTES, BitLanes, GROUP, Packed, SEGMENT_KEYS, block_step, header_group, read_bits, unzigzag,
+    window,
 };
 use crate::segment::Segment;
 use std::ops::{Add, BitAnd, Sub};
@@ -315,6 +316,9 @@ pub(crate) struct PackCache {
     headers: Headers,
     /// Per plane, how its lanes code the segment `cur`.
     coding: Vec<PlaneCoding>,
+    /// The factor on the steps in the block of segment `cur`
+    /// ([`crate::pack::BlockScales`]).
+    factor: f32,
     /// The predictor: the last two keys' integers, per plane.
     x0: Vec<i32x8>,
     x1: Vec<i32x8>,
@@ -340,6 +344,7 @@ impl PackedKeys {
                 entry: vec![0; self.headed_base.len() + 1],
             },
             coding: vec![PlaneCoding::default(); np],
+            factor: 1.0,
             x0: vec![i32x8::ZERO; np],
             x1: vec![i32x8::ZERO; np],
             rows: vec![f32x8::ZERO; ROWS * np],
@@ -413,6 +418,7 @@ impl PackCache {
         if block {
             // A block's first headers code against the lanes' base widths.
             self.headers.width.copy_from_slice(&g.headed_base);
+            self.factor = g.packed.head.scales.factor(s);
         }
         let keys = (s + SEGMENT_KEYS).min(n) - s;
         // A block's first two keys come from its start values and deltas.
@@ -471,7 +477,8 @@ impl PackCache {
             // `headed_base` (`compile::packed`), below `headers.entry`'s.
             #[allow(unsafe_code)]
             unsafe {
-                v3::predict_gathered_here(g, &self.headers, pos, &mut self.x0, &mut self.x1, rows);
+                let (x0, x1, f) = (&mut self.x0, &mut self.x1, self.factor);
+                v3::predict_gathered_here(g, &self.headers, pos, f, x0, x1, rows);
             }
         }
         if !gather {
@@ -481,7 +488,7 @@ impl PackCache {
                 let c = &self.coding[p];
                 let (low, bias) = super::width_lanes(i32x8::from(c.width));
                 let coding = [i32x8::from(c.trend), low, bias];
-                let step = g.step[p];
+                let step = block_step(g.step[p], f32x8::splat(self.factor));
                 for row in rows.chunks_exact_mut(np) {
                     let v = &mut row[p];
                     let x = predict(a, b, bytemuck::cast(*v), coding);
@@ -530,7 +537,8 @@ impl PackCache {
             // stream's end and below i32::MAX.
             #[allow(unsafe_code)]
             unsafe {
-                v3::block_start_gathered_here(g, *pos, &mut self.x0, &mut self.x1, rows);
+                let (x0, x1, f) = (&mut self.x0, &mut self.x1, self.factor);
+                v3::block_start_gathered_here(g, *pos, f, x0, x1, rows);
             }
             *pos += g.start_bits;
             self.rebuild(g, 0..first);
@@ -551,6 +559,7 @@ impl PackCache {
         let (row0, row1) = self.rows[BEFORE * np..(BEFORE + first) * np].split_at_mut(np);
         let state = self.x0.iter_mut().zip(&mut self.x1).zip(&g.step);
         for (p, ((x0, x1), step)) in state.enumerate() {
+            let step = &block_step(*step, f32x8::splat(self.factor));
             let [k0, k1] = block_start_keys(*x0, *x1, first);
             row0[p] = super::dequantize_lanes(k0, *step);
             if let Some(row) = row1.get_mut(p) {
@@ -668,7 +677,7 @@ mod v3 {
         Headers, PackedKeys, Plane, block_start_keys, entry_fields, interior_tangents, predict,
         rebuild_rows,
     };
-    use crate::pack::{dequantize_lanes, unzigzag_lanes, width_lanes};
+    use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
         __m256, __m256i, _mm256_add_epi32, _mm256_and_si256, _mm256_i32gather_epi32,
         _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
@@ -780,13 +789,14 @@ mod v3 {
         g: &PackedKeys,
         h: &Headers,
         base: usize,
+        factor: f32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
     ) {
         debug_assert!(crate::isa::avx2());
         // SAFETY: the caller's (above).
-        unsafe { predict_gathered(g, h, base as i32, x0, x1, rows) }
+        unsafe { predict_gathered(g, h, base as i32, factor, x0, x1, rows) }
     }
 
     #[inline(always)]
@@ -834,19 +844,21 @@ mod v3 {
     pub(super) unsafe fn block_start_gathered_here(
         g: &PackedKeys,
         base: usize,
+        factor: f32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
     ) {
         debug_assert!(crate::isa::avx2() && !g.start_gather.is_empty());
         // SAFETY: the caller's (above).
-        unsafe { block_start_gathered(g, base as i32, x0, x1, rows) }
+        unsafe { block_start_gathered(g, base as i32, factor, x0, x1, rows) }
     }
 
     #[target_feature(enable = "avx2,fma")]
     fn block_start_gathered(
         g: &PackedKeys,
         base: i32,
+        factor: f32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
@@ -868,7 +880,7 @@ mod v3 {
                 unzigzag_lanes(z & width_lanes(I8(*w)).0)
             };
             let (start, delta) = (read(abs_at, abs_w), read(delta_at, delta_w));
-            let step = W8(step.to_array());
+            let step = block_step(W8(step.to_array()), W8([factor; 8]));
             let [k0, k1] = block_start_keys(start, delta, keys);
             row0[p] = f32x8::new(dequantize_lanes(k0, step).0);
             if let Some(row) = row1.get_mut(p) {
@@ -883,6 +895,7 @@ mod v3 {
         g: &PackedKeys,
         h: &Headers,
         base: i32,
+        factor: f32,
         x0: &mut [i32x8],
         x1: &mut [i32x8],
         rows: &mut [f32x8],
@@ -902,7 +915,7 @@ mod v3 {
             let code = [trend, low, bias];
             let width = m(width.0);
             let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
-            let step = W8(g.step[p].to_array());
+            let step = block_step(W8(g.step[p].to_array()), W8([factor; 8]));
             let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(start, keys));
             for row in rows.chunks_exact_mut(np) {
                 // SAFETY: every lane's bit is below the bound of
