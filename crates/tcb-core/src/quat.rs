@@ -33,11 +33,21 @@ pub fn mul<R: Real>(a: &[R; 4], b: &[R; 4]) -> [R; 4] {
 pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 4]>) {
     let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
     let inv = L::of(1.0) / len;
-    let q = p.map(|x| x * inv);
-    let qv = dp.map(|dp| {
-        let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
-        std::array::from_fn(|i| (dp[i] - q[i] * qd) * inv)
-    });
+    // Written out, without closures: the AVX2 kernels call this inside
+    // `#[target_feature]` functions (see `crate::simd::w8`).
+    let q = [p[0] * inv, p[1] * inv, p[2] * inv, p[3] * inv];
+    let qv = match dp {
+        Some(dp) => {
+            let qd = q[0] * dp[0] + q[1] * dp[1] + q[2] * dp[2] + q[3] * dp[3];
+            Some([
+                (dp[0] - q[0] * qd) * inv,
+                (dp[1] - q[1] * qd) * inv,
+                (dp[2] - q[2] * qd) * inv,
+                (dp[3] - q[3] * qd) * inv,
+            ])
+        }
+        None => None,
+    };
     (q, qv)
 }
 
@@ -52,7 +62,7 @@ pub fn normalize<L: Lane>(p: [L; 4], dp: Option<[L; 4]>) -> ([L; 4], Option<[L; 
 #[inline(always)]
 pub fn unit_key<L: Lane>(p: [L; 4]) -> [L; 4] {
     let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
-    p.map(|x| x / len)
+    [p[0] / len, p[1] / len, p[2] / len, p[3] / len]
 }
 
 /// The `w` of a unit quaternion from its `x y z` (`w >= 0`), as a packed

@@ -123,9 +123,23 @@ fn quat_curve(
     h: &[f32x8; 4],
     dh: Option<(&[f32x8; 4], f32x8)>,
 ) -> ([f32x8; 4], Option<[f32x8; 4]>) {
-    let p: [f32x8; 4] = std::array::from_fn(|c| hermite(h, p0[c], p1[c], m0[c], m1[c]));
-    let dp = dh
-        .map(|(dh, rate)| std::array::from_fn(|c| hermite(dh, p0[c], p1[c], m0[c], m1[c]) * rate));
+    // Written out, without closures (see `tcb_core::simd::w8`).
+    let curve = |h: &[f32x8; 4]| {
+        [
+            hermite(h, p0[0], p1[0], m0[0], m1[0]),
+            hermite(h, p0[1], p1[1], m0[1], m1[1]),
+            hermite(h, p0[2], p1[2], m0[2], m1[2]),
+            hermite(h, p0[3], p1[3], m0[3], m1[3]),
+        ]
+    };
+    let p = curve(h);
+    let dp = match dh {
+        Some((dh, rate)) => {
+            let d = curve(dh);
+            Some([d[0] * rate, d[1] * rate, d[2] * rate, d[3] * rate])
+        }
+        None => None,
+    };
     (p, dp)
 }
 
