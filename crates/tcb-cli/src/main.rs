@@ -389,17 +389,32 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("tcb: error: {e}");
+            eprintln!("tcb: error: {}", one_line(&e.to_string()));
             ExitCode::FAILURE
         }
     }
+}
+
+/// `message` with its control characters escaped (`\n`, `\u{1b}`): names
+/// come from files, and may hold line breaks or terminal escapes that
+/// would otherwise break the one-line message or reach the terminal.
+fn one_line(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    for c in message.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 type BoxError = Box<dyn std::error::Error>;
 
 fn warn(warnings: &[String]) {
     for w in warnings {
-        eprintln!("tcb: warning: {w}");
+        eprintln!("tcb: warning: {}", one_line(w));
     }
 }
 

@@ -493,6 +493,22 @@ fn every_bad_input_is_one_clear_line_and_no_csv() {
     }
 }
 
+/// A name with a line break and a terminal escape in it (JSON allows
+/// both) is printed escaped: the error stays one line, and the terminal is
+/// not told anything.
+#[test]
+fn control_characters_in_names_are_escaped_in_errors() {
+    let text = r#"{"format": "tcb-clip/1", "name": "t", "tracks": [
+        {"name": "bad\nname\u001b[31m", "kind": "scalar", "times": [0], "values": [1]}]}"#;
+    let path = temp_clip("control_name.json", text);
+    let o = tcb(&["sample", path.to_str().unwrap(), "--fps", "10"]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains('\u{1b}'), "{err:?}");
+    assert!(err.contains(r"bad\nname\u{1b}[31m"), "{err}");
+}
+
 #[test]
 fn tcb_beyond_one_is_allowed() {
     let text = clip_with(
