@@ -28,6 +28,7 @@ use crate::reduce::{
     Metric, ReduceError, ReduceOptions, Reference, Settings, bound_joint, descends, resolve,
 };
 use std::sync::Arc;
+use tcb_core::params::Ends;
 use tcb_core::skeleton::Skeleton;
 use tcb_core::{SourceClip, TrackKind};
 use tcb_runtime::{BlockScales, KeyValues, Packed};
@@ -193,8 +194,11 @@ pub fn compress(
         measure(steps, &BlockScales::default())
     })?;
     // Tracks the shell metric does not see keep their fixed steps: no
-    // factors where there are any.
-    let (measured, mut packed) = if budget.fixed.iter().any(Option::is_some) {
+    // factors where the grid has any.
+    let grid = &trial.1.head().tracks;
+    let fixed_on_grid = (clip.tracks().iter().zip(&budget.fixed))
+        .any(|(t, f)| f.is_some() && grid.iter().any(|g| g.name == t.name));
+    let (measured, mut packed) = if fixed_on_grid {
         trial
     } else {
         let blocks = BlockSearch::new(&trial.1, block, &times);
@@ -324,10 +328,39 @@ struct BlockSearch {
     /// Keys per block, and blocks of the grid.
     block: usize,
     blocks: usize,
-    /// Per check time, the blocks whose keys it depends on (a time between
-    /// keys `k` and `k + 1` those of keys `k - 1 ..= k + 2`, which make
-    /// the interval's tangents): `first ..= last`.
-    reach: Vec<(usize, usize)>,
+    /// Per check time, the blocks whose keys it depends on.
+    reach: Vec<Reach>,
+}
+
+/// The blocks `first ..= last`, and with `ends` the first and the last.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Reach {
+    first: usize,
+    last: usize,
+    ends: bool,
+}
+
+/// The blocks (of `block` keys, of a grid of `n`) whose keys the grid's
+/// values at `x` (in intervals from the first key) depend on: between keys
+/// `k` and `k + 1`, keys `k - 1 ..= k + 2` (which make the interval's
+/// tangents), and with `cyclic` ends the other end's too where those pass
+/// an end. Outside the grid (extrapolated: `repeat` reads any key) or at
+/// NaN, every block.
+fn reach(n: usize, block: usize, cyclic: bool, x: f64) -> Reach {
+    let last_key = (n - 1) as f64;
+    if !(x >= -1e-6 && x <= last_key + 1e-6) {
+        return Reach {
+            first: 0,
+            last: (n - 1) / block,
+            ends: false,
+        };
+    }
+    let k = (x.max(0.0).floor() as usize).min(n - 1);
+    Reach {
+        first: k.saturating_sub(1) / block,
+        last: (k + 2).min(n - 1) / block,
+        ends: cyclic && (k == 0 || k + 2 > n - 1),
+    }
 }
 
 /// Rounds of step 4: enough to bisect a code of 8 bits.
@@ -336,23 +369,14 @@ const BLOCK_ROUNDS: usize = 8;
 impl BlockSearch {
     fn new(packed: &Packed, block: usize, times: &[f64]) -> Self {
         let head = packed.head();
-        let n = head.keys;
+        let cyclic = head.tracks.iter().any(|t| t.settings.ends == Ends::Cyclic);
         let reach = times
             .iter()
-            .map(|&t| {
-                let at = ((t - head.start) / head.interval).floor();
-                // (Clamped: before the first key and after the last, and NaN, at the ends.)
-                let k = if at >= 0.0 {
-                    (at as usize).min(n - 1)
-                } else {
-                    0
-                };
-                (k.saturating_sub(1) / block, (k + 2).min(n - 1) / block)
-            })
+            .map(|&t| reach(head.keys, block, cyclic, (t - head.start) / head.interval))
             .collect();
         BlockSearch {
             block,
-            blocks: n.div_ceil(block),
+            blocks: head.keys.div_ceil(block),
             reach,
         }
     }
@@ -387,9 +411,13 @@ impl BlockSearch {
             }
             let trial = measure(&scales(&mid))?;
             let mut failed = vec![false; self.blocks];
-            for (&r, &(a, b)) in trial.0.at_time.iter().zip(&self.reach) {
+            for (&r, reach) in trial.0.at_time.iter().zip(&self.reach) {
                 if r > 1.0 {
-                    failed[a..=b].fill(true);
+                    failed[reach.first..=reach.last].fill(true);
+                    if reach.ends {
+                        failed[0] = true;
+                        failed[self.blocks - 1] = true;
+                    }
                 }
             }
             if trial.0.worst.ratio <= 1.0 && bytes(&trial) < best.0 {
@@ -533,5 +561,32 @@ impl Budget {
             .map(|&j| each[j])
             .fold(0.0, f64::max)
             .max(if self.reaches[t].is_empty() { 1.0 } else { 0.0 })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Reach, reach};
+
+    /// The blocks a check time depends on: the keys around its interval,
+    /// the other end's with cyclic ends, every block outside the grid.
+    #[test]
+    fn a_check_time_reaches_the_blocks_of_its_tangents_keys() {
+        let r = |first, last, ends| Reach { first, last, ends };
+        // 200 keys in blocks of 64: blocks 0 to 3.
+        assert_eq!(reach(200, 64, false, 0.5), r(0, 0, false));
+        assert_eq!(reach(200, 64, false, 62.25), r(0, 1, false));
+        assert_eq!(reach(200, 64, false, 64.0), r(0, 1, false));
+        assert_eq!(reach(200, 64, false, 65.0), r(1, 1, false));
+        assert_eq!(reach(200, 64, false, 199.0), r(3, 3, false));
+        assert_eq!(reach(200, 64, true, 0.5), r(0, 0, true));
+        assert_eq!(reach(200, 64, true, 197.5), r(3, 3, false));
+        assert_eq!(reach(200, 64, true, 198.5), r(3, 3, true));
+        assert_eq!(reach(200, 64, true, 100.5), r(1, 1, false));
+        for outside in [-0.5, 199.5, f64::NAN, f64::INFINITY] {
+            assert_eq!(reach(200, 64, false, outside), r(0, 3, false));
+        }
+        // One block, shorter than a block.
+        assert_eq!(reach(10, 64, false, 4.5), r(0, 0, false));
     }
 }

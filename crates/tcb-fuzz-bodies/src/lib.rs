@@ -242,19 +242,15 @@ pub fn pack(data: &[u8]) {
     let Ok(keys) = tcb_runtime::KeyValues::sample(&clip) else {
         return;
     };
-    // Blocks of 16 or 64 keys, with a factor on the steps per block (every
-    // code 0, the one `quantize` gives, is kept as none).
+    // Blocks of 16 or 64 keys, with a factor on the steps per block.
     let block = if u.arbitrary().unwrap_or(false) {
         16
     } else {
         64
     };
-    let Ok(plain) = keys.quantize(&input.steps) else {
-        return;
-    };
     let scales = match u.arbitrary::<bool>() {
         Ok(true) => {
-            let blocks = plain.keys.div_ceil(block);
+            let blocks = keys.grid_keys().div_ceil(block);
             let codes = (0..blocks).map(|_| u.arbitrary::<u8>().unwrap_or(0));
             tcb_runtime::BlockScales {
                 keys: block,
@@ -266,9 +262,6 @@ pub fn pack(data: &[u8]) {
     let Ok(mut source) = keys.quantize_scaled(&input.steps, &scales) else {
         return;
     };
-    if source.scales.codes.iter().all(|c| *c == 0) {
-        source.scales = tcb_runtime::BlockScales::default();
-    }
     for (t, tcb) in source.tracks.iter_mut().zip(&input.tcb) {
         t.tcb = *tcb;
     }

@@ -85,6 +85,19 @@ fn blocks_with_step_factors_play_their_reference() {
     };
     let e = keys.quantize_scaled(&steps, &wrong).unwrap_err();
     assert!(e.to_string().contains("3 step factors for"), "{e}");
+    // Every code 0 is no factors, in any block size.
+    let zeros = tcb_runtime::BlockScales {
+        keys: 64,
+        codes: vec![0; clip.key_times().len().div_ceil(64)],
+    };
+    let source = keys.quantize_scaled(&steps, &zeros).unwrap();
+    assert_eq!(source.scales, tcb_runtime::BlockScales::default());
+    assert!(Packed::encode_with(&source, 16).is_ok());
+    // A step whose integers, times the largest factor, would leave f32.
+    let mut huge = source.clone();
+    huge.tracks[0].step = 1e31;
+    let e = Packed::encode(&huge).unwrap_err().to_string();
+    assert!(e.contains("step 1e31 is above 4e30"), "{e}");
 }
 
 /// The packed clip in blocks of `block` keys against its reference, bit for bit.

@@ -164,14 +164,11 @@ impl<'a> Reader<'a> {
             ));
         }
         let codes = self.take(blocks, "the blocks' step factors")?;
-        let scales = if codes.iter().all(|c| *c == 0) {
-            BlockScales::default()
-        } else {
-            BlockScales {
-                keys: block,
-                codes: codes.to_vec(),
-            }
-        };
+        let scales = BlockScales {
+            keys: block,
+            codes: codes.to_vec(),
+        }
+        .canonical();
         let len = self.u32("the stream length")? as usize;
         // Every segment spends 3 bits at least per lane with headers on
         // them (an order bit and a width code): a file cannot describe more

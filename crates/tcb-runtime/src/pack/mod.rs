@@ -5,9 +5,9 @@
 //! continuity and bias needs only its values: every interior key's
 //! tangents follow from its two neighbours with constant chord weights
 //! (`tcb_core::tangent::ChordWeights`). A packed clip stores, per track,
-//! one quantization step (times a factor per block of keys,
-//! [`BlockScales`]) and the integers `x_k = round(v_k / step)` of each
-//! stored component (rotations: `x y z` with `w >= 0` rebuilt, or all four
+//! one quantization step, times a factor per block of keys
+//! ([`BlockScales`]: `step_k`), and the integers `x_k = round(v_k / step_k)`
+//! of each stored component (rotations: `x y z` with `w >= 0` rebuilt, or all four
 //! where `w` changes sign), coded as
 //!
 //! ```text
@@ -112,7 +112,27 @@ impl BlockScales {
         };
         scale_factor(code)
     }
+
+    /// A track's step `step` at key `k`: [`block_step`] by the key's
+    /// [`factor`](Self::factor).
+    pub fn step(&self, step: f32, k: usize) -> f32 {
+        block_step(step, self.factor(k))
+    }
+
+    /// The same factors, as a packed clip keeps them: none where every
+    /// code is 0.
+    pub fn canonical(self) -> BlockScales {
+        if self.codes.iter().all(|c| *c == 0) {
+            BlockScales::default()
+        } else {
+            self
+        }
+    }
 }
+
+/// The largest step: times the largest factor and the largest integer it
+/// stays finite in f32 (`3.4e38 / (4.98 * 2^24)`, about 4e30).
+pub const MAX_STEP: f32 = 4e30;
 
 /// The factor of a block's code: `1 + c / 64` (exact in f32: 1 to 4.98 in
 /// steps of 1/64).
@@ -139,7 +159,9 @@ pub struct PackTrack {
     pub settings: TrackSettings,
     /// Tension, continuity and bias of every key.
     pub tcb: Tcb,
-    /// Quantization step (finite, > 0): a value is `x as f32 * step`.
+    /// Quantization step (finite, > 0): a value is `x as f32 * step_k`,
+    /// `step_k` this step in key `k`'s block ([`BlockScales::step`]). At
+    /// most [`MAX_STEP`].
     pub step: f32,
     /// Rotations: `x y z` stored, `w >= 0` rebuilt
     /// ([`tcb_core::quat::rebuild_w`]); else every component is stored.
@@ -194,10 +216,8 @@ impl PackTrack {
 
     /// Its `k`-th integers' components as the reference clip is given them
     /// (rotations as given, not normalized: `RotationTrack::new_as_given`),
-    /// where the block's factor on the step is `factor`
-    /// ([`BlockScales::factor`]).
-    pub fn value(&self, k: usize, factor: f32) -> [f32; 4] {
-        let step = block_step(self.step, factor);
+    /// in steps of `step` (the key's: [`BlockScales::step`]).
+    pub fn value(&self, k: usize, step: f32) -> [f32; 4] {
         let mut v = [0.0f32; 4];
         for (c, x) in self.values.iter().enumerate() {
             v[c] = dequantize(x[k], step);
@@ -457,6 +477,12 @@ impl PackSource {
             if !(t.step.is_finite() && t.step > 0.0) {
                 return at(format!("step {} is not a positive number", t.step));
             }
+            if t.step > MAX_STEP {
+                return at(format!(
+                    "step {:e} is above {MAX_STEP:e} (with a block's factor its integers would overflow f32)",
+                    t.step
+                ));
+            }
             if !t.tcb.is_finite() {
                 return at("tension, continuity and bias must be finite".into());
             }
@@ -491,7 +517,7 @@ impl PackSource {
             }
             let (s, n) = (&t.settings, times.len());
             let vals: Vec<[f32; 4]> = (keys.iter().enumerate())
-                .map(|(i, &k)| t.value(i, self.scales.factor(k)))
+                .map(|(i, &k)| t.value(i, self.scales.step(t.step, k)))
                 .collect();
             let e = |e: tcb_core::TrackError| PackError(format!("track {}: {e}", t.name));
             let times = times.to_vec();
@@ -673,6 +699,11 @@ impl KeyValues {
         self.tracks.len() + self.loose.len()
     }
 
+    /// Keys of the grid.
+    pub fn grid_keys(&self) -> usize {
+        self.keys
+    }
+
     /// Track `i` (file order): on the grid (its index there) or loose.
     fn which(&self, i: usize) -> Result<usize, &loose::LooseKeys> {
         match self.loose.binary_search_by_key(&i, |l| l.at) {
@@ -727,7 +758,7 @@ impl KeyValues {
                 }
             };
             let q = |k: usize, x: f32| {
-                let step = block_step(step, scales.factor(k));
+                let step = scales.step(step, k);
                 let v = (f64::from(x) / f64::from(step)).round();
                 if v.abs() >= f64::from(MAX_INT) || v.is_nan() {
                     Err(PackError(format!(
@@ -771,7 +802,7 @@ impl KeyValues {
             interval: self.interval,
             keys: self.keys,
             tracks,
-            scales: scales.clone(),
+            scales: scales.clone().canonical(),
             loose,
         };
         source.validate_head()?;
@@ -830,7 +861,7 @@ fn relative_to_center(values: &mut [[f32; 4]]) -> Option<[f32; 4]> {
 /// stores all four components.
 fn one_hemisphere(xyz: &[Vec<i32>], step: f32, scales: &BlockScales) -> bool {
     let key = |k: usize| {
-        let step = block_step(step, scales.factor(k));
+        let step = scales.step(step, k);
         let [x, y, z] = [0, 1, 2].map(|c| dequantize(xyz[c][k], step));
         [x, y, z, tcb_core::quat::rebuild_w(x, y, z)].map(f64::from)
     };
@@ -1353,10 +1384,12 @@ impl Packed {
     /// Encode `source` in blocks of `block` keys (a multiple of
     /// [`SEGMENT_KEYS`], at most [`MAX_BLOCK_KEYS`]): a seek decodes up to
     /// `block - 1` keys; smaller blocks seek faster and take more bytes.
+    /// Factors on the steps ([`PackSource::scales`]) must be per `block`
+    /// keys.
     pub fn encode_with(source: &PackSource, block: usize) -> Result<Packed, PackError> {
         check_block(block)?;
         source.validate()?;
-        if !source.scales.codes.is_empty() && source.scales.keys != block {
+        if source.scales.codes.iter().any(|c| *c > 0) && source.scales.keys != block {
             return err(format!(
                 "step factors per {} keys for blocks of {block}",
                 source.scales.keys
@@ -1428,10 +1461,7 @@ impl Packed {
         for t in &mut head.tracks {
             t.values = Vec::new();
         }
-        // Every factor 1 is no factors.
-        if head.scales.codes.iter().all(|c| *c == 0) {
-            head.scales = BlockScales::default();
-        }
+        head.scales = head.scales.canonical();
         Ok(Packed {
             head,
             block,
@@ -1761,7 +1791,10 @@ impl Packed {
 
     /// Bytes of the encoded stream and its tables (what a runtime keeps).
     pub fn stream_bytes(&self) -> usize {
-        8 * self.stream.len() + 4 * self.block_at.len() + 3 * self.abs_bits.len()
+        8 * self.stream.len()
+            + 4 * self.block_at.len()
+            + self.head.scales.codes.len()
+            + 3 * self.abs_bits.len()
     }
 
     /// Bits of the residuals, widths and block starts.
@@ -1772,7 +1805,8 @@ impl Packed {
 
 /// The first 8 bytes of a `.tcbc` file.
 pub const MAGIC: [u8; 8] = *b"TCBC\0\r\n\x1a";
-/// The format version this build writes and reads (version 7: a
+/// The format version this build writes and reads (version 8: a factor
+/// on the grid's steps per block of keys; version 7: a
 /// segment's headers in groups of 8 components, of fixed-length codes;
 /// version 6: tracks on key times of their own beside the grid's; version 5: a table of
 /// where each block starts; version 4: rotations whose `w` changes sign
