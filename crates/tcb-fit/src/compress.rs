@@ -549,7 +549,9 @@ impl Budget {
         (0..self.unit.len())
             .map(|t| {
                 let step = self.fixed[t].unwrap_or(self.unit[t] * weight[t] * kappa);
-                step.clamp(self.finest[t], 1e3) as f32
+                // (A track of values above 2^22 * 1e3 has a finest step above 1e3.)
+                let finest = self.finest[t];
+                step.clamp(finest, finest.max(1e3)) as f32
             })
             .collect()
     }

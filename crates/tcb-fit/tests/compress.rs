@@ -103,3 +103,29 @@ fn blocks_take_coarser_steps_where_the_error_has_room() {
     assert_eq!(m.at_time.len(), times.len());
     assert_eq!(m.worst.ratio, m.at_time.iter().copied().fold(0.0, f64::max));
 }
+
+/// Values near 1e10 (a track whose finest step, its largest value over
+/// 2^22, is above the coarsest the search tries, 1e3): the search once
+/// panicked (`clamp` with its minimum above its maximum). Found by the
+/// `compress` fuzz target.
+#[test]
+fn huge_values_are_compressed_or_refused_without_a_panic() {
+    let times: Vec<f64> = (0..40).map(|k| f64::from(k) / 30.0).collect();
+    let values = times
+        .iter()
+        .map(|t| 8e9 + 1e6 * (*t as f32).sin())
+        .collect();
+    let track = Track::new(times, values, vec![], &TrackSettings::default()).unwrap();
+    let clip = tcb_core::SourceClip::new(
+        "huge",
+        vec![NamedTrack {
+            name: "x".into(),
+            data: TrackData::Scalar(track),
+        }],
+    )
+    .unwrap();
+    let c = tcb_fit::compress(&clip, None, &CompressOptions::default(), &|_, _| {});
+    if let Ok(c) = c {
+        assert!(c.worst.ratio <= 1.0, "{:?}", c.worst);
+    }
+}

@@ -184,10 +184,44 @@ pub(crate) type ReduceInput = (
 );
 
 pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
-    use tcb_core::skeleton::{Joint, Skeleton, Transform};
     use tcb_fit::{Knots, Metric, ReduceOptions, Speed, Tangents};
     let mut doc = arbitrary_doc(u).ok()?;
-    let skeleton = if bool::arbitrary(u).unwrap_or(false) {
+    let skeleton = arbitrary_skeleton(u, &mut doc);
+    let clip = doc.build().ok()?;
+    let number = option_number;
+    let options = ReduceOptions::default()
+        .tolerance(number(u))
+        .shell(number(u))
+        .metric(
+            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
+                .unwrap_or(&None),
+        )
+        .rotation_tolerance(number(u))
+        .knots(
+            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
+                .unwrap_or(&Knots::Track),
+        )
+        .tangents(
+            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
+                .unwrap_or(&Tangents::Best),
+        )
+        .speed(
+            *u.choose(&[Speed::Balanced, Speed::NeverSlower, Speed::FewestBytes])
+                .unwrap_or(&Speed::Balanced),
+        );
+    Some((doc, clip, skeleton, options))
+}
+
+/// Sometimes (else `None`) a skeleton whose joints `doc`'s tracks animate:
+/// track `i` renamed `j{i}.rotation`, `.translation`, `.scale` or
+/// `.weight` by its kind, joint `j{i}` under an earlier joint at a drawn
+/// rest offset.
+pub(crate) fn arbitrary_skeleton(
+    u: &mut Unstructured,
+    doc: &mut ClipDoc,
+) -> Option<tcb_core::skeleton::Skeleton> {
+    use tcb_core::skeleton::{Joint, Skeleton, Transform};
+    if bool::arbitrary(u).unwrap_or(false) {
         let mut joints = Vec::new();
         for (i, track) in doc.tracks.iter_mut().enumerate() {
             let channel = match track.kind {
@@ -214,34 +248,14 @@ pub(crate) fn reduce_input(u: &mut Unstructured) -> Option<ReduceInput> {
         Some(Skeleton::new(joints).unwrap())
     } else {
         None
-    };
-    let clip = doc.build().ok()?;
-    let number = |u: &mut Unstructured| -> Option<f64> {
-        match u.int_in_range(0..=3u8).unwrap_or(0) {
-            0 => None,
-            1 => f64::arbitrary(u).ok(),
-            _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
-        }
-    };
-    let options = ReduceOptions::default()
-        .tolerance(number(u))
-        .shell(number(u))
-        .metric(
-            *u.choose(&[None, Some(Metric::Shell), Some(Metric::Value)])
-                .unwrap_or(&None),
-        )
-        .rotation_tolerance(number(u))
-        .knots(
-            *u.choose(&[Knots::Track, Knots::Joint, Knots::Clip])
-                .unwrap_or(&Knots::Track),
-        )
-        .tangents(
-            *u.choose(&[Tangents::Explicit, Tangents::Derived, Tangents::Best])
-                .unwrap_or(&Tangents::Best),
-        )
-        .speed(
-            *u.choose(&[Speed::Balanced, Speed::NeverSlower, Speed::FewestBytes])
-                .unwrap_or(&Speed::Balanced),
-        );
-    Some((doc, clip, skeleton, options))
+    }
+}
+
+/// An option's number: none (the default), any f64, or one of 1/1024 to 4.
+pub(crate) fn option_number(u: &mut Unstructured) -> Option<f64> {
+    match u.int_in_range(0..=3u8).unwrap_or(0) {
+        0 => None,
+        1 => f64::arbitrary(u).ok(),
+        _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
+    }
 }

@@ -314,6 +314,77 @@ pub fn pack(data: &[u8]) {
     }
 }
 
+/// The `compress` target: `tcb compress`'s search ([`tcb_fit::compress()`])
+/// on a clip as the `pack` target draws it (one even grid of 2 to 200 keys,
+/// every kind and rule, tracks on key times of their own), sometimes with
+/// a skeleton its tracks animate, and arbitrary options (tolerance, shell,
+/// metric, rotation tolerance, keys per block). A clip the search returns
+/// was measured within its tolerance; its bytes load
+/// (`Clip::from_bytes`), and measured again from them, at every check
+/// time of the contract, it is within the tolerance too.
+pub fn compress(data: &[u8]) {
+    let mut u = Unstructured::new(data);
+    let Ok(input) = arbitrary_pack(&mut u) else {
+        return;
+    };
+    let mut doc = input.doc;
+    let skeleton = arbitrary_skeleton(&mut u, &mut doc);
+    let Ok(clip) = doc.build() else {
+        return;
+    };
+    let options = tcb_fit::CompressOptions::default()
+        .tolerance(option_number(&mut u))
+        .shell(option_number(&mut u))
+        .metric(
+            *u.choose(&[
+                None,
+                Some(tcb_fit::Metric::Shell),
+                Some(tcb_fit::Metric::Value),
+            ])
+            .unwrap_or(&None),
+        )
+        .rotation_tolerance(option_number(&mut u))
+        .seek_keys(
+            *u.choose(&[None, Some(16), Some(64), Some(1024)])
+                .unwrap_or(&None),
+        );
+    let Ok(c) = tcb_fit::compress(&clip, skeleton.as_ref(), &options, &|_, _| {}) else {
+        return;
+    };
+    assert!(
+        c.worst.ratio <= 1.0,
+        "compressed beyond its tolerance: {:?} ({:?})",
+        c.worst,
+        c.settings
+    );
+    let bytes = c.packed.to_bytes();
+    assert_eq!(bytes.len(), c.bytes, "the bytes it reported");
+    let loaded = Arc::new(tcb_runtime::Clip::from_bytes(&bytes).expect("its own file loads"));
+    let times = tcb_fit::metric::check_times(&clip);
+    let reference = Arc::new(tcb_runtime::Clip::compile(&clip));
+    let s = &c.settings;
+    let again: tcb_fit::metric::Measured = match (s.metric, skeleton.as_ref()) {
+        (tcb_fit::Metric::Shell, Some(sk)) => {
+            tcb_fit::metric::shell_error(sk, &reference, &loaded, &times, s.shell, s.tolerance)
+        }
+        _ => tcb_fit::metric::value_error(
+            &clip,
+            &tcb_fit::metric::play(&reference, &times),
+            &loaded,
+            &times,
+            s.tolerance,
+            s.rotation_tolerance,
+        ),
+    };
+    assert!(
+        again.worst.ratio <= 1.0,
+        "the file, loaded, is beyond the tolerance: {:?} (the search measured {:?}; {:?})",
+        again.worst,
+        c.worst,
+        c.settings
+    );
+}
+
 /// Play a clip that built at its key times, between them, beyond them and
 /// at the awkward times, against the reference.
 fn play(clip: &tcb_core::SourceClip) {

@@ -49,6 +49,11 @@ fn blend_corpus() {
 }
 
 #[test]
+fn compress_corpus() {
+    replay("compress", bodies::compress);
+}
+
+#[test]
 fn reduce_corpus() {
     replay("reduce", bodies::reduce);
 }
