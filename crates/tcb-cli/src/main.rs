@@ -639,6 +639,9 @@ fn compress(args: &CompressArgs) -> Result<(), BoxError> {
 /// The output's folder exists: found out before the work, not after it.
 fn output_folder_exists(output: &std::path::Path) -> Result<(), BoxError> {
     match output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) if dir.exists() && !dir.is_dir() => {
+            Err(format!("{}: not a directory", dir.display()).into())
+        }
         Some(dir) if !dir.is_dir() => Err(format!("{}: no such directory", dir.display()).into()),
         _ => Ok(()),
     }
@@ -986,7 +989,7 @@ fn info_tcbc(args: &InfoArgs) -> Result<(), BoxError> {
         .fold((f32::INFINITY, 0.0f32), |(a, b), &f| (a.min(f), b.max(f)));
     writeln!(
         out,
-        "blocks: {blocks} of {} keys, the steps times {least} to {most} (mean {:.4})",
+        "blocks: {blocks} ({} keys each), the grid's steps times {least} to {most} in them (mean {:.4})",
         packed.block_keys(),
         factors.iter().map(|&f| f64::from(f)).sum::<f64>() / blocks as f64
     )?;

@@ -257,6 +257,9 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     stderr_has(&o, "the output must end in .json");
     let o = tcb_to("reduce", &bounce, "/nonexistent-tcb-dir/x.json", &[]);
     stderr_has(&o, "/nonexistent-tcb-dir: no such directory");
+    // A file where the output's folder should be.
+    let o = tcb_to("reduce", &bounce, format!("{bounce}/x.json"), &[]);
+    stderr_has(&o, "bounce.json: not a directory");
 }
 
 #[test]

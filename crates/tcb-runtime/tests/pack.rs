@@ -261,6 +261,12 @@ fn bad_files_are_one_line_errors() {
     let e = |b: &[u8]| Packed::from_bytes(b).unwrap_err().to_string();
     assert!(e(b"").contains("not a .tcbc file"), "{}", e(b""));
     assert!(e(b"{\"format\": \"tcb-clip/1\"}").contains("not a .tcbc file"));
+    // The magic number, then less than a header: said to be cut short.
+    let short = e(b"TCBC\0\r\n\x1a\x08\x00");
+    assert!(
+        short.contains("10 bytes, shorter than a .tcbc header (24)"),
+        "{short}"
+    );
     // Every truncation is refused, none panics.
     for cut in (0..bytes.len()).step_by(997) {
         let msg = e(&bytes[..cut]);

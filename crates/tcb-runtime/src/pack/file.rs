@@ -597,6 +597,13 @@ impl Packed {
 /// The body of `.tcbc` bytes after their header, once the
 /// magic number, version, length and checksum hold.
 fn checked_body(bytes: &[u8]) -> Result<&[u8], PackError> {
+    let n = bytes.len().min(MAGIC.len());
+    if bytes.len() < HEADER && bytes.len() >= 4 && bytes[..n] == MAGIC[..n] {
+        return err(format!(
+            "cut short: {} bytes, shorter than a .tcbc header ({HEADER})",
+            bytes.len()
+        ));
+    }
     if bytes.len() < HEADER || bytes[..8] != MAGIC {
         return err("not a .tcbc file (no TCBC magic number)");
     }
