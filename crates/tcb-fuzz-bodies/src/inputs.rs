@@ -259,3 +259,32 @@ pub(crate) fn option_number(u: &mut Unstructured) -> Option<f64> {
         _ => Some(f64::from(u.int_in_range(1..=4096u16).unwrap_or(1)) / 1024.0),
     }
 }
+
+/// `played` measured afresh against `clip` (compiled) at every check time
+/// of the contract, by the metric and values of `settings` (`shell` with
+/// `skeleton`, else `value`): what the `reduce_readback` and `compress`
+/// targets hold a written clip to.
+pub(crate) fn measure_again(
+    clip: &tcb_core::SourceClip,
+    skeleton: Option<&tcb_core::skeleton::Skeleton>,
+    played: &std::sync::Arc<tcb_runtime::Clip>,
+    settings: &tcb_fit::reduce::Settings,
+) -> tcb_fit::metric::Measured {
+    use tcb_fit::metric;
+    let reference = std::sync::Arc::new(tcb_runtime::Clip::compile(clip));
+    let times = metric::check_times(clip);
+    let s = settings;
+    match (s.metric, skeleton) {
+        (tcb_fit::Metric::Shell, Some(sk)) => {
+            metric::shell_error(sk, &reference, played, &times, s.shell, s.tolerance)
+        }
+        _ => metric::value_error(
+            clip,
+            &metric::play(&reference, &times),
+            played,
+            &times,
+            s.tolerance,
+            s.rotation_tolerance,
+        ),
+    }
+}

@@ -360,22 +360,7 @@ pub fn compress(data: &[u8]) {
     let bytes = c.packed.to_bytes();
     assert_eq!(bytes.len(), c.bytes, "the bytes it reported");
     let loaded = Arc::new(tcb_runtime::Clip::from_bytes(&bytes).expect("its own file loads"));
-    let times = tcb_fit::metric::check_times(&clip);
-    let reference = Arc::new(tcb_runtime::Clip::compile(&clip));
-    let s = &c.settings;
-    let again: tcb_fit::metric::Measured = match (s.metric, skeleton.as_ref()) {
-        (tcb_fit::Metric::Shell, Some(sk)) => {
-            tcb_fit::metric::shell_error(sk, &reference, &loaded, &times, s.shell, s.tolerance)
-        }
-        _ => tcb_fit::metric::value_error(
-            &clip,
-            &tcb_fit::metric::play(&reference, &times),
-            &loaded,
-            &times,
-            s.tolerance,
-            s.rotation_tolerance,
-        ),
-    };
+    let again = measure_again(&clip, skeleton.as_ref(), &loaded, &c.settings);
     assert!(
         again.worst.ratio <= 1.0,
         "the file, loaded, is beyond the tolerance: {:?} (the search measured {:?}; {:?})",

@@ -3,8 +3,6 @@
 
 use arbitrary::Unstructured;
 use std::sync::Arc;
-use tcb_fit::Metric;
-use tcb_fit::metric;
 use tcb_io::ClipDoc;
 
 /// `tcb reduce`'s input as the `reduce` target draws it. A reduction that
@@ -40,30 +38,8 @@ pub fn reduce_readback(data: &[u8]) {
     }
     let built = back.build().expect("the reduced clip builds");
     let reduced = Arc::new(tcb_runtime::Clip::compile(&built));
-    let reference = Arc::new(tcb_runtime::Clip::compile(&clip));
-    let times = metric::check_times(&clip);
     let s = &r.settings;
-    let measured = match s.metric {
-        Metric::Shell => metric::shell_error(
-            skeleton.as_ref().expect("shell has a skeleton"),
-            &reference,
-            &reduced,
-            &times,
-            s.shell,
-            s.tolerance,
-        ),
-        Metric::Value => {
-            let rows = metric::play(&reference, &times);
-            metric::value_error(
-                &clip,
-                &rows,
-                &reduced,
-                &times,
-                s.tolerance,
-                s.rotation_tolerance,
-            )
-        }
-    };
+    let measured = crate::inputs::measure_again(&clip, skeleton.as_ref(), &reduced, s);
     assert!(
         measured.worst.ratio <= 1.0,
         "read back, the reduced clip is beyond its tolerance: {:?} (reported {:?}; {s:?})",
