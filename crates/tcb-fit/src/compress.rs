@@ -422,8 +422,9 @@ impl BlockSearch {
                     }
                 }
             }
-            if trial.0.worst.ratio <= 1.0 && bytes(&trial) < best.0 {
-                best = (bytes(&trial), trial);
+            let size = bytes(&trial);
+            if trial.0.worst.ratio <= 1.0 && size < best.0 {
+                best = (size, trial);
             }
             if last {
                 break;
