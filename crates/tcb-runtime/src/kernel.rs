@@ -223,23 +223,6 @@ pub(crate) fn renormalize_scaled(
     }
 }
 
-/// [`normalize`] in place on one block of 4 planes (rotations sampled as
-/// loose lanes: the curve and its derivative, normalized as soon as a block
-/// is evaluated).
-#[inline(always)]
-pub(crate) fn normalize_block(v: &mut [f32x8; 4], mut vel: Option<&mut [f32x8; 4]>) {
-    let p = *v;
-    let dp = vel.as_deref().copied();
-    let (q, qv) = normalize(p, dp);
-    *v = q;
-    if let (Some(d), Some(qv)) = (vel.as_deref_mut(), qv) {
-        *d = qv;
-    }
-    if in_range(&p).to_bitmask() != 0xff {
-        renormalize_scaled(&p, dp.as_ref(), v, vel.map(|d| d.as_mut_slice()));
-    }
-}
-
 /// The lanes of `mask` (`e.mask`, or `e.value_mask` without velocities) in
 /// one rotation block (4 planes), exactly: squad
 /// in f64 ([`tcb_core::simd::squad`]) at `s`, normalized, velocity times `rate`.

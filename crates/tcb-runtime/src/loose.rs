@@ -25,14 +25,17 @@
 //!
 //! The rows are evaluated by the same [`tcb_core::simd::basis::hermite`] on
 //! `f32x8` as every other kernel, from the same f64 `u` as the reference,
-//! so the values are the reference's bit for bit.
+//! so the values are the reference's bit for bit. Where `crate::isa` runs
+//! the AVX2 instance, blocks inside their keys compute `u`, the ease and
+//! the rows on `W8` and `D4` (one AVX instruction where `wide` runs two
+//! SSE2 halves): the same operations, the same bits.
 use crate::grid::{LaneRows, TimeGrid, sentinel_rows};
 use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
 use tcb_core::ease::{SegmentEase, ease};
 use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
 use tcb_core::simd::extrapolate::{ModeLanes, map_lanes};
-use tcb_core::simd::lane::Lane;
+use tcb_core::simd::lane::{Lane, Mask};
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
 
@@ -729,22 +732,64 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
     }
 }
 
+/// The lanes a block's kernel computes on: `wide`'s, as the build compiled
+/// them ([`Wide`]), or `tcb_core::simd::w8`'s, whose element-wise loops
+/// become AVX instructions in the AVX2 instance (`v3`). Either runs the
+/// same IEEE operations per lane in the same order: the same bits.
+trait Lanes {
+    /// Eight `f32`.
+    type F: Lane;
+    /// Four `f64`.
+    type D: Lane;
+    fn d(x: f64x4) -> Self::D;
+    fn f(x: &f32x8) -> Self::F;
+    fn store(x: Self::F) -> f32x8;
+    /// Two halves as eight lanes, each rounded as `as f32` does.
+    fn narrow(a: Self::D, b: Self::D) -> Self::F;
+}
+
+/// `wide`'s lanes, as the build compiled them.
+struct Wide;
+
+impl Lanes for Wide {
+    type F = f32x8;
+    type D = f64x4;
+    #[inline(always)]
+    fn d(x: f64x4) -> f64x4 {
+        x
+    }
+    #[inline(always)]
+    fn f(x: &f32x8) -> f32x8 {
+        *x
+    }
+    #[inline(always)]
+    fn store(x: f32x8) -> f32x8 {
+        x
+    }
+    #[inline(always)]
+    fn narrow(a: f64x4, b: f64x4) -> f32x8 {
+        f32x8_of(a, b)
+    }
+}
+
 /// `s` and the rate of a block (its two halves, its rates of uneased
 /// segments) when every lane is inside its keys, `t_0 <= time < t_{n-1}`,
 /// and so (after [`LooseState::advance`]) inside the segment it holds: `u`
 /// and the ease, nothing else.
 #[inline(always)]
-fn inside(eased: bool, half: &[Half; 2], rate: f32x8, time: f64) -> (f32x8, f32x8) {
-    let t = f64x4::splat(time);
+fn inside<K: Lanes>(eased: bool, half: &[Half; 2], rate: &f32x8, time: f64) -> (K::F, K::F) {
+    let t = K::D::of(time);
     // `t - ws` is at least 0 and at most `we - ws = D`, so `u` is already
-    // within the [0, 1] the reference clamps it to.
-    let u = half.map(|h| (t - h.ws) / h.d);
+    // within the [0, 1] the reference clamps it to. Written out, without
+    // closures (see `tcb_core::simd::w8`).
+    let d = [K::d(half[0].d), K::d(half[1].d)];
+    let u = [(t - K::d(half[0].ws)) / d[0], (t - K::d(half[1].ws)) / d[1]];
     if eased {
-        let e = [0, 1].map(|i| ease(u[i], half[i].from, half[i].to));
-        let rate = [e[0].1 / half[0].d, e[1].1 / half[1].d];
-        (f32x8_of(e[0].0, e[1].0), f32x8_of(rate[0], rate[1]))
+        let e0 = ease(u[0], K::d(half[0].from), K::d(half[0].to));
+        let e1 = ease(u[1], K::d(half[1].from), K::d(half[1].to));
+        (K::narrow(e0.0, e1.0), K::narrow(e0.1 / d[0], e1.1 / d[1]))
     } else {
-        (f32x8_of(u[0], u[1]), rate)
+        (K::narrow(u[0], u[1]), K::f(rate))
     }
 }
 
@@ -841,9 +886,38 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
 /// Sample every loose track at `time` into its pose planes.
 ///
 /// `ROTATIONS`: the lanes are rotations, each block normalized
-/// ([`crate::kernel::normalize_block`]) as soon as it is evaluated.
+/// ([`crate::kernel::normalize`]) as soon as it is evaluated.
 #[inline(always)]
 pub(crate) fn sample<const ROTATIONS: bool>(
+    loose: &Loose,
+    st: &mut LooseState,
+    time: f64,
+    values: &mut [f32x8],
+    velocities: Option<&mut [f32x8]>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::isa::avx2_kernels() {
+        return v3::sample_here::<ROTATIONS>(loose, st, time, values, velocities);
+    }
+    sample_wide::<ROTATIONS>(loose, st, time, values, velocities);
+}
+
+/// [`sample`] on `wide`'s lanes as built (out of line, as the AVX2
+/// instance is).
+#[inline(never)]
+fn sample_wide<const ROTATIONS: bool>(
+    loose: &Loose,
+    st: &mut LooseState,
+    time: f64,
+    values: &mut [f32x8],
+    velocities: Option<&mut [f32x8]>,
+) {
+    sample_on::<ROTATIONS, Wide>(loose, st, time, values, velocities);
+}
+
+/// [`sample`] on the lanes of `K`.
+#[inline(always)]
+fn sample_on<const ROTATIONS: bool, K: Lanes>(
     loose: &Loose,
     st: &mut LooseState,
     time: f64,
@@ -853,15 +927,16 @@ pub(crate) fn sample<const ROTATIONS: bool>(
     // Once per frame, so that the blocks' loop of the usual set (finite
     // controls) has no test for the other.
     if loose.unbounded {
-        sample_blocks::<ROTATIONS, true>(loose, st, time, values, velocities);
+        sample_blocks::<ROTATIONS, true, K>(loose, st, time, values, velocities);
     } else {
-        sample_blocks::<ROTATIONS, false>(loose, st, time, values, velocities);
+        sample_blocks::<ROTATIONS, false, K>(loose, st, time, values, velocities);
     }
 }
 
 /// [`sample`], with `UNBOUNDED` where some block stores a non-finite
 /// control.
-fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool>(
+#[inline(always)]
+fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
     loose: &Loose,
     st: &mut LooseState,
     time: f64,
@@ -883,28 +958,30 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool>(
                 let i = l % 4;
                 h.ws.to_array()[i] <= time && time < h.we.to_array()[i]
             }));
-            let (s, rate) = inside(info.eased, &block.half, block.rate, time);
+            let (s, rate) = inside::<K>(info.eased, &block.half, &block.rate, time);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
-                *o = hermite(&h, k[0], k[1], k[2], k[3]);
+                let v = hermite(&h, K::f(&k[0]), K::f(&k[1]), K::f(&k[2]), K::f(&k[3]));
+                *o = K::store(v);
             }
             if UNBOUNDED && info.unbounded {
                 // At a segment's end the value is its key, as the reference
                 // has it, even beside a tangent that overflowed f32 (0 x inf).
-                let at_end = Lane::eq(s, f32x8::ONE);
+                let at_end = Lane::eq(s, K::F::of(1.0));
                 for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
-                    *o = Lane::select(at_end, k[1], *o);
+                    *o = K::store(Lane::select(at_end, K::f(&k[1]), K::f(o)));
                 }
             }
             if let Some(vel) = velocities.as_deref_mut() {
                 let dh = hermite_basis_derivative(s);
                 for (k, o) in ctl.chunks_exact(4).zip(&mut vel[out.clone()]) {
-                    *o = hermite(&dh, k[0], k[1], k[2], k[3]) * rate;
+                    let v = hermite(&dh, K::f(&k[0]), K::f(&k[1]), K::f(&k[2]), K::f(&k[3]));
+                    *o = K::store(v * rate);
                 }
             }
             if ROTATIONS {
-                normalize(values, velocities.as_deref_mut(), out);
+                normalize::<K>(values, velocities.as_deref_mut(), out);
             }
             continue;
         }
@@ -925,19 +1002,133 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool>(
             }
         }
         if ROTATIONS {
-            normalize(values, velocities.as_deref_mut(), out);
+            normalize::<K>(values, velocities.as_deref_mut(), out);
         }
     }
 }
 
-/// Normalize the rotation block at planes `out` (and its velocities).
+/// Normalize the rotation block at planes `out` (and its velocities) on
+/// the lanes of `K` (out of range, through
+/// [`crate::kernel::renormalize_scaled`]). Matches rather than
+/// `Option::map`: no closure passed to a generic function in the AVX2
+/// instance (see `tcb_core::simd::w8`).
 #[inline(always)]
-fn normalize(values: &mut [f32x8], vel: Option<&mut [f32x8]>, out: std::ops::Range<usize>) {
+#[allow(clippy::manual_map)]
+fn normalize<K: Lanes>(
+    values: &mut [f32x8],
+    vel: Option<&mut [f32x8]>,
+    out: std::ops::Range<usize>,
+) {
     fn block(v: &mut [f32x8], out: std::ops::Range<usize>) -> &mut [f32x8; 4] {
         (&mut v[out]).try_into().expect("4 planes")
     }
-    let vel = vel.map(|v| block(v, out.clone()));
-    crate::kernel::normalize_block(block(values, out), vel);
+    let v = block(values, out.clone());
+    let mut vel = match vel {
+        Some(d) => Some(block(d, out)),
+        None => None,
+    };
+    let raw = *v;
+    let load = |x: &[f32x8; 4]| [K::f(&x[0]), K::f(&x[1]), K::f(&x[2]), K::f(&x[3])];
+    let p = load(&raw);
+    let raw_dp = vel.as_deref().copied();
+    let dp = match &raw_dp {
+        Some(d) => Some(load(d)),
+        None => None,
+    };
+    let (q, qv) = crate::kernel::normalize(p, dp);
+    *v = [
+        K::store(q[0]),
+        K::store(q[1]),
+        K::store(q[2]),
+        K::store(q[3]),
+    ];
+    if let (Some(d), Some(qv)) = (vel.as_deref_mut(), qv) {
+        *d = [
+            K::store(qv[0]),
+            K::store(qv[1]),
+            K::store(qv[2]),
+            K::store(qv[3]),
+        ];
+    }
+    if !crate::kernel::in_range(&p).all() {
+        let vel = match vel {
+            Some(d) => Some(d.as_mut_slice()),
+            None => None,
+        };
+        crate::kernel::renormalize_scaled(&raw, raw_dp.as_ref(), v, vel);
+    }
+}
+
+/// The AVX2 + FMA instance of the blocks' kernel (see `crate::isa`): the
+/// same code on `tcb_core::simd::w8`'s `W8` and `D4`.
+#[cfg(target_arch = "x86_64")]
+mod v3 {
+    use crate::loose::{Lanes, Loose, LooseState, sample_on};
+    use wide::{f32x8, f64x4};
+    use tcb_core::simd::w8::{D4, W8};
+
+    /// `W8` and `D4`.
+    pub(super) struct Avx2;
+
+    impl Lanes for Avx2 {
+        type F = W8;
+        type D = D4;
+        #[inline(always)]
+        fn d(x: f64x4) -> D4 {
+            D4(x.to_array())
+        }
+        #[inline(always)]
+        fn f(x: &f32x8) -> W8 {
+            W8(x.to_array())
+        }
+        #[inline(always)]
+        fn store(x: W8) -> f32x8 {
+            f32x8::new(x.0)
+        }
+        #[inline(always)]
+        fn narrow(a: D4, b: D4) -> W8 {
+            let (a, b) = (a.0, b.0);
+            W8([
+                a[0] as f32,
+                a[1] as f32,
+                a[2] as f32,
+                a[3] as f32,
+                b[0] as f32,
+                b[1] as f32,
+                b[2] as f32,
+                b[3] as f32,
+            ])
+        }
+    }
+
+    /// [`crate::loose::sample`], where `crate::isa::avx2_kernels` said so.
+    #[inline(always)]
+    pub(super) fn sample_here<const ROTATIONS: bool>(
+        loose: &Loose,
+        st: &mut LooseState,
+        time: f64,
+        values: &mut [f32x8],
+        velocities: Option<&mut [f32x8]>,
+    ) {
+        debug_assert!(crate::isa::avx2_kernels());
+        // SAFETY: `crate::isa::avx2` detected AVX2 and FMA on this CPU
+        // before the caller came here.
+        #[allow(unsafe_code)]
+        unsafe {
+            sample::<ROTATIONS>(loose, st, time, values, velocities)
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn sample<const ROTATIONS: bool>(
+        loose: &Loose,
+        st: &mut LooseState,
+        time: f64,
+        values: &mut [f32x8],
+        velocities: Option<&mut [f32x8]>,
+    ) {
+        sample_on::<ROTATIONS, Avx2>(loose, st, time, values, velocities);
+    }
 }
 
 /// `P_{n-1} - P_0` of each lane and component, per block of 8 lanes and

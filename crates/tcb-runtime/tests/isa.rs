@@ -49,6 +49,60 @@ fn compare(name: &str, avx2: &[u32], base: &[u32]) {
     }
 }
 
+/// 24 tracks, each on key times of its own (loose lanes): scalars, vectors
+/// and rotations (`hermite` and `squad`), with eases, a step and every
+/// extrapolation mode, and more than 8 of each kind (two blocks).
+fn loose_clip() -> tcb_core::SourceClip {
+    let modes = ["constant", "linear", "repeat", "offset-repeat", "oscillate"];
+    let tracks: Vec<String> = (0..24)
+        .map(|i| {
+            let d = 0.05 * i as f64;
+            let times = format!("[{d}, {}, {}, {}]", 0.4 + d, 1.1 + d, 1.7 + 2.0 * d);
+            let (mut pre, mut post) = (modes[i % 5], modes[(i / 5) % 5]);
+            let keys = match i % 6 {
+                0 => r#", "keys": [{}, {"ease": [0.5, 0.25]}, {"tcb": [0.5, -0.5, 0.25]}, {}]"#,
+                1 => r#", "keys": [{}, {"interp": "step"}, {}, {}]"#,
+                _ => "",
+            };
+            let (kind, values, extra) = match i % 4 {
+                0 | 1 => ("scalar", format!("[{i}, 3, -1, 2.5]"), ""),
+                2 => (
+                    "vec3",
+                    format!("[[{i}, 0, 1], [1, 2, 3], [-1, 0.5, 2], [0, 0, {d}]]"),
+                    "",
+                ),
+                _ => (
+                    // Rotations have neither `linear` nor `offset-repeat`.
+                    {
+                        for m in [&mut pre, &mut post] {
+                            if *m == "linear" || *m == "offset-repeat" {
+                                *m = "oscillate";
+                            }
+                        }
+                        "quat"
+                    },
+                    format!(
+                        "[[0, 0, 0, 1], [0.2, 0.1, 0, 0.97], [0.{i}, -0.3, 0.1, 0.9], [0, 0.7, 0, 0.7]]"
+                    ),
+                    if i % 8 == 3 {
+                        r#", "rotation": "hermite""#
+                    } else {
+                        ""
+                    },
+                ),
+            };
+            format!(
+                r#"{{"name": "t{i}", "kind": "{kind}", "times": {times}, "values": {values}, "pre": "{pre}", "post": "{post}"{keys}{extra}}}"#
+            )
+        })
+        .collect();
+    let text = format!(
+        r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
+        tracks.join(",")
+    );
+    tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()
+}
+
 /// Keys, a quarter and three quarters between them, and beyond both ends.
 fn times_of(clip: &tcb_core::SourceClip) -> Vec<f64> {
     let keys = clip.key_times();
@@ -82,13 +136,31 @@ fn the_avx2_kernels_give_the_baselines_bits() {
         same_bits(&format!("cmu {mode:?}"), &clip, &times_of(&clip));
     }
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+    let mut loose = 0;
     for dir in ["examples/clips", "tools/check/clips"] {
         for entry in std::fs::read_dir(format!("{root}/{dir}")).unwrap() {
             let path = entry.unwrap().path();
             let clip = tcb_io::load_clip(&path).unwrap();
+            loose += Clip::compile(&clip).loose_track_count();
             same_bits(&path.display().to_string(), &clip, &times_of(&clip));
         }
     }
+    // The loose tracks' kernel has an AVX2 instance too: the bundled clips
+    // play some on loose lanes, and so does this one, of every kind.
+    assert!(loose > 0, "the bundled clips have loose tracks");
+    let clip = loose_clip();
+    assert!(Clip::compile(&clip).loose_track_count() > 16);
+    let mut times = times_of(&clip);
+    times.extend([-3.3, -0.5, 9.75, 33.1, 1e300]);
+    same_bits("loose lanes", &clip, &times);
+    // Alone, the rotation with tangents of 2.3e36 is a loose lane.
+    let clip = common::huge_tangent_rotations(1, 0);
+    assert_eq!(Clip::compile(&clip).loose_track_count(), 1);
+    same_bits(
+        "huge tangents, loose",
+        &clip,
+        &[0.25, 0.5, 0.9, 1.0, 1.5, 2.0],
+    );
     // Tangents of 2.3e36 on one of 9 `hermite` rotations on one grid: its
     // |p|^2 overflows f32, and the group kernel redoes the block scaled.
     let clip = common::huge_tangent_rotations(9, 5);

@@ -259,6 +259,53 @@ mod tests {
     }
 
     #[test]
+    fn d4_lanes_agree_with_wide() {
+        use crate::simd::w8::D4;
+        let xs = [-2.5, 1e300, f64::NAN, 0.5];
+        let ys = [1.0, -0.0, 0.0, 0.5];
+        let (da, db) = (D4(xs), D4(ys));
+        let (va, vb) = (f64x4::new(xs), f64x4::new(ys));
+        let same = |d: D4, v: f64x4| {
+            for (x, y) in d.0.iter().zip(v.to_array()) {
+                assert!(
+                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+                    "{x} {y}"
+                );
+            }
+        };
+        same(da + db, va + vb);
+        same(da - db, va - vb);
+        same(da * db, va * vb);
+        same(da / db, va / vb);
+        same(-da, -va);
+        same(D4::splat(0.1), <f64x4 as Real>::splat(0.1));
+        same((da / D4::of(3.0)).sqrt(), (va / f64x4::of(3.0)).sqrt());
+        same(da.abs(), va.abs());
+        same(da.floor(), va.floor());
+        for (d, v) in [
+            (
+                D4::select(da.lt(db), da, db),
+                f64x4::select(va.lt(vb), va, vb),
+            ),
+            (
+                D4::select(da.le(db), da, db),
+                f64x4::select(va.le(vb), va, vb),
+            ),
+            (
+                D4::select(da.eq(db), da, db),
+                f64x4::select(va.eq(vb), va, vb),
+            ),
+        ] {
+            same(d, v);
+        }
+        let m = da.le(db);
+        assert_eq!(m.any(), va.le(vb).any());
+        assert_eq!(m.all(), va.le(vb).all());
+        assert!(!(m & !m).any());
+        assert!((m | !m).all());
+    }
+
+    #[test]
     fn i8_lanes_agree_with_wide() {
         use crate::simd::w8::I8;
         use wide::i32x8;

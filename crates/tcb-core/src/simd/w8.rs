@@ -36,6 +36,18 @@ pub struct M8(pub [u32; 8]);
 #[repr(C, align(32))]
 pub struct I8(pub [i32; 8]);
 
+/// Four `f64` lanes, as [`W8`] is eight `f32`: what the AVX2 instance of
+/// the loose tracks' kernel computes times in (`wide::f64x4`'s two SSE2
+/// halves in a default build).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct D4(pub [f64; 4]);
+
+/// Per-lane booleans of [`D4`]: all bits set or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct M4(pub [u64; 4]);
+
 impl I8 {
     /// Each lane shifted right by `N` bits as an unsigned integer (zeros
     /// in from the left).
@@ -93,92 +105,99 @@ macro_rules! elementwise {
         }
     };
 }
-elementwise!(W8, Add, add, +);
-elementwise!(W8, Sub, sub, -);
-elementwise!(W8, Mul, mul, *);
-elementwise!(W8, Div, div, /);
-impl Neg for W8 {
-    type Output = W8;
-    #[inline(always)]
-    fn neg(self) -> W8 {
-        W8(self.0.map(|x| -x))
-    }
-}
 elementwise!(I8, Add, add, .wrapping_add);
 elementwise!(I8, Sub, sub, .wrapping_sub);
 elementwise!(I8, BitAnd, bitand, &);
 elementwise!(I8, BitXor, bitxor, ^);
-elementwise!(M8, BitAnd, bitand, &);
-elementwise!(M8, BitOr, bitor, |);
-impl Not for M8 {
-    type Output = M8;
-    #[inline(always)]
-    fn not(self) -> M8 {
-        M8(self.0.map(|x| !x))
-    }
+
+/// Float lanes `$t` of `$n` elements `$e`, with masks `$m` of the
+/// unsigned integers `$u` of the same width: arithmetic, [`Real`] and
+/// [`Lane`], each an element-wise loop.
+macro_rules! float_lanes {
+    ($t:ident, $m:ident, $e:ty, $u:ty) => {
+        elementwise!($t, Add, add, +);
+        elementwise!($t, Sub, sub, -);
+        elementwise!($t, Mul, mul, *);
+        elementwise!($t, Div, div, /);
+        impl Neg for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn neg(self) -> $t {
+                $t(self.0.map(|x| -x))
+            }
+        }
+        elementwise!($m, BitAnd, bitand, &);
+        elementwise!($m, BitOr, bitor, |);
+        impl Not for $m {
+            type Output = $m;
+            #[inline(always)]
+            fn not(self) -> $m {
+                $m(self.0.map(|x| !x))
+            }
+        }
+        impl Mask for $m {
+            #[inline(always)]
+            fn any(self) -> bool {
+                self.0.iter().fold(0, |a, &x| a | x) != 0
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                self.0.iter().fold(<$u>::MAX, |a, &x| a & x) == <$u>::MAX
+            }
+        }
+        impl Real for $t {
+            #[inline(always)]
+            fn splat(x: f32) -> Self {
+                $t([<$e>::from(x); _])
+            }
+        }
+        impl Lane for $t {
+            type Mask = $m;
+            #[inline(always)]
+            fn of(x: f64) -> Self {
+                $t([x as $e; _])
+            }
+            #[inline(always)]
+            fn lt(self, o: Self) -> $m {
+                $m(std::array::from_fn(|i| <$u>::from(self.0[i] < o.0[i]).wrapping_neg()))
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> $m {
+                $m(std::array::from_fn(|i| <$u>::from(self.0[i] <= o.0[i]).wrapping_neg()))
+            }
+            #[inline(always)]
+            fn eq(self, o: Self) -> $m {
+                $m(std::array::from_fn(|i| <$u>::from(self.0[i] == o.0[i]).wrapping_neg()))
+            }
+            #[inline(always)]
+            fn select(k: $m, a: Self, b: Self) -> Self {
+                $t(std::array::from_fn(|i| {
+                    <$e>::from_bits((a.0[i].to_bits() & k.0[i]) | (b.0[i].to_bits() & !k.0[i]))
+                }))
+            }
+            #[inline(always)]
+            fn floor(self) -> Self {
+                $t(self.0.map(<$e>::floor))
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $t(self.0.map(<$e>::sqrt))
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                $t(self.0.map(<$e>::abs))
+            }
+            #[inline(always)]
+            fn sin_cos(self) -> (Self, Self) {
+                ($t(self.0.map(<$e>::sin)), $t(self.0.map(<$e>::cos)))
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                $t(std::array::from_fn(|i| self.0[i].atan2(x.0[i])))
+            }
+        }
+    };
 }
-impl Mask for M8 {
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.iter().fold(0, |a, &x| a | x) != 0
-    }
-    #[inline(always)]
-    fn all(self) -> bool {
-        self.0.iter().fold(u32::MAX, |a, &x| a & x) == u32::MAX
-    }
-}
-impl Real for W8 {
-    #[inline(always)]
-    fn splat(x: f32) -> Self {
-        W8([x; 8])
-    }
-}
-#[inline(always)]
-fn m(b: bool) -> u32 {
-    if b { u32::MAX } else { 0 }
-}
-impl Lane for W8 {
-    type Mask = M8;
-    #[inline(always)]
-    fn of(x: f64) -> Self {
-        W8([x as f32; 8])
-    }
-    #[inline(always)]
-    fn lt(self, o: Self) -> M8 {
-        M8(std::array::from_fn(|i| m(self.0[i] < o.0[i])))
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> M8 {
-        M8(std::array::from_fn(|i| m(self.0[i] <= o.0[i])))
-    }
-    #[inline(always)]
-    fn eq(self, o: Self) -> M8 {
-        M8(std::array::from_fn(|i| m(self.0[i] == o.0[i])))
-    }
-    #[inline(always)]
-    fn select(k: M8, a: Self, b: Self) -> Self {
-        W8(std::array::from_fn(|i| {
-            f32::from_bits((a.0[i].to_bits() & k.0[i]) | (b.0[i].to_bits() & !k.0[i]))
-        }))
-    }
-    #[inline(always)]
-    fn floor(self) -> Self {
-        W8(self.0.map(f32::floor))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        W8(self.0.map(f32::sqrt))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        W8(self.0.map(f32::abs))
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        (W8(self.0.map(f32::sin)), W8(self.0.map(f32::cos)))
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        W8(std::array::from_fn(|i| self.0[i].atan2(x.0[i])))
-    }
-}
+
+float_lanes!(W8, M8, f32, u32);
+float_lanes!(D4, M4, f64, u64);
