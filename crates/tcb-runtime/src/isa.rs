@@ -2,8 +2,9 @@
 //!
 //! A default x86-64 build runs `wide`'s `f32x8` as two SSE2 halves. Where
 //! the CPU has AVX2 and FMA, the group kernels (vector channels, and
-//! rotation values), the loose tracks' blocks and the packed clips'
-//! decoder run an instance compiled for them instead, on
+//! rotation values), the expansion of 16-bit controls, the loose
+//! tracks' blocks and the packed clips' decoder run an instance compiled
+//! for them instead, on
 //! [`tcb_core::simd::w8::W8`], `D4` and `I8`: the same
 //! formulas, the same IEEE operations per lane in the same order, so the
 //! same bits (`tests/isa.rs` compares the two on every scenario shape).

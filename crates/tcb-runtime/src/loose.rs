@@ -112,7 +112,9 @@ impl LooseLane {
             Keys::U16(u) => {
                 let U16Keys { q, min, scale } = &**u;
                 let c = i % self.dim;
-                std::array::from_fn(|j| min[c][j] + f32::from(q[i][j]) * scale[c][j])
+                std::array::from_fn(|j| {
+                    crate::quant::dequantize16(min[c][j], f32::from(q[i][j]), scale[c][j])
+                })
             }
         }
     }
@@ -165,7 +167,8 @@ impl LooseLane {
                         0
                     };
                     let e = &mut error[c][j];
-                    *e = crate::quant::worse(*e, (lo + f32::from(q) * s - k[j]).abs());
+                    let back = crate::quant::dequantize16(lo, f32::from(q), s);
+                    *e = crate::quant::worse(*e, (back - k[j]).abs());
                     q
                 })
             })
@@ -1064,8 +1067,8 @@ fn normalize<K: Lanes>(
 #[cfg(target_arch = "x86_64")]
 mod v3 {
     use crate::loose::{Lanes, Loose, LooseState, sample_on};
-    use wide::{f32x8, f64x4};
     use tcb_core::simd::w8::{D4, W8};
+    use wide::{f32x8, f64x4};
 
     /// `W8` and `D4`.
     pub(super) struct Avx2;

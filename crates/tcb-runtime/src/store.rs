@@ -215,10 +215,11 @@ impl KeyStore {
         let ([pa, _], [pb, ib]) = (self.at[a], self.at[b]);
         let (pa, pb, ib) = (pa as usize, pb as usize, ib as usize);
         let ti = if ib == pb + n { TO } else { TI };
-        cache.ensure(q, sa, P, pa);
-        cache.ensure(q, sa, TO, pa + n);
-        cache.ensure(q, sb, P, pb);
-        cache.ensure(q, sb, ti, ib);
+        let avx2 = crate::isa::avx2_kernels();
+        cache.ensure(q, sa, P, pa, avx2);
+        cache.ensure(q, sa, TO, pa + n, avx2);
+        cache.ensure(q, sb, P, pb, avx2);
+        cache.ensure(q, sb, ti, ib, avx2);
         Segment {
             p0: cache.section(sa, P, n),
             m0: cache.section(sa, TO, n),
@@ -307,13 +308,13 @@ impl KeyCache {
     }
 
     /// Expand section `j` of slot `s` from the quantized numbers at `at`,
-    /// unless it is there.
+    /// unless it is there (`avx2`: as [`Quantized::expand`] takes it).
     #[inline(always)]
-    fn ensure(&mut self, q: &Quantized, s: usize, j: usize, at: usize) {
+    fn ensure(&mut self, q: &Quantized, s: usize, j: usize, at: usize, avx2: bool) {
         if self.valid[s] & (1 << j) == 0 {
             let n = self.planes;
             let start = (3 * s + j) * n;
-            q.expand(at, j != P, &mut self.data[start..start + n]);
+            q.expand(at, j != P, &mut self.data[start..start + n], avx2);
             self.valid[s] |= 1 << j;
         }
     }

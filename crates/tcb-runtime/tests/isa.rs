@@ -17,6 +17,14 @@ fn rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> 
     compiled_rows(Arc::new(Clip::compile(clip)), times)
 }
 
+/// [`rows`] of `clip` compiled with 16-bit controls.
+fn quantized_rows(clip: &tcb_core::SourceClip, times: &[f64], baseline: bool) -> Vec<u32> {
+    tcb_runtime::force_baseline_simd(baseline);
+    let mut options = tcb_runtime::CompileOptions::default();
+    options.quantize = true;
+    compiled_rows(Arc::new(Clip::compile_with(clip, &options)), times)
+}
+
 /// Rows of a compiled clip at `times`, without and with velocities.
 fn compiled_rows(compiled: Arc<Clip>, times: &[f64]) -> Vec<u32> {
     let n = compiled.channel_count();
@@ -135,6 +143,15 @@ fn the_avx2_kernels_give_the_baselines_bits() {
         let clip = bvh.to_clip_doc("cmu", mode).unwrap().build().unwrap();
         same_bits(&format!("cmu {mode:?}"), &clip, &times_of(&clip));
     }
+    // 16-bit controls: the groups expand them with an AVX2 instance too.
+    let clip = bvh
+        .to_clip_doc("cmu", RotationMode::Hermite)
+        .unwrap()
+        .build()
+        .unwrap();
+    let times = times_of(&clip);
+    let avx2 = quantized_rows(&clip, &times, false);
+    compare("cmu quantized", &avx2, &quantized_rows(&clip, &times, true));
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
     let mut loose = 0;
     for dir in ["examples/clips", "tools/check/clips"] {
