@@ -55,11 +55,26 @@ pub fn force_baseline_simd(on: bool) {
     STATE.store(if on { BASELINE } else { detect() }, Ordering::Relaxed);
 }
 
-/// Whether the group kernels run the AVX2 instance: in builds without
-/// AVX2, where it was detected (module docs).
+/// Whether the group kernels (and the 16-bit expansion and the loose
+/// lanes' blocks) run the AVX2 instance: in builds without AVX2, where it
+/// was detected (module docs).
 #[inline(always)]
 pub(crate) fn avx2_kernels() -> bool {
     !cfg!(target_feature = "avx2") && avx2()
+}
+
+/// Proof that [`avx2_kernels`] said yes: a function that takes one may run
+/// AVX2 and FMA instructions. Only [`Avx2Kernels::now`] makes one.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Avx2Kernels(());
+
+impl Avx2Kernels {
+    /// One where [`avx2_kernels`] says so, for a caller that asks once and
+    /// passes it on to several kernels.
+    #[inline(always)]
+    pub(crate) fn now() -> Option<Self> {
+        avx2_kernels().then_some(Avx2Kernels(()))
+    }
 }
 
 /// Whether the AVX2 instance of the packed decoder runs (detected, or

@@ -27,8 +27,9 @@
 //! `f32x8` as every other kernel, from the same f64 `u` as the reference,
 //! so the values are the reference's bit for bit. Where `crate::isa` runs
 //! the AVX2 instance, blocks inside their keys compute `u`, the ease and
-//! the rows on `W8` and `D4` (one AVX instruction where `wide` runs two
-//! SSE2 halves): the same operations, the same bits.
+//! the rows on `W8` and `D4`, and every rotation block is normalized on
+//! `W8` (one AVX instruction where `wide` runs two SSE2 halves): the same
+//! operations, the same bits.
 use crate::grid::{LaneRows, TimeGrid, sentinel_rows};
 use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
@@ -738,7 +739,9 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
 /// The lanes a block's kernel computes on: `wide`'s, as the build compiled
 /// them ([`Wide`]), or `tcb_core::simd::w8`'s, whose element-wise loops
 /// become AVX instructions in the AVX2 instance (`v3`). Either runs the
-/// same IEEE operations per lane in the same order: the same bits.
+/// same IEEE operations per lane in the same order (arithmetic, square
+/// roots, compares, selects and conversions; the kernel calls no
+/// `sin_cos` or `atan2`, whose polynomials differ): the same bits.
 trait Lanes {
     /// Eight `f32`.
     type F: Lane;
@@ -889,7 +892,7 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
 /// Sample every loose track at `time` into its pose planes.
 ///
 /// `ROTATIONS`: the lanes are rotations, each block normalized
-/// ([`crate::kernel::normalize`]) as soon as it is evaluated.
+/// ([`normalize`]) as soon as it is evaluated.
 #[inline(always)]
 pub(crate) fn sample<const ROTATIONS: bool>(
     loose: &Loose,

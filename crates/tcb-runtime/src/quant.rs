@@ -143,18 +143,26 @@ impl Quantized {
 
     /// Expand the section (`planes` vectors) starting at `at` into `out`:
     /// a `P` section, or with `tangent` a `TO` or `TI` one.
-    /// `avx2`: run the AVX2 instance (what `crate::isa::avx2_kernels`
-    /// says, asked once per segment by the caller).
+    /// `avx2`: run the AVX2 instance (asked once per segment by the
+    /// caller).
     #[inline(always)]
-    pub fn expand(&self, at: usize, tangent: bool, out: &mut [f32x8], avx2: bool) {
+    pub fn expand(
+        &self,
+        at: usize,
+        tangent: bool,
+        out: &mut [f32x8],
+        avx2: Option<crate::isa::Avx2Kernels>,
+    ) {
         let n = self.planes;
         let r = usize::from(tangent) * n;
         let src = &self.data[at..at + n];
         let (min, scale) = (&self.min[r..r + n], &self.scale[r..r + n]);
         #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            return v3::expand_here(src, min, scale, out);
+        if let Some(avx2) = avx2 {
+            return v3::expand_here(avx2, src, min, scale, out);
         }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = avx2;
         for (((o, q), lo), s) in out.iter_mut().zip(src).zip(min).zip(scale) {
             *o = dequantize16(*lo, f32x8::from_i32x8(i32x8::from_u16x8(*q)), *s);
         }
@@ -173,18 +181,24 @@ impl Quantized {
 /// converted in one instruction per plane.
 #[cfg(target_arch = "x86_64")]
 mod v3 {
+    use crate::isa::Avx2Kernels;
     use crate::quant::dequantize16;
     use std::arch::x86_64::{__m256, _mm256_cvtepi32_ps, _mm256_cvtepu16_epi32};
     use tcb_core::simd::w8::W8;
     use wide::{f32x8, u16x8};
 
     /// [`crate::quant::Quantized::expand`]'s planes, where
-    /// `crate::isa::avx2_kernels` said so.
+    /// `crate::isa::avx2_kernels` said so (the token).
     #[inline(always)]
-    pub(super) fn expand_here(src: &[u16x8], min: &[f32x8], scale: &[f32x8], out: &mut [f32x8]) {
-        debug_assert!(crate::isa::avx2_kernels());
-        // SAFETY: `crate::isa::avx2` detected AVX2 and FMA on this CPU
-        // before the caller came here (`avx2` of `Quantized::expand`).
+    pub(super) fn expand_here(
+        _: Avx2Kernels,
+        src: &[u16x8],
+        min: &[f32x8],
+        scale: &[f32x8],
+        out: &mut [f32x8],
+    ) {
+        // SAFETY: an `Avx2Kernels` exists only where `crate::isa` detected
+        // AVX2 and FMA on this CPU.
         #[allow(unsafe_code)]
         unsafe {
             expand(src, min, scale, out)

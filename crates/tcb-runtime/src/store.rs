@@ -215,7 +215,7 @@ impl KeyStore {
         let ([pa, _], [pb, ib]) = (self.at[a], self.at[b]);
         let (pa, pb, ib) = (pa as usize, pb as usize, ib as usize);
         let ti = if ib == pb + n { TO } else { TI };
-        let avx2 = crate::isa::avx2_kernels();
+        let avx2 = crate::isa::Avx2Kernels::now();
         cache.ensure(q, sa, P, pa, avx2);
         cache.ensure(q, sa, TO, pa + n, avx2);
         cache.ensure(q, sb, P, pb, avx2);
@@ -310,7 +310,14 @@ impl KeyCache {
     /// Expand section `j` of slot `s` from the quantized numbers at `at`,
     /// unless it is there (`avx2`: as [`Quantized::expand`] takes it).
     #[inline(always)]
-    fn ensure(&mut self, q: &Quantized, s: usize, j: usize, at: usize, avx2: bool) {
+    fn ensure(
+        &mut self,
+        q: &Quantized,
+        s: usize,
+        j: usize,
+        at: usize,
+        avx2: Option<crate::isa::Avx2Kernels>,
+    ) {
         if self.valid[s] & (1 << j) == 0 {
             let n = self.planes;
             let start = (3 * s + j) * n;

@@ -1,9 +1,13 @@
-//! The AVX2 instance of the group kernels (`tcb_runtime::simd`) against
-//! the build's own, bit for bit: the CMU capture in both rotation modes,
-//! every bundled clip, and tangents beyond f32 (the out-of-range redo), at
-//! keys, between them and beyond them, with and without velocities; and
-//! the packed decoder's instances on packed clips. One
-//! test in its own binary: it switches the process-wide choice.
+//! The AVX2 instance of the kernels (`tcb_runtime::simd`) against the
+//! build's own, bit for bit: the CMU capture in both rotation modes and
+//! with 16-bit controls, every bundled clip, tracks on key times of their
+//! own (loose lanes) of every kind, and tangents beyond f32 (the
+//! out-of-range redo), at keys, between them and beyond them, with and
+//! without velocities; and the packed decoder's instances on packed
+//! clips. One test in its own binary: it switches the process-wide
+//! choice. In builds with AVX2 enabled (`-C target-cpu=native`), the group
+//! kernels, the 16-bit expansion and the loose blocks are `wide`'s own
+//! AVX2 already: there the comparisons are of one instance with itself.
 
 use std::sync::Arc;
 use tcb_core::params::RotationMode;
@@ -57,50 +61,55 @@ fn compare(name: &str, avx2: &[u32], base: &[u32]) {
     }
 }
 
-/// 24 tracks, each on key times of its own (loose lanes): scalars, vectors
-/// and rotations (`hermite` and `squad`), with eases, a step and every
-/// extrapolation mode, and more than 8 of each kind (two blocks).
+/// 32 tracks, each on key times of its own: 16 vector tracks (scalars
+/// and 3-vectors) and 16 `hermite` rotations, loose lanes in two blocks of
+/// each, with eases, steps, every extrapolation mode and, on one
+/// scalar, tangents beyond f32 (its block is `unbounded`: at a segment's
+/// end the key is selected).
 fn loose_clip() -> tcb_core::SourceClip {
-    let modes = ["constant", "linear", "repeat", "offset-repeat", "oscillate"];
-    let tracks: Vec<String> = (0..24)
+    let modes = [
+        "constant",
+        "linear",
+        "repeat",
+        "offset-repeat",
+        "oscillate",
+        "reset",
+    ];
+    let tracks: Vec<String> = (0..32)
         .map(|i| {
             let d = 0.05 * i as f64;
             let times = format!("[{d}, {}, {}, {}]", 0.4 + d, 1.1 + d, 1.7 + 2.0 * d);
-            let (mut pre, mut post) = (modes[i % 5], modes[(i / 5) % 5]);
-            let keys = match i % 6 {
-                0 => r#", "keys": [{}, {"ease": [0.5, 0.25]}, {"tcb": [0.5, -0.5, 0.25]}, {}]"#,
-                1 => r#", "keys": [{}, {"interp": "step"}, {}, {}]"#,
+            let (mut pre, mut post) = (modes[i % 6], modes[(i / 6) % 6]);
+            let keys = match (i, i % 3) {
+                (_, 0) => r#", "keys": [{}, {"ease": [0.5, 0.25]}, {"tcb": [0.5, -0.5, 0.25]}, {}]"#,
+                (_, 1) => r#", "keys": [{}, {"interp": "step"}, {}, {}]"#,
                 _ => "",
             };
-            let (kind, values, extra) = match i % 4 {
-                0 | 1 => ("scalar", format!("[{i}, 3, -1, 2.5]"), ""),
-                2 => (
+            let (kind, values) = match i % 4 {
+                // Chords of 6e38: tangents beyond f32.
+                0 if i == 4 => ("scalar", "[0, 3e38, -3e38, 3e38]".to_string()),
+                0 => ("scalar", format!("[{i}, 3, -1, 2.5]")),
+                1 => (
                     "vec3",
                     format!("[[{i}, 0, 1], [1, 2, 3], [-1, 0.5, 2], [0, 0, {d}]]"),
-                    "",
                 ),
-                _ => (
+                _ => {
                     // Rotations have neither `linear` nor `offset-repeat`.
-                    {
-                        for m in [&mut pre, &mut post] {
-                            if *m == "linear" || *m == "offset-repeat" {
-                                *m = "oscillate";
-                            }
+                    for m in [&mut pre, &mut post] {
+                        if *m == "linear" || *m == "offset-repeat" {
+                            *m = "oscillate";
                         }
-                        "quat"
-                    },
-                    format!(
-                        "[[0, 0, 0, 1], [0.2, 0.1, 0, 0.97], [0.{i}, -0.3, 0.1, 0.9], [0, 0.7, 0, 0.7]]"
-                    ),
-                    if i % 8 == 3 {
-                        r#", "rotation": "hermite""#
-                    } else {
-                        ""
-                    },
-                ),
+                    }
+                    (
+                        "quat",
+                        format!(
+                            "[[0, 0, 0, 1], [0.2, 0.1, 0, 0.97], [0.{i}, -0.3, 0.1, 0.9], [0, 0.7, 0, 0.7]]"
+                        ),
+                    )
+                }
             };
             format!(
-                r#"{{"name": "t{i}", "kind": "{kind}", "times": {times}, "values": {values}, "pre": "{pre}", "post": "{post}"{keys}{extra}}}"#
+                r#"{{"name": "t{i}", "kind": "{kind}", "times": {times}, "values": {values}, "pre": "{pre}", "post": "{post}", "rotation": "hermite"{keys}}}"#
             )
         })
         .collect();
@@ -150,6 +159,14 @@ fn the_avx2_kernels_give_the_baselines_bits() {
         .build()
         .unwrap();
     let times = times_of(&clip);
+    tcb_runtime::force_baseline_simd(false);
+    let mut options = tcb_runtime::CompileOptions::default();
+    options.quantize = true;
+    let bytes = Clip::compile_with(&clip, &options).memory_bytes();
+    assert!(
+        bytes < Clip::compile(&clip).memory_bytes() * 2 / 3,
+        "quantized"
+    );
     let avx2 = quantized_rows(&clip, &times, false);
     compare("cmu quantized", &avx2, &quantized_rows(&clip, &times, true));
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
@@ -166,7 +183,10 @@ fn the_avx2_kernels_give_the_baselines_bits() {
     // play some on loose lanes, and so does this one, of every kind.
     assert!(loose > 0, "the bundled clips have loose tracks");
     let clip = loose_clip();
-    assert!(Clip::compile(&clip).loose_track_count() > 16);
+    let stats = Clip::compile(&clip).stats();
+    // Two blocks of each (some rotations take a group of their own).
+    assert_eq!(stats.loose_vector_tracks, 16);
+    assert!(stats.loose_rotation_tracks > 8, "{stats:?}");
     let mut times = times_of(&clip);
     times.extend([-3.3, -0.5, 9.75, 33.1, 1e300]);
     same_bits("loose lanes", &clip, &times);

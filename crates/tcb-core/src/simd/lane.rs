@@ -3,7 +3,8 @@
 //! [`Lane`] extends [`Real`] with division, comparisons, selects and a few
 //! functions. It is implemented for `f32` and `f64` (one lane: the scalar
 //! reference), for `wide::f32x8` and `wide::f64x4` (the runtime's
-//! kernels) and for [`crate::simd::w8::W8`] (their AVX2 instance), so time
+//! kernels) and for [`crate::simd::w8::W8`] and [`crate::simd::w8::D4`]
+//! (their AVX2 instance), so time
 //! mapping, ease, normalization and the Hermite basis run the same
 //! operations in the same order on one lane and on eight (as
 //! ultraviolet and wide do). Branches become selects: every side of a
@@ -261,7 +262,7 @@ mod tests {
     #[test]
     fn d4_lanes_agree_with_wide() {
         use crate::simd::w8::D4;
-        let xs = [-2.5, 1e300, f64::NAN, 0.5];
+        let xs = [-2.5, 1e300, f64::NAN, -0.0];
         let ys = [1.0, -0.0, 0.0, 0.5];
         let (da, db) = (D4(xs), D4(ys));
         let (va, vb) = (f64x4::new(xs), f64x4::new(ys));
@@ -297,6 +298,15 @@ mod tests {
             ),
         ] {
             same(d, v);
+        }
+        same(
+            da.clamp_to(D4::of(0.0), db.abs()),
+            va.clamp_to(f64x4::of(0.0), vb.abs()),
+        );
+        for (x, y) in [(da, db), (db, db), (da + D4::of(1e301), db)] {
+            let (vx, vy) = (f64x4::new(x.0), f64x4::new(y.0));
+            assert_eq!(x.le(y).any(), vx.le(vy).any());
+            assert_eq!(x.le(y).all(), vx.le(vy).all());
         }
         let m = da.le(db);
         assert_eq!(m.any(), va.le(vb).any());

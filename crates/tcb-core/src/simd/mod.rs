@@ -1,6 +1,7 @@
 //! The formulas the runtime's SIMD kernels share with the reference, over
-//! lane types (`f32`, `f64`, `wide`'s `f32x8` and `f64x4`, and [`w8::W8`],
-//! eight lanes for kernels compiled for AVX2 at run time): the lane
+//! lane types (`f32`, `f64`, `wide`'s `f32x8` and `f64x4`, and [`w8::W8`]
+//! and [`w8::D4`], eight and four lanes for kernels compiled for AVX2 at
+//! run time): the lane
 //! trait, the Hermite basis row, squad in power form and extrapolation over
 //! lanes with per-lane mode masks.
 //!

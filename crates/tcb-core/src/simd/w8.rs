@@ -1,5 +1,5 @@
-//! Eight `f32` lanes as a plain array, for kernels compiled for an
-//! instruction set chosen at run time.
+//! Eight `f32` (and four `f64`) lanes as a plain array, for kernels
+//! compiled for an instruction set chosen at run time.
 //!
 //! `wide::f32x8` picks its instructions when `wide` is compiled: two SSE2
 //! halves in a default x86-64 build, even inside a function compiled with
@@ -38,7 +38,9 @@ pub struct I8(pub [i32; 8]);
 
 /// Four `f64` lanes, as [`W8`] is eight `f32`: what the AVX2 instance of
 /// the loose tracks' kernel computes times in (`wide::f64x4`'s two SSE2
-/// halves in a default build).
+/// halves in a default build). Its arithmetic, square root, compares and
+/// selects give `wide::f64x4`'s bits; its `sin_cos` and `atan2` are
+/// `std`'s, not `wide`'s polynomials (as [`W8`]'s).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
 pub struct D4(pub [f64; 4]);
