@@ -6,7 +6,7 @@
 //! packed one track per lane, eight per block, components as x/y/z/w planes,
 //! and everything per frame is done across lanes:
 //!
-//! 1. Each lane's current segment (window `[ws, we)`, width, ease, rate and
+//! 1. Each lane's current segment (window `[ws, we)`, width, ease and
 //!    controls) lives in the [`crate::Instance`], packed per block, as
 //!    ozz-animation's sampling context does. Forward playback keeps it
 //!    current from one list of every `(lane, segment)` in the order playback
@@ -412,14 +412,12 @@ struct Half {
 struct BlockState {
     /// Lanes 0-3 and 4-7.
     half: [Half; 2],
-    /// `1 / D` in f32 per lane, the rate of uneased segments.
-    rate: f32x8,
     /// The stored segment each lane has loaded.
     seg: [usize; 8],
 }
 
 /// Per-instance state of the loose tracks: each lane's window, width,
-/// ease, rate and controls, written lane by lane only when a lane crosses a
+/// ease and controls, written lane by lane only when a lane crosses a
 /// key and read four or eight lanes at a time; and where forward playback is
 /// in [`Loose::order`].
 #[derive(Clone, Debug)]
@@ -449,7 +447,6 @@ impl LooseState {
         };
         let block = BlockState {
             half: [half; 2],
-            rate: f32x8::ZERO,
             seg: [usize::MAX; 8],
         };
         LooseState {
@@ -531,8 +528,6 @@ impl LooseState {
             half.from.as_mut_array()[j] = e.from();
             half.to.as_mut_array()[j] = e.to();
         }
-        // The reference's rate `(ds/du / D) as f32` with ds/du = 1.
-        block.rate.as_mut_array()[i] = (1.0 / d) as f32;
         block.seg[i] = seg;
     }
 
@@ -778,12 +773,12 @@ impl Lanes for Wide {
     }
 }
 
-/// `s` and the rate of a block (its two halves, its rates of uneased
-/// segments) when every lane is inside its keys, `t_0 <= time < t_{n-1}`,
-/// and so (after [`LooseState::advance`]) inside the segment it holds: `u`
-/// and the ease, nothing else.
+/// `s` of a block (its two halves) when every lane is inside its keys,
+/// `t_0 <= time < t_{n-1}`, and so (after [`LooseState::advance`]) inside
+/// the segment it holds: `u` and the ease, nothing else; and with
+/// `velocity` its rate, the reference's `(ds/du / D) as f32` (0 without).
 #[inline(always)]
-fn inside<K: Lanes>(eased: bool, half: &[Half; 2], rate: &f32x8, time: f64) -> (K::F, K::F) {
+fn inside<K: Lanes>(eased: bool, half: &[Half; 2], time: f64, velocity: bool) -> (K::F, K::F) {
     let t = K::D::of(time);
     // `t - ws` is at least 0 and at most `we - ws = D`, so `u` is already
     // within the [0, 1] the reference clamps it to. Written out, without
@@ -793,9 +788,17 @@ fn inside<K: Lanes>(eased: bool, half: &[Half; 2], rate: &f32x8, time: f64) -> (
     if eased {
         let e0 = ease(u[0], K::d(half[0].from), K::d(half[0].to));
         let e1 = ease(u[1], K::d(half[1].from), K::d(half[1].to));
-        (K::narrow(e0.0, e1.0), K::narrow(e0.1 / d[0], e1.1 / d[1]))
+        let rate = if velocity {
+            K::narrow(e0.1 / d[0], e1.1 / d[1])
+        } else {
+            K::F::of(0.0)
+        };
+        (K::narrow(e0.0, e1.0), rate)
+    } else if velocity {
+        let one = K::D::of(1.0);
+        (K::narrow(u[0], u[1]), K::narrow(one / d[0], one / d[1]))
     } else {
-        (K::narrow(u[0], u[1]), K::f(rate))
+        (K::narrow(u[0], u[1]), K::F::of(0.0))
     }
 }
 
@@ -964,7 +967,8 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
                 let i = l % 4;
                 h.ws.to_array()[i] <= time && time < h.we.to_array()[i]
             }));
-            let (s, rate) = inside::<K>(info.eased, &block.half, &block.rate, time);
+            let velocity = velocities.is_some();
+            let (s, rate) = inside::<K>(info.eased, &block.half, time, velocity);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
