@@ -685,8 +685,15 @@ struct Rows {
 /// (the compiler makes it `cvtpd2ps`).
 #[inline(always)]
 fn f32x8_of(a: f64x4, b: f64x4) -> f32x8 {
-    let (a, b): ([f64; 4], [f64; 4]) = (bytemuck::cast(a), bytemuck::cast(b));
-    f32x8::new([
+    f32x8::new(narrow8(bytemuck::cast(a), bytemuck::cast(b)))
+}
+
+/// Eight `f64` (two halves) rounded to `f32` as `as f32` does: one
+/// formula for [`f32x8_of`] and the AVX2 instance's `narrow`. Written out
+/// (see `tcb_core::simd::w8`).
+#[inline(always)]
+fn narrow8(a: [f64; 4], b: [f64; 4]) -> [f32; 8] {
+    [
         a[0] as f32,
         a[1] as f32,
         a[2] as f32,
@@ -695,7 +702,7 @@ fn f32x8_of(a: f64x4, b: f64x4) -> f32x8 {
         b[1] as f32,
         b[2] as f32,
         b[3] as f32,
-    ])
+    ]
 }
 
 fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
@@ -1073,7 +1080,7 @@ fn normalize<K: Lanes>(
 /// same code on `tcb_core::simd::w8`'s `W8` and `D4`.
 #[cfg(target_arch = "x86_64")]
 mod v3 {
-    use crate::loose::{Lanes, Loose, LooseState, sample_on};
+    use crate::loose::{Lanes, Loose, LooseState, narrow8, sample_on};
     use tcb_core::simd::w8::{D4, W8};
     use wide::{f32x8, f64x4};
 
@@ -1097,17 +1104,7 @@ mod v3 {
         }
         #[inline(always)]
         fn narrow(a: D4, b: D4) -> W8 {
-            let (a, b) = (a.0, b.0);
-            W8([
-                a[0] as f32,
-                a[1] as f32,
-                a[2] as f32,
-                a[3] as f32,
-                b[0] as f32,
-                b[1] as f32,
-                b[2] as f32,
-                b[3] as f32,
-            ])
+            W8(narrow8(a.0, b.0))
         }
     }
 
