@@ -44,9 +44,11 @@
 //! How it works: see [`clip`] (the layout), `grid.rs` (the per-frame basis
 //! and the sentinels that keep the kernels free of per-channel branches).
 
-// Denied rather than forbidden: the AVX2 instance of the group kernels
-// (`kernel::v3`) is called, after detecting the CPU's features, from two
-// `#[allow]`ed blocks in `kernel.rs`; nothing else is unsafe.
+// Denied rather than forbidden: the AVX2 instances (`v3` in `kernel`,
+// `quant`, `loose` and `pack::store`) are called, after detecting the
+// CPU's features, from `#[allow]`ed blocks there, and the packed decoder's
+// gathers read the stream through raw pointers inside bounds it checks
+// first; nothing else is unsafe.
 #![deny(unsafe_code)]
 
 pub mod blend;

@@ -912,8 +912,8 @@ pub(crate) fn sample<const ROTATIONS: bool>(
     velocities: Option<&mut [f32x8]>,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if crate::isa::avx2_kernels() {
-        return v3::sample_here::<ROTATIONS>(loose, st, time, values, velocities);
+    if let Some(avx2) = crate::isa::Avx2Kernels::now() {
+        return v3::sample_here::<ROTATIONS>(avx2, loose, st, time, values, velocities);
     }
     sample_wide::<ROTATIONS>(loose, st, time, values, velocities);
 }
@@ -1108,18 +1108,19 @@ mod v3 {
         }
     }
 
-    /// [`crate::loose::sample`], where `crate::isa::avx2_kernels` said so.
+    /// [`crate::loose::sample`], where `crate::isa::avx2_kernels` said so
+    /// (the token).
     #[inline(always)]
     pub(super) fn sample_here<const ROTATIONS: bool>(
+        _: crate::isa::Avx2Kernels,
         loose: &Loose,
         st: &mut LooseState,
         time: f64,
         values: &mut [f32x8],
         velocities: Option<&mut [f32x8]>,
     ) {
-        debug_assert!(crate::isa::avx2_kernels());
-        // SAFETY: `crate::isa::avx2` detected AVX2 and FMA on this CPU
-        // before the caller came here.
+        // SAFETY: an `Avx2Kernels` exists only where `crate::isa` detected
+        // AVX2 and FMA on this CPU.
         #[allow(unsafe_code)]
         unsafe {
             sample::<ROTATIONS>(loose, st, time, values, velocities)

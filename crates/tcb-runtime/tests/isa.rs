@@ -204,10 +204,12 @@ fn the_avx2_kernels_give_the_baselines_bits() {
     let times = [0.25, 0.5, 0.9, 0.999, 1.0001, 1.0, 1.5, 2.0];
     same_bits("huge tangents", &clip, &times);
     // Nine rotation blocks on one grid (the AVX2 kernel's loop once ran
-    // eight blocks at a time from eight on), the last block's lane
-    // rescaled.
-    let clip = common::huge_tangent_rotations(70, 66);
-    same_bits("nine rotation blocks", &clip, &times);
+    // eight blocks at a time from eight on): all in range, then with the
+    // last block's lane rescaled.
+    for at in [70, 66] {
+        let clip = common::huge_tangent_rotations(70, at);
+        same_bits(&format!("nine rotation blocks, {at}"), &clip, &times);
+    }
     packed_clips_decode_to_the_same_bits();
     tcb_runtime::force_baseline_simd(false);
 }

@@ -688,8 +688,9 @@ mod v3 {
     impl Plane for W8 {
         // Through AVX vectors: a loop of these is not vectorized again
         // across its iterations (LLVM's loop vectorizer does, on arrays,
-        // with a gather per operand). The group kernels' loads are better
-        // as arrays (`kernel::v3`: fewer instructions on every scenario).
+        // with a gather per operand), as the group kernels' rotation loop
+        // loads (`kernel::v3`; their vector loop stays on arrays, which
+        // LLVM unrolls).
         #[inline(always)]
         fn load(x: &f32x8) -> Self {
             let v: __m256 = bytemuck::cast(*x);
