@@ -120,6 +120,23 @@ fn loose_clip() -> tcb_core::SourceClip {
     tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()
 }
 
+/// 12 `vec3` tracks on one key grid: a group of 36 vector channels in five
+/// blocks (the AVX2 instance runs vector blocks from two on).
+fn shared_vectors_clip() -> tcb_core::SourceClip {
+    let tracks: Vec<String> = (0..12)
+        .map(|i| {
+            format!(
+                r#"{{"name": "v{i}", "kind": "vec3", "times": [0, 0.4, 1.1, 1.7], "values": [[{i}, 0, 1], [1, 2.{i}, 3], [-1, 0.5, 2], [0, 0, 0.{i}]], "post": "offset-repeat", "keys": [{{}}, {{"tcb": [0.5, -0.5, 0.25]}}, {{}}, {{}}]}}"#
+            )
+        })
+        .collect();
+    let text = format!(
+        r#"{{"format": "tcb-clip/1", "tracks": [{}]}}"#,
+        tracks.join(",")
+    );
+    tcb_io::ClipDoc::parse(&text).unwrap().build().unwrap()
+}
+
 /// Keys, a quarter and three quarters between them, and beyond both ends.
 fn times_of(clip: &tcb_core::SourceClip) -> Vec<f64> {
     let keys = clip.key_times();
@@ -210,6 +227,9 @@ fn the_avx2_kernels_give_the_baselines_bits() {
         let clip = common::huge_tangent_rotations(70, at);
         same_bits(&format!("nine rotation blocks, {at}"), &clip, &times);
     }
+    let clip = shared_vectors_clip();
+    assert_eq!(Clip::compile(&clip).loose_track_count(), 0);
+    same_bits("vector blocks on one grid", &clip, &times_of(&clip));
     packed_clips_decode_to_the_same_bits();
     tcb_runtime::force_baseline_simd(false);
 }
