@@ -802,6 +802,9 @@ fn inside<K: Lanes>(eased: bool, half: &[Half; 2], time: f64, velocity: bool) ->
         };
         (K::narrow(e0.0, e1.0), rate)
     } else if velocity {
+        // The same rate with `ds/du = 1`. Written as one expression for
+        // both branches (`ds / d`), it cost `sparse` 2.3% more instructions
+        // in SSE2.
         let one = K::D::of(1.0);
         (K::narrow(u[0], u[1]), K::narrow(one / d[0], one / d[1]))
     } else {
@@ -963,6 +966,7 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
     let planes = loose.out..loose.out + 4 * loose.blocks;
     let values = &mut values[planes.clone()];
     let mut velocities = velocities.map(|v| &mut v[planes]);
+    let velocity = velocities.is_some();
     for (b, info) in loose.block.iter().enumerate() {
         let out = 4 * b..4 * b + 4;
         if time >= info.inner[0] && time < info.inner[1] {
@@ -974,7 +978,6 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
                 let i = l % 4;
                 h.ws.to_array()[i] <= time && time < h.we.to_array()[i]
             }));
-            let velocity = velocities.is_some();
             let (s, rate) = inside::<K>(info.eased, &block.half, time, velocity);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);

@@ -80,9 +80,9 @@ fn loose_clip() -> tcb_core::SourceClip {
             let d = 0.05 * i as f64;
             let times = format!("[{d}, {}, {}, {}]", 0.4 + d, 1.1 + d, 1.7 + 2.0 * d);
             let (mut pre, mut post) = (modes[i % 6], modes[(i / 6) % 6]);
-            let keys = match (i, i % 3) {
-                (_, 0) => r#", "keys": [{}, {"ease": [0.5, 0.25]}, {"tcb": [0.5, -0.5, 0.25]}, {}]"#,
-                (_, 1) => r#", "keys": [{}, {"interp": "step"}, {}, {}]"#,
+            let keys = match i % 3 {
+                0 => r#", "keys": [{}, {"ease": [0.5, 0.25]}, {"tcb": [0.5, -0.5, 0.25]}, {}]"#,
+                1 => r#", "keys": [{}, {"interp": "step"}, {}, {}]"#,
                 _ => "",
             };
             let (kind, values) = match i % 4 {
