@@ -64,13 +64,36 @@ impl KeyTimes {
         }
     }
 
-    /// The listed times; empty for an even grid (only a packed clip's
-    /// group has one, and it has no loose lanes or exact segments, which
-    /// read this).
+    /// The listed times; empty for an even grid (only groups have one,
+    /// and only loose lanes, whose times stay listed, read this).
     pub fn listed(&self) -> &[f64] {
         match self {
             KeyTimes::Listed(t) => t,
             KeyTimes::Even { .. } => &[],
+        }
+    }
+
+    /// `times` (n >= 2, strictly increasing) as an even grid where every
+    /// key is [`even_time`]`(t_0, t_1 - t_0, k)` bit for bit (a BVH's
+    /// `k * Frame Time`, baked output), else as listed. The same times
+    /// either way; an even grid finds a random time by one quotient where a
+    /// list searches, and keeps no list.
+    pub fn from_times(times: Vec<f64>) -> KeyTimes {
+        let even = |t: &[f64]| {
+            let (start, interval) = (t[0], t[1] - t[0]);
+            (interval > 0.0 && interval.is_finite())
+                .then_some(KeyTimes::Even {
+                    start,
+                    interval,
+                    keys: t.len(),
+                })
+                .filter(|_| {
+                    (0..t.len()).all(|k| even_time(start, interval, k).to_bits() == t[k].to_bits())
+                })
+        };
+        match times.get(..2) {
+            Some(_) => even(&times).unwrap_or(KeyTimes::Listed(times)),
+            None => KeyTimes::Listed(times),
         }
     }
 
@@ -98,15 +121,29 @@ impl KeyTimes {
                 keys,
             } => (*start, *interval, *keys),
         };
-        let last = keys - 2;
-        // Before the keys, or NaN.
-        if time.is_nan() || time < start {
+        // Where `time` falls (a saturating cast: 0 for NaN), checked
+        // against the keys' own times: no loop, so no vectorized search,
+        // and the caller's times of the segment are these.
+        let k = ((((time - start) / interval) as i64).max(0) as usize).min(keys - 2);
+        if even_time(start, interval, k) <= time && time < even_time(start, interval, k + 1) {
+            k
+        } else {
+            self.locate_near(time, k)
+        }
+    }
+
+    /// [`locate`](Self::locate) on an even grid where the quotient's
+    /// segment `k` is not the one: before the keys (or NaN), after them,
+    /// or a key either way for the quotient's rounding, else bisection.
+    #[cold]
+    fn locate_near(&self, time: f64, k: usize) -> usize {
+        let last = self.len() - 2;
+        if time.is_nan() || time < self.at(0) {
             return 0;
         }
-        // Where `time` falls (a saturating cast), then a key either way for
-        // the quotient's rounding; no loop, so no vectorized search.
-        let k = (((time - start) / interval) as i64).max(0) as usize;
-        let k = k.min(last);
+        if time >= self.at(last + 1) {
+            return last;
+        }
         let k = if k > 0 && self.at(k) > time {
             k - 1
         } else if k < last && self.at(k + 1) <= time {
@@ -114,7 +151,7 @@ impl KeyTimes {
         } else {
             k
         };
-        if self.at(k) <= time && (k == last || time < self.at(k + 1)) {
+        if self.at(k) <= time && time < self.at(k + 1) {
             k
         } else {
             self.bisect(time, last)
@@ -480,6 +517,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A list of `k * dt` (a BVH's frames) becomes an even grid with the
+    /// same times; lists that are not that bit for bit stay lists.
+    #[test]
+    fn even_lists_become_even_grids() {
+        let bvh: Vec<f64> = (0..2752).map(|k| k as f64 * 0.008333).collect();
+        let even = KeyTimes::from_times(bvh.clone());
+        assert!(matches!(even, KeyTimes::Even { keys: 2752, .. }));
+        assert_eq!(even.to_vec(), bvh);
+        assert_eq!(even.heap_bytes(), 0);
+        let mut off = bvh.clone();
+        off[2000] = off[2000].next_up();
+        let uneven = [
+            off,
+            vec![0.0, 1.0, 3.0],
+            vec![0.0, 0.1, 0.2, 0.30000000000000004 + 1e-12],
+        ];
+        for t in uneven {
+            assert_eq!(KeyTimes::from_times(t.clone()), KeyTimes::Listed(t));
+        }
+        assert!(matches!(
+            KeyTimes::from_times(vec![2.0, 2.5]),
+            KeyTimes::Even { keys: 2, .. }
+        ));
     }
 
     #[test]

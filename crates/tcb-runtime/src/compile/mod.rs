@@ -20,7 +20,7 @@ mod packed;
 mod rotation;
 
 use crate::clip::Clip;
-use crate::grid::TimeGrid;
+use crate::grid::{KeyTimes, TimeGrid};
 use crate::group::Group;
 use crate::layout::{PoseLayout, TrackSlot, plane_slots};
 use crate::loose::{Loose, LooseLane};
@@ -434,6 +434,11 @@ fn build_group(
 ) -> Group {
     let (vec_out, vec_blocks, hq_blocks) =
         assign_group_slots(vectors, rotations, &mut per_track.slots, blocks);
+    // Groups only: loose lanes search their own listed times.
+    let grid = TimeGrid {
+        times: KeyTimes::from_times(grid.times.to_vec()),
+        ..grid
+    };
     let segments = grid.times.len() + 1;
     let delta = if [grid.pre, grid.post].contains(&Extrapolation::OffsetRepeat) {
         let d: Vec<Vec<[f32; 1]>> = vectors
