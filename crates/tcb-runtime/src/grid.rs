@@ -40,10 +40,23 @@ pub enum KeyTimes {
         start: f64,
         interval: f64,
         keys: usize,
+        /// `1 / interval`: where a time falls, by a product (checked
+        /// against the keys' times, so its rounding does not matter).
+        per: f64,
     },
 }
 
 impl KeyTimes {
+    /// The even grid of `keys` times from `start`, `interval` apart.
+    pub fn even(start: f64, interval: f64, keys: usize) -> KeyTimes {
+        KeyTimes::Even {
+            start,
+            interval,
+            keys,
+            per: 1.0 / interval,
+        }
+    }
+
     /// Number of keys.
     #[inline]
     pub fn len(&self) -> usize {
@@ -82,11 +95,7 @@ impl KeyTimes {
         let even = |t: &[f64]| {
             let (start, interval) = (t[0], t[1] - t[0]);
             (interval > 0.0 && interval.is_finite())
-                .then_some(KeyTimes::Even {
-                    start,
-                    interval,
-                    keys: t.len(),
-                })
+                .then(|| KeyTimes::even(start, interval, t.len()))
                 .filter(|_| {
                     (0..t.len()).all(|k| even_time(start, interval, k).to_bits() == t[k].to_bits())
                 })
@@ -113,18 +122,20 @@ impl KeyTimes {
     /// `time` falls, then checked against the keys' own times.
     #[inline]
     fn locate(&self, time: f64, hint: usize) -> usize {
-        let (start, interval, keys) = match self {
+        let (start, interval, keys, per) = match self {
             KeyTimes::Listed(t) => return segment_from(t, time, hint),
             KeyTimes::Even {
                 start,
                 interval,
                 keys,
-            } => (*start, *interval, *keys),
+                per,
+            } => (*start, *interval, *keys, *per),
         };
-        // Where `time` falls (a saturating cast: 0 for NaN), checked
+        // Where `time` falls (a saturating cast: 0 for NaN), by a product
+        // rather than a division (on the frame's critical path), checked
         // against the keys' own times: no loop, so no vectorized search,
         // and the caller's times of the segment are these.
-        let k = ((((time - start) / interval) as i64).max(0) as usize).min(keys - 2);
+        let k = ((((time - start) * per) as i64).max(0) as usize).min(keys - 2);
         if even_time(start, interval, k) <= time && time < even_time(start, interval, k + 1) {
             k
         } else {
@@ -496,11 +507,7 @@ mod tests {
             (1e6, 1.0 / 30.0, 40),
             (-3.5, 0.1, 7),
         ] {
-            let even = KeyTimes::Even {
-                start,
-                interval,
-                keys,
-            };
+            let even = KeyTimes::even(start, interval, keys);
             let listed = KeyTimes::Listed(even.to_vec());
             let mut probes = vec![f64::NAN, f64::NEG_INFINITY, f64::INFINITY, start - 1.0];
             for k in 0..keys {

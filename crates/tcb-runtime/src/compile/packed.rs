@@ -52,11 +52,7 @@ impl Clip {
         let keys = packed_keys(&packed, &clip);
         let g = &mut clip.groups[0];
         g.grid = TimeGrid {
-            times: KeyTimes::Even {
-                start: head.start,
-                interval: head.interval,
-                keys: head.keys,
-            },
+            times: KeyTimes::even(head.start, head.interval, head.keys),
             eases: Vec::new(),
             steps: Vec::new(),
             pre: g.grid.pre,
