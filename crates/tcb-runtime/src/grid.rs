@@ -39,8 +39,8 @@ pub enum KeyTimes {
     Even {
         start: f64,
         interval: f64,
-        keys: usize,
         /// `1 / interval`: where a time falls, by a product (checked
+        keys: usize,
         /// against the keys' times, so its rounding does not matter).
         per: f64,
     },
@@ -347,6 +347,17 @@ impl TimeGrid {
                 reset: false,
             };
         }
+        self.frame_outside(time, cursor)
+    }
+
+    /// [`frame`](Self::frame) for a time outside the keys (or NaN), out of
+    /// line: the registers its table takes would otherwise be saved and
+    /// restored on every frame.
+    #[cold]
+    #[inline(never)]
+    fn frame_outside(&self, time: f64, cursor: &mut Cursor) -> FrameBasis {
+        let n = self.times.len();
+        let (t0, tn) = (self.times.at(0), self.times.at(n - 1));
         // Which row of the table (module docs), and the stored segment.
         let (mut real, mut line, mut reset, mut hold) = (false, false, false, false);
         let (mut s, mut rate, mut dir, mut dt, mut cyc) = (0.0f64, 0.0f32, 1.0f32, 0.0f32, 0.0f32);

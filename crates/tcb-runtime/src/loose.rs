@@ -64,8 +64,10 @@ pub(crate) struct LooseLane {
     /// three tests per load.
     plain: u8,
     pub grid: TimeGrid,
-    /// Components used (1 to 4).
-    pub dim: usize,
+    /// Components used (1 to 4): a byte, so that the lane stays 128 bytes
+    /// wide (a shift per entry of `Loose::order` where 136 takes two
+    /// instructions).
+    dim: u8,
 }
 
 /// A loose lane's keys, in f32 or in 16 bits with a range per component
@@ -101,8 +103,14 @@ impl LooseLane {
             ctl_at: 0,
             plain: 0,
             grid,
-            dim,
+            dim: u8::try_from(dim).expect("1 to 4 components"),
         }
+    }
+
+    /// Components used (1 to 4).
+    #[inline(always)]
+    pub fn dim(&self) -> usize {
+        usize::from(self.dim)
     }
 
     /// Entry `i` (`key * dim + c`) of the keys.
@@ -112,7 +120,7 @@ impl LooseLane {
             Keys::F32(k) => k[i],
             Keys::U16(u) => {
                 let U16Keys { q, min, scale } = &**u;
-                let c = i % self.dim;
+                let c = i % self.dim();
                 std::array::from_fn(|j| {
                     crate::quant::dequantize16(min[c][j], f32::from(q[i][j]), scale[c][j])
                 })
@@ -140,9 +148,9 @@ impl LooseLane {
     /// f32), keep them in f32 and return `None`.
     pub fn quantize(&mut self) -> Option<Vec<[f32; KEY_STRIDE]>> {
         let Keys::F32(keys) = &self.keys else {
-            return Some(vec![[0.0; KEY_STRIDE]; self.dim]);
+            return Some(vec![[0.0; KEY_STRIDE]; self.dim()]);
         };
-        let dim = self.dim;
+        let dim = self.dim();
         let mut min = vec![[f32::INFINITY; KEY_STRIDE]; dim];
         let mut max = vec![[f32::NEG_INFINITY; KEY_STRIDE]; dim];
         for (i, k) in keys.iter().enumerate() {
@@ -188,7 +196,7 @@ impl LooseLane {
     #[inline(always)]
     fn segment(&self, ka: usize, kb: usize, ctl: &mut [f32]) {
         // One copy per dimension, so that each is straight-line code.
-        match self.dim {
+        match self.dim() {
             1 => self.segment_of::<1>(ka, kb, ctl),
             2 => self.segment_of::<2>(ka, kb, ctl),
             3 => self.segment_of::<3>(ka, kb, ctl),
@@ -338,7 +346,7 @@ impl Loose {
         let mut ctl_planes = 0;
         let block: Vec<Block> = (0..blocks)
             .map(|b| {
-                let planes = 4 * block_lanes(b).map(|l| l.dim).max().unwrap_or(0);
+                let planes = 4 * block_lanes(b).map(|l| l.dim()).max().unwrap_or(0);
                 ctl_planes += planes;
                 Block {
                     inner: [
@@ -361,7 +369,7 @@ impl Loose {
             let g = &lane.grid;
             let plain = g.eases.iter().all(|e| e.is_none()) && !g.steps.contains(&true);
             lane.plain = match lane.keys {
-                Keys::F32(_) if plain => lane.dim as u8,
+                Keys::F32(_) if plain => lane.dim,
                 _ => 0,
             };
         }
@@ -631,7 +639,7 @@ impl LooseState {
         we: f64,
         k: &[[f32; KEY_STRIDE]],
     ) {
-        debug_assert!(usize::from(lane.plain) == N && lane.dim == N && seg >= 1);
+        debug_assert!(usize::from(lane.plain) == N && lane.dim() == N && seg >= 1);
         debug_assert_eq!((seg - 1, seg), lane.grid.key_pair(seg));
         self.set_window(l, seg, [ws, we, we - ws], None);
         // Keys `seg - 1` and `seg`, `N` components each.
@@ -1150,11 +1158,11 @@ fn offset_deltas(lanes: &[LooseLane], blocks: usize) -> Vec<f32x8> {
         for c in 0..4 {
             delta[4 * b + c] = f32x8::new(std::array::from_fn(|l| {
                 lanes.get(8 * b + l).map_or(0.0, |x| {
-                    if c >= x.dim {
+                    if c >= x.dim() {
                         return 0.0;
                     }
                     let n = x.grid.times.len();
-                    x.key((n - 1) * x.dim + c)[0] - x.key(c)[0]
+                    x.key((n - 1) * x.dim() + c)[0] - x.key(c)[0]
                 })
             }));
         }
