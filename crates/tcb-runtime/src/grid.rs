@@ -30,17 +30,19 @@ use tcb_core::simd::extrapolate::{Mapped, map_time};
 use tcb_core::simd::lane::Lane;
 use tcb_core::track::segment_from;
 
-/// A grid's key times (n >= 2, strictly increasing): listed, or the
-/// packed clip's even grid, `start + k * interval` in f64, which keeps no
-/// list (a `.tcbc` file's memory does not grow with the keys it claims).
+/// A grid's key times (n >= 2, strictly increasing): listed, or an even
+/// grid, `start + k * interval` in f64, which keeps no list: a packed
+/// clip's (a `.tcbc` file's memory does not grow with the keys it claims),
+/// and any group's whose listed times are exactly that
+/// ([`KeyTimes::from_times`]). Loose lanes keep theirs listed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum KeyTimes {
     Listed(Vec<f64>),
     Even {
         start: f64,
         interval: f64,
-        /// `1 / interval`: where a time falls, by a product (checked
         keys: usize,
+        /// `1 / interval`: where a time falls, by a product (checked
         /// against the keys' times, so its rounding does not matter).
         per: f64,
     },
@@ -82,7 +84,10 @@ impl KeyTimes {
     pub fn listed(&self) -> &[f64] {
         match self {
             KeyTimes::Listed(t) => t,
-            KeyTimes::Even { .. } => &[],
+            KeyTimes::Even { .. } => {
+                debug_assert!(false, "an even grid has no list of times");
+                &[]
+            }
         }
     }
 
@@ -113,7 +118,10 @@ impl KeyTimes {
 
     /// Heap bytes.
     pub fn heap_bytes(&self) -> usize {
-        std::mem::size_of_val(self.listed())
+        match self {
+            KeyTimes::Listed(t) => std::mem::size_of_val(t.as_slice()),
+            KeyTimes::Even { .. } => 0,
+        }
     }
 
     /// Segment k with `at(k) <= time < at(k+1)`, 0 before the keys (or for
@@ -283,8 +291,9 @@ impl TimeGrid {
         self
     }
 
-    /// Segment k with `times[k] <= time < times[k+1]`, starting from the
-    /// cursor ([`tcb_core::track::segment_from`]).
+    /// Segment k with `times[k] <= time < times[k+1]`: listed times from
+    /// the cursor ([`tcb_core::track::segment_from`]), even ones from where
+    /// `time` falls (the cursor only records the answer).
     #[inline]
     fn locate(&self, time: f64, cursor: &mut Cursor) -> usize {
         cursor.0 = self.times.locate(time, cursor.0);
@@ -517,6 +526,12 @@ mod tests {
             (0.0, 1.0 / 120.0, 50),
             (1e6, 1.0 / 30.0, 40),
             (-3.5, 0.1, 7),
+            (5.0, 0.25, 2),
+            // 1 / interval overflows to infinity.
+            (0.0, 5e-324, 3),
+            (-1e308, 1e308, 3),
+            // Times that cross powers of two, where the sums round unevenly.
+            (1024.0 - 1e-10, 0.1, 50),
         ] {
             let even = KeyTimes::even(start, interval, keys);
             let listed = KeyTimes::Listed(even.to_vec());

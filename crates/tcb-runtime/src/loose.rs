@@ -70,6 +70,10 @@ pub(crate) struct LooseLane {
     dim: u8,
 }
 
+// The stream indexes lanes by a shift (see `LooseLane::dim`).
+#[cfg(target_pointer_width = "64")]
+const _: () = assert!(std::mem::size_of::<LooseLane>() == 128);
+
 /// A loose lane's keys, in f32 or in 16 bits with a range per component
 /// and control (see `crate::quant`; expanded only when a lane crosses a key).
 #[derive(Clone, Debug)]

@@ -266,7 +266,12 @@ impl RotationSafe for Extrapolation {
 
 fn sample_times(rng: &mut Rng, clip: &tcb_core::SourceClip) -> Vec<f64> {
     let (a, b) = clip.time_range().unwrap();
-    let mut t: Vec<f64> = clip.key_times();
+    let keys = clip.key_times();
+    // Every key, and an ulp either side of it.
+    let mut t: Vec<f64> = keys
+        .iter()
+        .flat_map(|&k| [k, k.next_down(), k.next_up()])
+        .collect();
     for _ in 0..40 {
         t.push(rng.f(a - 3.0, b + 3.0));
     }
