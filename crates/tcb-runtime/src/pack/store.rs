@@ -148,32 +148,32 @@ impl PackedKeys {
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
     fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
         let (np, n) = (self.planes, self.keys);
-        let mut m = std::mem::take(&mut c.m);
-        let (m0, m1) = m.split_at_mut(np);
         if a > 0 && b < n - 1 {
-            // Both (all but the end segments): the chord P_b - P_a once.
-            let keys = c.ring4(a - 1, np);
+            // Both (all but the end segments): the chord P_b - P_a once,
+            // from the rows of keys `a - 1 ..= b + 1`.
+            let at = (a - 1 + BEFORE - SEGMENT_KEYS * c.cur) * np;
+            let keys = &c.rows[at..at + 4 * np];
+            let (m0, m1) = c.m.split_at_mut(np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
-                v3::interior_tangents_here(keys, &self.weights, m0, m1);
-                c.m = m;
-                return;
+                return v3::interior_tangents_here(keys, &self.weights, m0, m1);
             }
-            interior_tangents::<f32x8>(keys, &self.weights, m0, m1);
-        } else {
-            if a > 0 {
-                let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
-                let rows = x.iter().zip(y).zip(z);
-                for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
-                    *m = tangent(*y - *x, *z - *y, w[2], w[3]);
-                }
+            return interior_tangents::<f32x8>(keys, &self.weights, m0, m1);
+        }
+        let mut m = std::mem::take(&mut c.m);
+        let (m0, m1) = m.split_at_mut(np);
+        if a > 0 {
+            let (x, y, z) = (c.ring(a - 1, np), c.ring(a, np), c.ring(b, np));
+            let rows = x.iter().zip(y).zip(z);
+            for ((m, ((x, y), z)), w) in m0.iter_mut().zip(rows).zip(&self.weights) {
+                *m = tangent(*y - *x, *z - *y, w[2], w[3]);
             }
-            if b < n - 1 {
-                let (x, y, z) = (c.ring(a, np), c.ring(b, np), c.ring(b + 1, np));
-                let rows = x.iter().zip(y).zip(z);
-                for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
-                    *m = tangent(*y - *x, *z - *y, w[0], w[1]);
-                }
+        }
+        if b < n - 1 {
+            let (x, y, z) = (c.ring(a, np), c.ring(b, np), c.ring(b + 1, np));
+            let rows = x.iter().zip(y).zip(z);
+            for ((m, ((x, y), z)), w) in m1.iter_mut().zip(rows).zip(&self.weights) {
+                *m = tangent(*y - *x, *z - *y, w[0], w[1]);
             }
         }
         c.m = m;
@@ -187,16 +187,20 @@ fn tangent<L: Real>(before: L, after: L, wa: L, wb: L) -> L {
     before * wa + after * wb
 }
 
-/// `TO_a` and `TI_b` of a segment whose four keys `a - 1 ..= b + 1`
-/// (`keys`) are decoded: each plane's chord `P_b - P_a` once.
+/// `TO_a` and `TI_b` of a segment whose four keys `a - 1 ..= b + 1` are
+/// decoded (`keys`: their rows, a plane per entry of `m0`): each plane's
+/// chord `P_b - P_a` once.
 #[inline(always)]
 fn interior_tangents<L: Plane>(
-    keys: [&[f32x8]; 4],
+    keys: &[f32x8],
     weights: &[[f32x8; 4]],
     m0: &mut [f32x8],
     m1: &mut [f32x8],
 ) {
-    let [v, x, y, z] = keys;
+    let np = m0.len();
+    let (v, rest) = keys.split_at(np);
+    let (x, rest) = rest.split_at(np);
+    let (y, z) = rest.split_at(np);
     let rows = v.iter().zip(x).zip(y.iter().zip(z));
     let out = m0.iter_mut().zip(m1.iter_mut());
     for (((m0, m1), ((v, x), (y, z))), w) in out.zip(rows).zip(weights) {
@@ -361,15 +365,6 @@ impl PackCache {
         &self.rows[at..at + np]
     }
 
-    /// Rows of keys `k ..= k + 3` (decoded, as [`ring`](Self::ring)'s).
-    #[inline(always)]
-    fn ring4(&self, k: usize, np: usize) -> [&[f32x8]; 4] {
-        let at = (k + BEFORE - SEGMENT_KEYS * self.cur) * np;
-        let (v, rest) = self.rows[at..at + 4 * np].split_at(np);
-        let (x, rest) = rest.split_at(np);
-        let (y, z) = rest.split_at(np);
-        [v, x, y, z]
-    }
 
     /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
     /// `lo`'s at most) have rows: on from the segment decoded last, or
@@ -719,7 +714,7 @@ mod v3 {
     /// [`interior_tangents`] in AVX2.
     #[inline(always)]
     pub(super) fn interior_tangents_here(
-        keys: [&[f32x8]; 4],
+        keys: &[f32x8],
         weights: &[[f32x8; 4]],
         m0: &mut [f32x8],
         m1: &mut [f32x8],
@@ -732,7 +727,7 @@ mod v3 {
     }
 
     #[target_feature(enable = "avx2,fma")]
-    fn tangents(keys: [&[f32x8]; 4], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
+    fn tangents(keys: &[f32x8], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
         interior_tangents::<W8>(keys, weights, m0, m1);
     }
 
