@@ -312,7 +312,12 @@ impl TimeGrid {
         let (tk, tk1) = (self.times.at(k), self.times.at(k + 1));
         let d = tk1 - tk;
         let u = ((time - tk) / d).clamp(0.0, 1.0);
-        let (eased, ds_du) = self.ease(k).apply(u);
+        // Most grids ease nowhere (`compact` empties the list): no lookup.
+        let (eased, ds_du) = if self.eases.is_empty() {
+            (u, 1.0)
+        } else {
+            self.ease(k).apply(u)
+        };
         // Selects, not a branch: almost no grid has step segments.
         let hold = !self.steps.is_empty() && self.is_step(k);
         let (eased, ds_du) = if hold { (0.0, 0.0) } else { (eased, ds_du) };

@@ -365,7 +365,6 @@ impl PackCache {
         &self.rows[at..at + np]
     }
 
-
     /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
     /// `lo`'s at most) have rows: on from the segment decoded last, or
     /// from the start of `lo`'s block.
