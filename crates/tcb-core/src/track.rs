@@ -103,6 +103,10 @@ pub fn segment_from(times: &[f64], time: f64, hint: usize) -> usize {
     } else {
         guess.min(k)
     };
+    // Nearly even keys (capture, baked output): the guess itself.
+    if times[g] <= time && time < times[g + 1] {
+        return g;
+    }
     gallop(times, time, g)
 }
 
