@@ -97,17 +97,23 @@ impl KeyTimes {
     /// either way; an even grid finds a random time by one quotient where a
     /// list searches, and keeps no list.
     pub fn from_times(times: Vec<f64>) -> KeyTimes {
-        let even = |t: &[f64]| {
-            let (start, interval) = (t[0], t[1] - t[0]);
-            (interval > 0.0 && interval.is_finite())
-                .then(|| KeyTimes::even(start, interval, t.len()))
-                .filter(|_| {
-                    (0..t.len()).all(|k| even_time(start, interval, k).to_bits() == t[k].to_bits())
-                })
-        };
-        match times.get(..2) {
-            Some(_) => even(&times).unwrap_or(KeyTimes::Listed(times)),
-            None => KeyTimes::Listed(times),
+        if let [start, t1, ..] = times[..] {
+            let interval = t1 - start;
+            let even =
+                |(k, t): (usize, &f64)| even_time(start, interval, k).to_bits() == t.to_bits();
+            if interval > 0.0 && interval.is_finite() && times.iter().enumerate().all(even) {
+                return KeyTimes::even(start, interval, times.len());
+            }
+        }
+        KeyTimes::Listed(times)
+    }
+
+    /// These times as [`from_times`](Self::from_times) keeps them: an
+    /// even grid where a list is one (the list moved, not copied).
+    pub fn into_even(self) -> KeyTimes {
+        match self {
+            KeyTimes::Listed(t) => KeyTimes::from_times(t),
+            even => even,
         }
     }
 

@@ -20,7 +20,7 @@ mod packed;
 mod rotation;
 
 use crate::clip::Clip;
-use crate::grid::{KeyTimes, TimeGrid};
+use crate::grid::TimeGrid;
 use crate::group::Group;
 use crate::layout::{PoseLayout, TrackSlot, plane_slots};
 use crate::loose::{Loose, LooseLane};
@@ -436,7 +436,7 @@ fn build_group(
         assign_group_slots(vectors, rotations, &mut per_track.slots, blocks);
     // Groups only: loose lanes search their own listed times.
     let grid = TimeGrid {
-        times: KeyTimes::from_times(grid.times.to_vec()),
+        times: grid.times.into_even(),
         ..grid
     };
     let segments = grid.times.len() + 1;
