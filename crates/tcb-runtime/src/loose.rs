@@ -406,8 +406,10 @@ impl Loose {
     }
 }
 
-/// The segments four lanes have loaded.
-#[derive(Clone, Copy, Debug)]
+/// The segments four lanes have loaded. Plain old data (`repr(C)`), so
+/// that a load writes one lane's window through `f64`s ([`window_at`]).
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 struct Half {
     /// Window start and width (`t_{k+1} - t_k`, 1 on sentinels): what
     /// every frame reads.
@@ -419,13 +421,11 @@ struct Half {
     to: f64x4,
 }
 
-/// The segments the 8 lanes of a block have loaded, as every frame reads them.
-#[derive(Clone, Copy, Debug)]
-struct BlockState {
-    /// Lanes 0-3 and 4-7.
-    half: [Half; 2],
-    /// The stored segment each lane has loaded.
-    seg: [usize; 8],
+/// Where lane `l`'s `Half::ws` is in `LooseState::half` as `f64`s (`d`
+/// and `we` are 4 and 8 after it): 20 per half block, its lanes in order.
+#[inline(always)]
+fn window_at(l: usize) -> usize {
+    l / 4 * 20 + l % 4
 }
 
 /// Per-instance state of the loose tracks: each lane's window, width,
@@ -434,8 +434,12 @@ struct BlockState {
 /// in [`Loose::order`].
 #[derive(Clone, Debug)]
 pub(crate) struct LooseState {
-    /// Per block: the segments its lanes have loaded.
-    block: Vec<BlockState>,
+    /// Per block, its lanes 0-3 and 4-7: the segments they have loaded,
+    /// as every frame reads them.
+    half: Vec<[Half; 2]>,
+    /// Per lane: the stored segment it has loaded (`u32::MAX` before the
+    /// first).
+    seg: Vec<u32>,
     /// Per block (`Block::ctl`): `[P0, P1, M0, M1]` per component.
     ctl: Vec<f32x8>,
     /// The next entry of `Loose::order` and its time.
@@ -457,12 +461,9 @@ impl LooseState {
             from: f64x4::ZERO,
             to: f64x4::ZERO,
         };
-        let block = BlockState {
-            half: [half; 2],
-            seg: [usize::MAX; 8],
-        };
         LooseState {
-            block: vec![block; loose.blocks],
+            half: vec![[half; 2]; loose.blocks],
+            seg: vec![u32::MAX; loose.lanes.len()],
             ctl: vec![f32x8::ZERO; loose.ctl_planes],
             next: 0,
             next_time: loose.order_time(0),
@@ -529,18 +530,19 @@ impl LooseState {
         [ws, we, d]: [f64; 3],
         ease: Option<SegmentEase>,
     ) {
-        let (b, i) = (l / 8, l % 8);
-        let block = &mut self.block[b];
-        let half = &mut block.half[i / 4];
-        let j = i % 4;
-        half.ws.as_mut_array()[j] = ws;
-        half.d.as_mut_array()[j] = d;
-        half.we.as_mut_array()[j] = we;
+        let window: &mut [f64] = bytemuck::cast_slice_mut(&mut self.half);
+        let at = window_at(l);
+        let Some(window) = window.get_mut(at..at + 17) else {
+            unreachable!("a lane's window is in the instance")
+        };
+        window[0] = ws;
+        window[4] = d;
+        window[8] = we;
         if let Some(e) = ease {
-            half.from.as_mut_array()[j] = e.from();
-            half.to.as_mut_array()[j] = e.to();
+            window[12] = e.from();
+            window[16] = e.to();
         }
-        block.seg[i] = seg;
+        self.seg[l] = index_u32(seg);
     }
 
     /// The stored segment for mapped time `tm` (within the keys, or the
@@ -584,20 +586,23 @@ impl LooseState {
     #[inline(never)]
     fn stream(&mut self, loose: &Loose, time: f64) {
         // In registers, stored once: the loads write through `self`.
-        let mut next = self.next;
-        let seek_at = next + 4 * loose.lanes.len() + 64;
-        while let Some(&[l, seg]) = loose.order.get(next) {
+        let first = self.next;
+        let seek_at = 4 * loose.lanes.len() + 64;
+        let order = loose.order.get(first..).unwrap_or_default();
+        for (i, &[l, seg]) in order.iter().enumerate() {
             let (l, seg) = (l as usize, seg as usize);
             let lane = &loose.lanes[l];
             let t = lane.grid.times.listed();
             // The entry's time is its segment's first key (`seg >= 1`).
-            let start = t[seg - 1];
+            let Some(&start) = t.get(seg.wrapping_sub(1)) else {
+                unreachable!("an entry's segment starts at a key")
+            };
             if time < start {
-                self.next = next;
+                self.next = first + i;
                 self.next_time = start;
                 return;
             }
-            if next == seek_at {
+            if i == seek_at {
                 return self.seek(loose, time);
             }
             match t.get(seg) {
@@ -608,9 +613,8 @@ impl LooseState {
                 Some(&end) => self.load_real(loose, l, seg, start, end),
                 None => self.load_inline(loose, l, seg),
             }
-            next += 1;
         }
-        self.next = next;
+        self.next = loose.order.len();
         // `next_time` is infinite past the end, which an infinite `time` passes.
         self.next_time = f64::INFINITY;
     }
@@ -646,12 +650,19 @@ impl LooseState {
         debug_assert!(usize::from(lane.plain) == N && lane.dim() == N && seg >= 1);
         debug_assert_eq!((seg - 1, seg), lane.grid.key_pair(seg));
         self.set_window(l, seg, [ws, we, we - ws], None);
-        // Keys `seg - 1` and `seg`, `N` components each.
-        let keys = &k[(seg - 1) * N..][..2 * N];
+        // Keys `seg - 1` and `seg`, `N` components each (`seg` is at most
+        // the key count, which is far below `usize::MAX / 4`).
+        let Some(keys) = k.get((seg - 1) * N..(seg + 1) * N) else {
+            unreachable!("a real segment's keys are the lane's")
+        };
         let (a, b) = keys.split_at(N);
         let ctl: &mut [f32] = bytemuck::cast_slice_mut(&mut self.ctl);
+        let at = lane.ctl_at as usize;
+        let Some(out) = ctl.get_mut(at..at + 32 * N - 7) else {
+            unreachable!("a lane's controls are in the instance")
+        };
         put_controls::<N>(
-            &mut ctl[lane.ctl_at as usize..],
+            out,
             a.try_into().expect("N components"),
             b.try_into().expect("N components"),
         );
@@ -727,7 +738,7 @@ fn mask_of(a: f64x4, b: f64x4) -> f32x8 {
 /// Reload the lanes of half block `i` whose window does not hold `tm`.
 #[inline(always)]
 fn refresh(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4) {
-    let half = &st.block[i / 2].half[i % 2];
+    let half = &st.half[i / 2][i % 2];
     let ok = half.ws.simd_le(tm) & tm.simd_lt(half.we);
     let stale = !ok.to_bitmask() & 0xf;
     if stale != 0 {
@@ -743,7 +754,7 @@ fn load_stale(loose: &Loose, st: &mut LooseState, i: usize, tm: f64x4, mut stale
         stale &= stale - 1;
         let l = 4 * i + k;
         if l < loose.lanes.len() {
-            let current = st.block[l / 8].seg[l % 8];
+            let current = st.seg[l] as usize;
             let seg = LooseState::segment_for(&loose.lanes[l], current, tm.to_array()[k]);
             st.load(loose, l, seg);
         }
@@ -870,7 +881,7 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
             we,
             from: a,
             to: e,
-        } = st.block[b].half[h];
+        } = st.half[b][h];
         let is_real =
             ws.simd_gt(f64x4::splat(f64::NEG_INFINITY)) & we.simd_lt(f64x4::splat(f64::INFINITY));
         let u = is_real.select(((out_tm[h] - ws) / d).max(zero).min(one), zero);
@@ -982,15 +993,15 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
     for (b, info) in loose.block.iter().enumerate() {
         let out = 4 * b..4 * b + 4;
         if time >= info.inner[0] && time < info.inner[1] {
-            let block = &st.block[b];
+            let half = &st.half[b];
             // Every real lane holds `time` (padding lanes span +-PAD_SPAN
             // only: beyond it their u leaves [0, 1], which nobody reads).
             debug_assert!((8 * b..loose.lanes.len().min(8 * b + 8)).all(|l| {
-                let h = &block.half[(l % 8) / 4];
+                let h = &half[(l % 8) / 4];
                 let i = l % 4;
                 h.ws.to_array()[i] <= time && time < h.we.to_array()[i]
             }));
-            let (s, rate) = inside::<K>(info.eased, &block.half, time, velocity);
+            let (s, rate) = inside::<K>(info.eased, half, time, velocity);
             let ctl = &st.ctl[info.ctl.clone()];
             let h = hermite_basis(s);
             for (k, o) in ctl.chunks_exact(4).zip(&mut values[out.clone()]) {
