@@ -636,7 +636,8 @@ impl LooseState {
     /// [`Self::load_inline`] for real segment `seg` (window `[ws, we)`) of
     /// a lane with `N` components, no ease and no step, and keys `k` in
     /// f32: what forward playback loads nearly every time, in straight-line
-    /// code (one bounds check each for the block, the keys and the controls).
+    /// code (one range check each for the window, the loaded segment, the
+    /// keys and the controls).
     #[inline(always)]
     fn load_plain<const N: usize>(
         &mut self,
