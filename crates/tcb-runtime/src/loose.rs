@@ -35,7 +35,7 @@ use crate::store::{KEY_STRIDE, per_key};
 use tcb_core::Extrapolation;
 use tcb_core::ease::{SegmentEase, ease};
 use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
-use tcb_core::simd::extrapolate::{ModeLanes, map_lanes};
+use tcb_core::simd::extrapolate::{ModeLanes, hold_lanes, map_lanes};
 use tcb_core::simd::lane::{Lane, Mask};
 use tcb_core::track::segment_from;
 use wide::{f32x8, f64x4};
@@ -281,6 +281,9 @@ struct Block {
     inner: [f64; 2],
     /// Whether any lane has an eased segment.
     eased: bool,
+    /// Whether every lane's `pre` and `post` are `constant`: outside its
+    /// keys a lane then holds an end key ([`hold_lanes`]).
+    hold: bool,
     /// Whether any lane stores a non-finite control (a tangent that
     /// overflowed f32): at a segment's end its value is then selected, not
     /// summed (`0 x inf`).
@@ -358,6 +361,10 @@ impl Loose {
                         block_lanes(b).map(last).fold(f64::INFINITY, f64::min),
                     ],
                     eased: block_lanes(b).any(|l| l.grid.eases.iter().any(|e| !e.is_none())),
+                    hold: block_lanes(b).all(|l| {
+                        l.grid.pre == Extrapolation::Constant
+                            && l.grid.post == Extrapolation::Constant
+                    }),
                     unbounded: block_lanes(b).any(|l| match &l.keys {
                         Keys::F32(k) => k.iter().flatten().any(|x| !x.is_finite()),
                         // Quantized lanes are finite (quant keeps the rest in f32).
@@ -837,9 +844,16 @@ fn inside<K: Lanes>(eased: bool, half: &[Half; 2], time: f64, velocity: bool) ->
 }
 
 /// Rows for block `b` at `time` (any f64), reloading lanes whose mapped
-/// time left their window.
+/// time left their window; `HOLD` where every lane's modes are `constant`
+/// (`Block::hold`).
 #[inline(never)]
-fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity: bool) -> Rows {
+fn rows_mapped<const HOLD: bool>(
+    loose: &Loose,
+    st: &mut LooseState,
+    b: usize,
+    time: f64,
+    velocity: bool,
+) -> Rows {
     // Hot (a block whose lanes left their keys, per frame), kept whole:
     // two halves of 4 lanes in f64 feed one f32x8 row computation.
     let t = f64x4::splat(time);
@@ -852,7 +866,11 @@ fn rows_mapped(loose: &Loose, st: &mut LooseState, b: usize, time: f64, velocity
     let mut dt = [zero; 2];
     for h in 0..2 {
         let i = 2 * b + h;
-        let m = map_lanes(t, loose.t0[i], loose.tn[i], &loose.pre[i], &loose.post[i]);
+        let m = if HOLD {
+            hold_lanes(t, loose.t0[i], loose.tn[i])
+        } else {
+            map_lanes(t, loose.t0[i], loose.tn[i], &loose.pre[i], &loose.post[i])
+        };
         // Lanes outside the keys read a sentinel: 0 before, n after. A
         // time mapped inside but rounded below the first key (`oscillate`
         // over a huge span) is the first segment at u = 0, as the
@@ -1029,7 +1047,11 @@ fn sample_blocks<const ROTATIONS: bool, const UNBOUNDED: bool, K: Lanes>(
             }
             continue;
         }
-        let rows = rows_mapped(loose, st, b, time, velocities.is_some());
+        let rows = if info.hold {
+            rows_mapped::<true>(loose, st, b, time, velocities.is_some())
+        } else {
+            rows_mapped::<false>(loose, st, b, time, velocities.is_some())
+        };
         let ctl = &st.ctl[info.ctl.clone()];
         for (c, k) in ctl.chunks_exact(4).enumerate() {
             let mut v = hermite(&rows.h, k[0], k[1], k[2], k[3]);

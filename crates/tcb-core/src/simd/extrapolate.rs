@@ -231,10 +231,67 @@ pub fn map_lanes<L: Lane>(
     }
 }
 
+/// [`map_lanes`] where every lane's `pre` and `post` are `constant` (the
+/// default): the time itself inside the keys, a hold of the end key
+/// elsewhere (NaN too), without the other modes' arithmetic. `time`
+/// outside the keys and `dt` are left as the time and zero: only modes
+/// that are not there read them. Every other field is `map_lanes`'s
+/// (`hold_lanes_is_map_lanes_of_constant`).
+#[inline(always)]
+pub fn hold_lanes<L: Lane>(time: L, t0: L, tn: L) -> MappedLanes<L> {
+    let within = time.ge(t0) & time.le(tn);
+    let none = within & !within;
+    MappedLanes {
+        inside: within,
+        hold: !within,
+        reset: none,
+        line: none,
+        last: time.gt(tn),
+        time,
+        direction: L::of(1.0),
+        cycles: L::of(0.0),
+        dt: L::of(0.0),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use Extrapolation as E;
+
+    #[test]
+    fn hold_lanes_is_map_lanes_of_constant() {
+        let c = ModeLanes::of(E::Constant);
+        let times = [
+            -f64::INFINITY,
+            -f64::MAX,
+            -1.0,
+            0.0,
+            0.5,
+            1.0,
+            2.0,
+            3.0,
+            3.0 + f64::EPSILON,
+            1e300,
+            f64::INFINITY,
+            f64::NAN,
+        ];
+        for (t0, tn) in [(0.0, 1.0), (1.0, 3.0), (-1e300, 1e300), (2.0, 2.0)] {
+            for time in times {
+                let (m, h) = (map_lanes(time, t0, tn, &c, &c), hold_lanes(time, t0, tn));
+                let at = format!("{time} in [{t0}, {tn}]");
+                assert_eq!(
+                    (m.inside, m.hold, m.reset, m.line, m.last),
+                    (h.inside, h.hold, h.reset, h.line, h.last),
+                    "{at}"
+                );
+                assert_eq!((m.direction, m.cycles), (h.direction, h.cycles), "{at}");
+                if m.inside {
+                    assert_eq!(m.time.to_bits(), h.time.to_bits(), "{at}");
+                }
+            }
+        }
+    }
 
     fn inside(time: f64, direction: f64, cycles: f64) -> Mapped {
         Mapped::Inside {
