@@ -293,7 +293,8 @@ struct Block {
     ctl: std::ops::Range<usize>,
 }
 
-/// Lane or segment index as stored in [`Loose::order`].
+/// Lane or segment index as stored in [`Loose::order`] and
+/// `LooseState::seg`.
 fn index_u32(i: usize) -> u32 {
     u32::try_from(i).expect("fewer than 2^32 loose lanes and keys")
 }

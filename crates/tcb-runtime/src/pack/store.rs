@@ -151,8 +151,7 @@ impl PackedKeys {
         if a > 0 && b < n - 1 {
             // Both (all but the end segments): the chord P_b - P_a once,
             // from the rows of keys `a - 1 ..= b + 1`.
-            let at = (a - 1 + BEFORE - SEGMENT_KEYS * c.cur) * np;
-            let keys = &c.rows[at..at + 4 * np];
+            let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
             let (m0, m1) = c.m.split_at_mut(np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
@@ -357,12 +356,21 @@ impl PackedKeys {
     }
 }
 
+/// The rows of keys `k .. k + count` in a cache's `rows` (`PackCache::rows`,
+/// holding segment `cur`; decoded, as [`PackCache::ring`]'s), `np` vectors
+/// each. A free function, so that a caller may borrow the cache's tangents
+/// mutably beside them.
+#[inline(always)]
+fn key_rows(rows: &[f32x8], cur: usize, k: usize, count: usize, np: usize) -> &[f32x8] {
+    let at = (k + BEFORE - SEGMENT_KEYS * cur) * np;
+    &rows[at..at + count * np]
+}
+
 impl PackCache {
     /// Key `k`'s row (decoded: `valid <= k` and in or before `cur`).
     #[inline(always)]
     fn ring(&self, k: usize, np: usize) -> &[f32x8] {
-        let at = (k + BEFORE - SEGMENT_KEYS * self.cur) * np;
-        &self.rows[at..at + np]
+        key_rows(&self.rows, self.cur, k, 1, np)
     }
 
     /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
