@@ -72,16 +72,39 @@ pub(crate) fn hermite_quats(
     rows_d: [f32; 4],
     rate_s: f32,
     out: &mut [f32x8],
-    mut vel: Option<&mut [f32x8]>,
+    vel: Option<&mut [f32x8]>,
 ) {
+    const LOW: u32 = F32_RANGE[0].to_bits();
+    quats_above::<LOW, true>(c, rows, rows_d, rate_s, out, vel);
+}
+
+/// `|p|^2` where [`normalize`] may run as it is: well inside f32's range.
+pub(crate) const F32_RANGE: [f32; 2] = [1e-30, 1e30];
+
+/// [`hermite_quats`], the lanes' `|p|^2` checked to be above
+/// `f32::from_bits(LOW)` (and below [`F32_RANGE`]'s top): where some lane's
+/// is not, with `RESCALE` the cold path ([`rescale_quats`]) redoes its
+/// block, and without it `out` (and `vel`) are not final and the result
+/// is `false`.
+#[inline(always)]
+pub(crate) fn quats_above<const LOW: u32, const RESCALE: bool>(
+    c: Segment,
+    rows: [f32; 4],
+    rows_d: [f32; 4],
+    rate_s: f32,
+    out: &mut [f32x8],
+    mut vel: Option<&mut [f32x8]>,
+) -> bool {
+    let low = f32::from_bits(LOW);
     #[cfg(target_arch = "x86_64")]
     if vel.is_none()
         && let Some(avx2) = crate::isa::Avx2Kernels::now()
     {
-        if !v3::quats_here(avx2, c, rows, out) {
+        let ok = v3::quats_here::<LOW>(avx2, c, rows, out);
+        if RESCALE && !ok {
             rescale_quats(c, rows, rows_d, rate_s, out, vel);
         }
-        return;
+        return ok;
     }
     let (h, dh, rate) = (&splat4(rows), &splat4(rows_d), f32x8::splat(rate_s));
     let keys = quat_keys(c);
@@ -91,19 +114,20 @@ pub(crate) fn hermite_quats(
     match vel.as_deref_mut() {
         None => {
             for (k, o) in keys.zip(blocks) {
-                ok &= hermite_quat_block(k, h, None, o, None);
+                ok &= hermite_quat_block(k, h, None, o, None, low);
             }
         }
         Some(vel) => {
             let vel = vel.as_chunks_mut::<4>().0;
             for ((k, o), v) in keys.zip(blocks).zip(vel) {
-                ok &= hermite_quat_block(k, h, Some((dh, rate)), o, Some(v));
+                ok &= hermite_quat_block(k, h, Some((dh, rate)), o, Some(v), low);
             }
         }
     }
-    if ok.to_bitmask() != 0xff {
+    if RESCALE && ok.to_bitmask() != 0xff {
         rescale_quats(c, rows, rows_d, rate_s, out, vel);
     }
+    ok.to_bitmask() == 0xff
 }
 
 /// `P0 P1 M0 M1` of one rotation block (four planes each).
@@ -150,8 +174,8 @@ fn quat_curve(
     (p, dp)
 }
 
-/// One block of [`hermite_quats`]: 8 rotations. Returns the lanes whose
-/// `|p|^2` is in range ([`in_range`]).
+/// One block of [`quats_above`]: 8 rotations. Returns the lanes whose
+/// `|p|^2` is in range ([`in_range`] from `low`).
 #[inline(always)]
 fn hermite_quat_block(
     k: QuatKeys,
@@ -159,6 +183,7 @@ fn hermite_quat_block(
     dh: Option<(&[f32x8; 4], f32x8)>,
     out: &mut [f32x8; 4],
     vel: Option<&mut [f32x8; 4]>,
+    low: f32,
 ) -> f32x8 {
     let (p, dp) = quat_curve(k, h, dh);
     let (q, qv) = normalize(p, dp);
@@ -166,7 +191,7 @@ fn hermite_quat_block(
     if let (Some(v), Some(qv)) = (vel, qv) {
         *v = qv;
     }
-    in_range(&p)
+    in_range(&p, low)
 }
 
 /// [`hermite_quats`] again for the blocks with a lane out of range, each
@@ -189,7 +214,7 @@ fn rescale_quats(
     let (h, dh, rate) = (&splat4(h), &splat4(dh), f32x8::splat(rate));
     for (b, k) in quat_keys(c).enumerate() {
         let (p, dp) = quat_curve(k, h, vel.is_some().then_some((dh, rate)));
-        if in_range(&p).to_bitmask() != 0xff {
+        if in_range(&p, F32_RANGE[0]).to_bitmask() != 0xff {
             let p = if at_end { *k.0.0.1 } else { p };
             let planes = 4 * b..4 * b + 4;
             let v = vel.as_deref_mut().map(|v| &mut v[planes.clone()]);
@@ -200,13 +225,14 @@ fn rescale_quats(
 
 pub(crate) use tcb_core::quat::normalize;
 
-/// The lanes where `|p|^2` is well inside f32's range, so that
+/// The lanes where `|p|^2` is above `low` and below [`F32_RANGE`]'s top:
+/// with `low` [`F32_RANGE`]'s bottom, well inside f32's range, so that
 /// [`normalize`] may run as it is (all bits set there, none elsewhere; NaN
 /// is out of range).
 #[inline(always)]
-pub(crate) fn in_range<L: Lane>(p: &[L; 4]) -> L::Mask {
+pub(crate) fn in_range<L: Lane>(p: &[L; 4], low: f32) -> L::Mask {
     let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
-    n2.gt(L::splat(1e-30)) & n2.lt(L::splat(1e30))
+    n2.gt(L::splat(low)) & n2.lt(L::splat(F32_RANGE[1]))
 }
 
 /// Rewrite `out` (and `vel`) with [`normalize`] of a block where `|p|^2`
@@ -355,11 +381,16 @@ mod v3 {
 
     /// [`quats`], where `crate::isa::avx2_kernels` said so (the token).
     #[inline(always)]
-    pub(super) fn quats_here(_: Avx2Kernels, c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
+    pub(super) fn quats_here<const LOW: u32>(
+        _: Avx2Kernels,
+        c: Segment,
+        h: [f32; 4],
+        out: &mut [f32x8],
+    ) -> bool {
         // SAFETY: as in `vectors_here`.
         #[allow(unsafe_code)]
         unsafe {
-            quats(c, h, out)
+            quats::<LOW>(c, h, out)
         }
     }
 
@@ -398,11 +429,12 @@ mod v3 {
         }
     }
 
-    /// [`crate::kernel::hermite_quats`] without velocities: the blocks' values,
-    /// normalized; `false` where some lane's `|p|^2` is out of
-    /// [`crate::kernel::in_range`]'s range (the caller redoes those blocks).
+    /// [`crate::kernel::quats_above`] without velocities: the blocks'
+    /// values, normalized; `false` where some lane's `|p|^2` is out of
+    /// [`crate::kernel::in_range`]'s range from `f32::from_bits(LOW)`.
     #[target_feature(enable = "avx2,fma")]
-    fn quats(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
+    fn quats<const LOW: u32>(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
+        let low = f32::from_bits(LOW);
         let h = rows(h);
         let mut ok = M8([u32::MAX; 8]);
         for ((((p0, p1), m0), m1), o) in quat_keys(c).zip(out.as_chunks_mut::<4>().0) {
@@ -412,7 +444,7 @@ mod v3 {
                 hermite(&h, w(&p0[2]), w(&p1[2]), w(&m0[2]), w(&m1[2])),
                 hermite(&h, w(&p0[3]), w(&p1[3]), w(&m0[3]), w(&m1[3])),
             ];
-            ok = ok & in_range(&p);
+            ok = ok & in_range(&p, low);
             let (q, _) = normalize(p, None);
             *o = [back(q[0]), back(q[1]), back(q[2]), back(q[3])];
         }

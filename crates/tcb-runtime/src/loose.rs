@@ -1117,7 +1117,7 @@ fn normalize<K: Lanes>(
             K::store(qv[3]),
         ];
     }
-    if !crate::kernel::in_range(&p).all() {
+    if !crate::kernel::in_range(&p, crate::kernel::F32_RANGE[0]).all() {
         let vel = match vel {
             Some(d) => Some(d.as_mut_slice()),
             None => None,

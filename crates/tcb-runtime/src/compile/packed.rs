@@ -12,7 +12,7 @@
 use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
 use crate::grid::{KeyTimes, TimeGrid};
-use crate::pack::store::{GATHER_WIDTH, PackedKeys};
+use crate::pack::store::{GATHER_WIDTH, KEY_LENGTH2, PackedKeys};
 use crate::pack::{GROUP, PackError, Packed, err, key_weights};
 use std::sync::Arc;
 use tcb_core::TrackKind;
@@ -231,6 +231,10 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
     let mut rebuild = vec![[true; 8]; g.hq_blocks];
     let mut center: Vec<Option<[[f32; 8]; 4]>> = vec![None; g.hq_blocks];
     let rot_from = g.vec_blocks;
+    // The rotations' weights, and whether they and the centers allow the
+    // key form (`PackedKeys::key_weights`).
+    let mut rotation_weights = Vec::new();
+    let mut key_form = true;
     for (i, t) in head.tracks.iter().enumerate() {
         let slot = &clip.layout.tracks()[head.place(i)];
         // Flat indices in the group's planes.
@@ -252,6 +256,11 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
             }
         }
         if t.kind == TrackKind::Quat {
+            rotation_weights.push(w);
+            key_form &= w.iter().all(|w| w.abs() <= 1.0);
+            if let Some(c) = t.center {
+                key_form &= c.iter().map(|x| x * x).sum::<f32>() <= KEY_LENGTH2;
+            }
             let at = index[0];
             let b = (at / 8 - rot_from) / 4;
             rebuild[b][at % 8] = t.rebuild_w;
@@ -302,6 +311,10 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         step: step.into_iter().map(f32x8::new).collect(),
         weights: weights.into_iter().map(|w| w.map(f32x8::new)).collect(),
         rot_from,
+        key_weights: rotation_weights
+            .first()
+            .copied()
+            .filter(|w| key_form && rotation_weights.iter().all(|v| v == w)),
         rebuild: rebuild
             .into_iter()
             .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))

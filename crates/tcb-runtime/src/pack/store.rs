@@ -31,6 +31,16 @@
 //! reference is given them (`tcb_core::RotationTrack::new_as_given`): `w`
 //! rebuilt where the track stores three components, not normalized (the
 //! kernel normalizes the curve it plays).
+//!
+//! Where every rotation of the group shares its weights (a clip of one
+//! tangent rule, as capture is), interior segments play their rotations
+//! from their four keys instead ([`key_row`]: the basis row with the
+//! tangents written out, the same kernel), and only the vector planes'
+//! tangents are computed: the same curve, rounded otherwise (within a few
+//! 1e-7 of the reference, where the contract allows 1e-6), while vectors
+//! keep the reference's bits. Rows whose keys may be long
+//! ([`KEY_LENGTH2`]), and frames where a rotation's `|p|` is short
+//! ([`KEY_FORM_LOW`]), play from the tangents.
 
 use super::{
     BYTES, BitLanes, GROUP, Packed, SEGMENT_KEYS, block_step, header_group, read_bits, unzigzag,
@@ -40,7 +50,7 @@ use crate::segment::Segment;
 use std::ops::{Add, BitAnd, Sub};
 use std::sync::Arc;
 use tcb_core::simd::basis::Real;
-use tcb_core::simd::lane::Lane;
+use tcb_core::simd::lane::{Lane, Mask};
 use wide::{f32x8, i32x8};
 
 /// Sections of a key: `P`, `TO`, `TI`.
@@ -74,6 +84,11 @@ pub(crate) struct PackedKeys {
     pub stored_planes: Vec<u32>,
     /// The first rotation plane; rotation blocks of 4 planes follow.
     pub rot_from: usize,
+    /// The weights (`in_a in_b out_a out_b`) every rotation of the group
+    /// shares, where they do, each at most 1 in magnitude, and every
+    /// center's `|c|^2` is at most [`KEY_LENGTH2`]: then interior segments
+    /// play their rotations from their keys ([`PackedKeys::segment_keys`]).
+    pub key_weights: Option<[f32; 4]>,
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
     pub rebuild: Vec<f32x8>,
@@ -133,7 +148,7 @@ impl PackedKeys {
             let (lo, hi) = (a.saturating_sub(1), (b + 1).min(n - 1));
             c.ensure(self, lo, hi);
             self.tangents(a, b, c);
-            c.seg = a;
+            (c.seg, c.seg_vectors) = (a, a);
         }
         let np = self.planes;
         let (m0, m1) = c.m.split_at(np);
@@ -145,6 +160,62 @@ impl PackedKeys {
         }
     }
 
+    /// The controls of interior segment `a` to `b` (`0 < a`, `b < n - 1`)
+    /// in the key form, where the group has it ([`key_weights`](Self::key_weights)):
+    /// the vector planes' controls as [`segment`](Self::segment) gives
+    /// them; the rotation planes' four keys as a segment's `P0` (`P_a`),
+    /// `P1` (`P_b`), `M0` (`P_{a-1}`) and `M1` (`P_{b+1}`), played with
+    /// [`key_row`] of the frame's basis and the weights returned. `None`
+    /// at the ends and the sentinels, and where a key of the four may be
+    /// longer than [`KEY_LENGTH2`] allows (then [`segment`](Self::segment)).
+    #[inline(always)]
+    pub fn segment_keys<'a>(
+        &'a self,
+        a: usize,
+        b: usize,
+        c: &'a mut PackCache,
+    ) -> Option<(Segment<'a>, Segment<'a>, [f32; 4])> {
+        let w = self.key_weights?;
+        if a == 0 || b + 1 >= self.keys {
+            return None;
+        }
+        let (np, r) = (self.planes, self.rot_from);
+        if c.seg_vectors != a {
+            c.ensure(self, a - 1, b + 1);
+            // The vector planes' tangents (a root's translation: one plane,
+            // or none), here in line.
+            let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
+            let rows = [0, 1, 2, 3].map(|k| &keys[k * np..k * np + r]);
+            let (m0, m1) = c.m.split_at_mut(np);
+            interior_tangents::<f32x8>(rows, &self.weights, &mut m0[..r], &mut m1[..r]);
+            // The rows may have moved: the rotations' tangents of `c.seg`
+            // are not what `segment` would read with them.
+            (c.seg, c.seg_vectors) = (usize::MAX, a);
+        }
+        // Key `a - 1` in segment `cur`, or in the one before.
+        if !(c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded)) {
+            return None;
+        }
+        let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
+        let (before, rest) = keys.split_at(np);
+        let (pa, rest) = rest.split_at(np);
+        let (pb, after) = rest.split_at(np);
+        let (m0, m1) = c.m.split_at(np);
+        let vectors = Segment {
+            p0: &pa[..r],
+            m0: &m0[..r],
+            p1: &pb[..r],
+            m1: &m1[..r],
+        };
+        let rotations = Segment {
+            p0: &pa[r..],
+            m0: &before[r..],
+            p1: &pb[r..],
+            m1: &after[r..],
+        };
+        Some((vectors, rotations, w))
+    }
+
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
     fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
         let (np, n) = (self.planes, self.keys);
@@ -152,12 +223,13 @@ impl PackedKeys {
             // Both (all but the end segments): the chord P_b - P_a once,
             // from the rows of keys `a - 1 ..= b + 1`.
             let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
+            let rows = [0, 1, 2, 3].map(|k| &keys[k * np..(k + 1) * np]);
             let (m0, m1) = c.m.split_at_mut(np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
-                return v3::interior_tangents_here(keys, &self.weights, m0, m1);
+                return v3::interior_tangents_here(rows, &self.weights, m0, m1);
             }
-            return interior_tangents::<f32x8>(keys, &self.weights, m0, m1);
+            return interior_tangents::<f32x8>(rows, &self.weights, m0, m1);
         }
         let mut m = std::mem::take(&mut c.m);
         let (m0, m1) = m.split_at_mut(np);
@@ -179,6 +251,44 @@ impl PackedKeys {
     }
 }
 
+/// The basis row that plays an interior segment from its four keys
+/// ([`PackedKeys::segment_keys`]: `P_a`, `P_b`, `P_{a-1}`, `P_{b+1}`, in
+/// a segment's `P0 P1 M0 M1`): the hermite row `h` (`P0 P1 M0 M1`) with
+/// each tangent written out as [`tangent`] of its chords, weights `w` (`in_a
+/// in_b out_a out_b`):
+///
+/// ```text
+/// h0 P_a + h1 P_b + h2 TO_a + h3 TI_b,   TO_a = (P_a - P_{a-1}) out_a + (P_b - P_a) out_b
+///                                        TI_b = (P_b - P_a) in_a + (P_{b+1} - P_b) in_b
+/// = (h0 + h2 (out_a - out_b) - h3 in_a) P_a + (h1 + h2 out_b + h3 (in_a - in_b)) P_b
+///   - h2 out_a P_{a-1} + h3 in_b P_{b+1}
+/// ```
+///
+/// in f64, rounded once. The same curve in other roundings: rotations
+/// only (vectors keep the reference's bits).
+pub(crate) fn key_row(h: [f32; 4], w: [f32; 4]) -> [f32; 4] {
+    let [h0, h1, h2, h3] = h.map(f64::from);
+    let [in_a, in_b, out_a, out_b] = w.map(f64::from);
+    [
+        h0 + h2 * (out_a - out_b) - h3 * in_a,
+        h1 + h2 * out_b + h3 * (in_a - in_b),
+        -h2 * out_a,
+        h3 * in_b,
+    ]
+    .map(|x| x as f32)
+}
+
+/// `|P|^2` of every key that an interior segment's key form reads is at
+/// most this (checked as keys are decoded; the centers at compile time),
+/// and the form plays only where `|p|^2` is above [`KEY_FORM_LOW`]: then
+/// its roundings, and the reference's, move the normalized rotation by a
+/// few 1e-7 (weights at most 1, so that `key_row`'s coefficients sum to
+/// at most 1.6 in magnitude).
+pub(crate) const KEY_LENGTH2: f32 = 1.02;
+
+/// See [`KEY_LENGTH2`].
+pub(crate) const KEY_FORM_LOW: f32 = 0.81;
+
 /// The tangent rule on a key's two chords (`P_k - P_{k-1}`, `P_{k+1} -
 /// P_k`) with its weights, as `tcb_core::Track` computes it in f32.
 #[inline(always)]
@@ -191,15 +301,11 @@ fn tangent<L: Real>(before: L, after: L, wa: L, wb: L) -> L {
 /// chord `P_b - P_a` once.
 #[inline(always)]
 fn interior_tangents<L: Plane>(
-    keys: &[f32x8],
+    [v, x, y, z]: [&[f32x8]; 4],
     weights: &[[f32x8; 4]],
     m0: &mut [f32x8],
     m1: &mut [f32x8],
 ) {
-    let np = m0.len();
-    let (v, rest) = keys.split_at(np);
-    let (x, rest) = rest.split_at(np);
-    let (y, z) = rest.split_at(np);
     let rows = v.iter().zip(x).zip(y.iter().zip(z));
     let out = m0.iter_mut().zip(m1.iter_mut());
     for (((m0, m1), ((v, x), (y, z))), w) in out.zip(rows).zip(weights) {
@@ -238,16 +344,21 @@ fn block_start_keys<I: Copy + Add<Output = I>>(start: I, delta: I, keys: usize) 
 
 /// Rebuild `w` of the rotations that store three components, and turn
 /// the keys of rotations with a center by it (`PackTrack::value`), in the
-/// rows `rows` (`planes` vectors each).
+/// rows `rows` (`planes` vectors each). Returns whether every key's
+/// `|q|^2` before its center is at most [`KEY_LENGTH2`] (not NaN).
 #[inline(always)]
-fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) {
+fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
+    let limit = L::splat(KEY_LENGTH2);
+    let mut bounded = L::splat(0.0).le(limit);
     for row in rows.chunks_exact_mut(g.planes) {
         let rot = &mut row[g.rot_from..];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
             let [x, y, z] = [L::load(&block[0]), L::load(&block[1]), L::load(&block[2])];
             let w = L::load(&block[3]);
             let rebuilt = tcb_core::quat::rebuild_w(x, y, z);
-            block[3] = L::blend(mask, rebuilt, w).store();
+            let w = L::blend(mask, rebuilt, w);
+            block[3] = w.store();
+            bounded = bounded & (x * x + y * y + z * z + w * w).le(limit);
         }
         for (b, c) in &g.center {
             if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
@@ -270,6 +381,7 @@ fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) {
             }
         }
     }
+    bounded.all()
 }
 
 /// Eight `f32` lanes the decoder computes on, kept as `f32x8` in the rows:
@@ -310,8 +422,17 @@ pub(crate) struct PackCache {
     /// The first key whose row is valid (the three before `cur`'s first
     /// key, or, after a seek, the first key decoded).
     valid: usize,
-    /// The first key of the segment whose tangents `m` holds.
+    /// The first key of the segment whose tangents `m` holds, and of the
+    /// one whose tangents its vector planes hold
+    /// ([`PackedKeys::segment_keys`] computes only those).
     seg: usize,
+    seg_vectors: usize,
+    /// Whether every rotation key of segment `cur` (decoded so far) has
+    /// `|P|^2` at most [`KEY_LENGTH2`], and whether every key of segment
+    /// `cur - 1` has, where the rows hold its last keys. Per segment, so
+    /// that forward playback and a seek decide alike.
+    seg_bounded: bool,
+    before_bounded: bool,
     /// The stream's bit after segment `cur` (where the next one starts).
     pos: usize,
     /// Per stream lane with headers (`PackedKeys::headed`), as the
@@ -341,6 +462,9 @@ impl PackedKeys {
             cur: usize::MAX,
             valid: 0,
             seg: usize::MAX,
+            seg_vectors: usize::MAX,
+            seg_bounded: false,
+            before_bounded: false,
             pos: 0,
             headers: Headers {
                 width: self.headed_base.clone(),
@@ -403,13 +527,16 @@ impl PackCache {
         let block = s.is_multiple_of(g.packed.block);
         debug_assert!(block || self.cur.wrapping_add(1) == j);
         // The three keys before: the last rows of segment j - 1.
-        if self.cur.wrapping_add(1) == j {
+        self.before_bounded = if self.cur.wrapping_add(1) == j {
             self.rows
                 .copy_within(SEGMENT_KEYS * np..(SEGMENT_KEYS + BEFORE) * np, 0);
             self.valid = self.valid.max(s.saturating_sub(BEFORE));
+            self.seg_bounded
         } else {
             self.valid = s;
-        }
+            false
+        };
+        self.seg_bounded = true;
         self.cur = j;
         let words: &[u64] = &g.packed.stream;
         let mut pos = if block {
@@ -578,10 +705,14 @@ impl PackCache {
         let np = g.planes;
         let rows = &mut self.rows[(BEFORE + rows.start) * np..(BEFORE + rows.end) * np];
         #[cfg(target_arch = "x86_64")]
-        if crate::isa::avx2() {
-            return v3::rebuild_rows_here(g, rows);
-        }
-        rebuild_rows::<f32x8>(g, rows);
+        let bounded = if crate::isa::avx2() {
+            v3::rebuild_rows_here(g, rows)
+        } else {
+            rebuild_rows::<f32x8>(g, rows)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let bounded = rebuild_rows::<f32x8>(g, rows);
+        self.seg_bounded &= bounded;
     }
 }
 
@@ -721,7 +852,7 @@ mod v3 {
     /// [`interior_tangents`] in AVX2.
     #[inline(always)]
     pub(super) fn interior_tangents_here(
-        keys: &[f32x8],
+        keys: [&[f32x8]; 4],
         weights: &[[f32x8; 4]],
         m0: &mut [f32x8],
         m1: &mut [f32x8],
@@ -734,7 +865,7 @@ mod v3 {
     }
 
     #[target_feature(enable = "avx2,fma")]
-    fn tangents(keys: &[f32x8], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
+    fn tangents(keys: [&[f32x8]; 4], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
         interior_tangents::<W8>(keys, weights, m0, m1);
     }
 
@@ -760,7 +891,7 @@ mod v3 {
 
     /// [`rebuild_rows`] in AVX2.
     #[inline(always)]
-    pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) {
+    pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
         debug_assert!(crate::isa::avx2());
         #[allow(unsafe_code)]
         unsafe {
@@ -769,8 +900,8 @@ mod v3 {
     }
 
     #[target_feature(enable = "avx2,fma")]
-    fn rebuild(g: &PackedKeys, rows: &mut [f32x8]) {
-        rebuild_rows::<W8>(g, rows);
+    fn rebuild(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
+        rebuild_rows::<W8>(g, rows)
     }
 
     /// The prediction and dequantization of the rows `rows` (keys
@@ -982,5 +1113,45 @@ fn unpack16<const W: usize>(words: &[u64], pos: usize, out: &mut [i32], stride: 
         if let Some(x) = row.first_mut() {
             *x = v;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{key_row, tangent};
+    use tcb_core::simd::basis::{hermite, hermite_basis, hermite_basis_derivative};
+
+    /// [`key_row`] plays the curve of the tangents it writes out: at
+    /// random parameters, keys and weights (at most 1), its sum of four
+    /// keys is the hermite of the keys and their tangents (both in f32)
+    /// within a few roundings; at the segment's ends it is the key itself.
+    #[test]
+    fn key_row_is_the_tangents_curve() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut worst = 0.0f32;
+        for _ in 0..20_000 {
+            let p = [next(), next(), next(), next()].map(|v| v as f32);
+            let w = [next(), next(), next(), next()].map(|v| v as f32);
+            let s = (next() * 0.5 + 0.5) as f32;
+            let [before, pa, pb, after] = p;
+            let [in_a, in_b, out_a, out_b] = w;
+            let to = tangent(pa - before, pb - pa, out_a, out_b);
+            let ti = tangent(pb - pa, after - pb, in_a, in_b);
+            for h in [hermite_basis(s), hermite_basis_derivative(s)] {
+                let want = hermite(&h, pa, pb, to, ti);
+                let got = hermite(&key_row(h, w), pa, pb, before, after);
+                worst = worst.max((got - want).abs());
+            }
+        }
+        assert!(worst < 2e-6, "{worst}");
+        let w = [0.5, 0.25, -0.75, 1.0];
+        assert_eq!(key_row([1.0, 0.0, 0.0, 0.0], w), [1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(key_row([0.0, 1.0, 0.0, 0.0], w), [0.0, 1.0, 0.0, 0.0]);
     }
 }
