@@ -12,9 +12,10 @@
 //! each), then per plane of 8 lanes the prediction and dequantization, key
 //! by key, with the predictor in registers, then the rebuilt `w`s. Where
 //! the AVX2 instance runs (`crate::isa`), the first two passes are one:
-//! each key's residuals of a plane come straight from the stream, 32 bits
-//! gathered at each lane's byte, shifted and masked per lane (segments
-//! whose widths are all at most 25 bits; wider ones unpack first), and a
+//! each plane's residuals come straight from the stream, 64 bits gathered
+//! at each lane's byte for as many keys as every lane has in them, then
+//! shifted and masked per lane key by key (segments whose widths are all at
+//! most 25 bits; wider ones unpack first), and a
 //! block's start values and deltas are gathered a plane at a time too
 //! (`PackedKeys::start_gather`). Forward
 //! playback decodes each key once; playing backwards re-decodes from the
@@ -569,13 +570,13 @@ impl PackCache {
             let written = self.block_start(g, &mut pos, keys);
             debug_assert_eq!(written, first);
         }
-        // The AVX2 instance reads each key's residuals of a plane straight
-        // from the stream (a gather of 32 bits from each lane's byte), where
-        // every width has room in them and the segment's last bit lies 32
-        // bits before the stream's end.
+        // The AVX2 instance reads a plane's residuals straight from the
+        // stream (gathers of 64 bits from each lane's byte), where every
+        // width has room in 32 bits and the segment's last bit lies 64 bits
+        // before the stream's end.
         let last = pos + before * (keys - first);
         let gather =
-            crate::isa::avx2() && narrow && last + 32 <= (64 * words.len()).min(i32::MAX as usize);
+            crate::isa::avx2() && narrow && last + 64 <= (64 * words.len()).min(i32::MAX as usize);
         if !gather {
             // Residuals: 16 of each lane of a width above 0 (those past
             // the segment's keys land in spare rows, or in rows no key
@@ -600,7 +601,7 @@ impl PackCache {
             // residuals end at or before `last` (each lane's start is the
             // sum of the widths before it times `keys - first` bits after
             // `pos`, and `last` is `pos` plus the sum over all; lanes
-            // without headers start at `pos` with width 0), which is 32
+            // without headers start at `pos` with width 0), which is 64
             // bits before the stream's end and below i32::MAX; every
             // index of `plane_index` is at most the length of
             // `headed_base` (`compile::packed`), below `headers.entry`'s.
@@ -806,14 +807,18 @@ pub(crate) const GATHER_WIDTH: u32 = 25;
 /// key's residuals of a plane gathered straight from the stream.
 #[cfg(target_arch = "x86_64")]
 mod v3 {
+    use crate::pack::SEGMENT_KEYS;
     use crate::pack::store::{
         Headers, PackedKeys, Plane, block_start_keys, entry_fields, interior_tangents, predict,
         rebuild_rows,
     };
     use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
-        __m256, __m256i, _mm256_add_epi32, _mm256_and_si256, _mm256_i32gather_epi32,
-        _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
+        __m256, __m256i, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32, _mm256_add_epi32,
+        _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128,
+        _mm256_cvtepu32_epi64, _mm256_extracti128_si256, _mm256_i32gather_epi32,
+        _mm256_i64gather_epi64, _mm256_mullo_epi32, _mm256_permute4x64_epi64, _mm256_set1_epi32,
+        _mm256_shuffle_ps, _mm256_srli_epi32, _mm256_srlv_epi32, _mm256_srlv_epi64,
     };
     use tcb_core::simd::w8::{I8, W8};
     use wide::{f32x8, i32x8};
@@ -915,8 +920,8 @@ mod v3 {
     /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
     /// is below the length of `h.entry`, and for every lane the sum of the
     /// widths before it and its own, times `k`, plus `base` is
-    /// at most `64 * g.packed.stream.len() - 32` and below `i32::MAX`
-    /// (each gather reads 4 bytes from the byte of a lane's bit).
+    /// at most `64 * g.packed.stream.len() - 64` and below `i32::MAX`
+    /// (each gather reads 8 bytes from the byte of a lane's bit).
     #[inline(always)]
     #[allow(unsafe_code)]
     pub(super) unsafe fn predict_gathered_here(
@@ -1037,7 +1042,9 @@ mod v3 {
         let np = g.planes;
         let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
         let base = _mm256_set1_epi32(base);
-        let keys = _mm256_set1_epi32((rows.len() / np) as i32);
+        let n = rows.len() / np;
+        let keys = _mm256_set1_epi32(n as i32);
+        let seven = _mm256_set1_epi32(7);
         for &p in &g.stored_planes {
             let p = p as usize;
             // SAFETY: the caller's, every index inside `h.entry`.
@@ -1048,22 +1055,100 @@ mod v3 {
             let (low, bias) = width_lanes(width);
             let code = [trend, low, bias];
             let width = m(width.0);
+            // Keys whose residuals every lane has in the 57 bits after the
+            // first one's byte: one 8-byte read per lane serves them all.
+            let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
+            let width_q = halves(width);
             let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
             let step = block_step(W8(g.step[p].to_array()), W8([factor; 8]));
             let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(start, keys));
-            for row in rows.chunks_exact_mut(np) {
+            let mut chunks = rows.chunks_exact_mut(np);
+            let mut left = n;
+            while left > 0 {
+                let k = per.min(left);
+                left -= k;
+                // Each lane's 64 bits from the byte of its bit, shifted to
+                // it, in two halves of 4 lanes (as u64s).
+                let byte = halves(_mm256_srli_epi32::<3>(bit));
+                let shift = halves(_mm256_and_si256(bit, seven));
                 // SAFETY: every lane's bit is below the bound of
-                // `predict_gathered_here`'s contract, 32 bits before the
-                // end of `bytes`, so each 4-byte read is inside it.
+                // `predict_gathered_here`'s contract, 64 bits before the
+                // end of `bytes`, so each 8-byte read is inside it.
                 #[allow(unsafe_code)]
-                let z = unsafe { bits_at(bytes, bit) };
-                let x = predict(a, b, z, code);
-                (a, b) = (b, x);
-                row[p] = f32x8::new(dequantize_lanes(x, step).0);
-                bit = _mm256_add_epi32(bit, width);
+                let mut words = unsafe { [0, 1].map(|i| read64(bytes, byte[i])) };
+                for (w, s) in words.iter_mut().zip(shift) {
+                    *w = _mm256_srlv_epi64(*w, s);
+                }
+                for row in chunks.by_ref().take(k) {
+                    let z = I8(bytemuck::cast(low_words(words)));
+                    let x = predict(a, b, z, code);
+                    (a, b) = (b, x);
+                    row[p] = f32x8::new(dequantize_lanes(x, step).0);
+                    for (w, s) in words.iter_mut().zip(width_q) {
+                        *w = _mm256_srlv_epi64(*w, s);
+                    }
+                }
+                let k = _mm256_set1_epi32(k as i32);
+                bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
             }
             (x0[p], x1[p]) = (i32x8::new(a.0), i32x8::new(b.0));
         }
+    }
+
+    /// How many residuals of a width (at most 25) 57 bits hold: 64 bits
+    /// read from the byte of the first one's bit hold at least 57 after it.
+    const KEYS_IN_57_BITS: [u8; 32] = {
+        let mut t = [SEGMENT_KEYS as u8; 32];
+        let mut w = 1;
+        while w < 32 {
+            t[w] = (57 / w) as u8;
+            w += 1;
+        }
+        t
+    };
+
+    /// The largest of the 8 lanes of `x` (as u32).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn widest(x: __m256i) -> u32 {
+        let x = _mm_max_epu32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+        let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b01_00_11_10>(x));
+        let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b10_11_00_01>(x));
+        _mm_cvtsi128_si32(x) as u32
+    }
+
+    /// The 8 lanes of `x` as two halves of 4 lanes, each widened to u64.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn halves(x: __m256i) -> [__m256i; 2] {
+        [
+            _mm256_cvtepu32_epi64(_mm256_castsi256_si128(x)),
+            _mm256_cvtepu32_epi64(_mm256_extracti128_si256::<1>(x)),
+        ]
+    }
+
+    /// The low 32 bits of each u64 of two halves, as 8 lanes.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn low_words([lo, hi]: [__m256i; 2]) -> __m256i {
+        // Per 128 bits: lo's two low words, then hi's; then the 64-bit
+        // pairs in lane order.
+        let mixed =
+            _mm256_shuffle_ps::<0b10_00_10_00>(_mm256_castsi256_ps(lo), _mm256_castsi256_ps(hi));
+        _mm256_permute4x64_epi64::<0b11_01_10_00>(_mm256_castps_si256(mixed))
+    }
+
+    /// 8 bytes from `bytes` at each of 4 byte offsets (`at`, as u64).
+    ///
+    /// # Safety
+    ///
+    /// Each offset plus 8 is at most `bytes.len()`.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(unsafe_code)]
+    unsafe fn read64(bytes: &[u8], at: __m256i) -> __m256i {
+        // SAFETY: the caller's: each 8-byte read is inside `bytes`.
+        unsafe { _mm256_i64gather_epi64::<1>(bytes.as_ptr().cast(), at) }
     }
 }
 
