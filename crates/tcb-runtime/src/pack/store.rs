@@ -729,13 +729,19 @@ pub(crate) struct Headers {
     entry: Vec<i32>,
 }
 
-/// A lane's entry in [`Headers::entry`]: its width (at most 31), `order1`
-/// (1 where the prediction order is 1, the last value; 0 for 2, the line
-/// through the last two) and its first bit in the segment (the sum of the
-/// widths before it, below 2^25: `pack::MAX_LANES`).
+/// Lanes' entries in [`Headers::entry`]: each one's width (at most 31),
+/// `order1` (1 where the prediction order is 1, the last value; 0 for 2,
+/// the line through the last two) and its first bit in the segment (the
+/// sum of the widths before it, below 2^25: `pack::MAX_LANES`).
 #[inline(always)]
-fn entry(width: i32, order1: i32, start: i32) -> i32 {
+fn entry(width: i32x8, order1: i32x8, start: i32x8) -> i32x8 {
     width | (order1 << 5) | (start << 6)
+}
+
+/// The 8 bytes of `x`, little-endian, as lanes.
+#[inline(always)]
+fn bytes_to_lanes(x: u64) -> i32x8 {
+    i32x8::new(x.to_le_bytes().map(i32::from))
 }
 
 /// [`entry`] undone in each lane: `[width, trend, start]`, `trend` -1 for
@@ -771,15 +777,12 @@ impl Headers {
             // The sums of the widths up to each byte (at most 248).
             let sums = read.width.wrapping_mul(BYTES);
             let start = sums << 8;
-            let entries: &mut [i32; GROUP] = (&mut self.entry[lanes]).try_into().expect("8 lanes");
-            for (i, e) in entries.iter_mut().enumerate() {
-                let byte = |x: u64| ((x >> (8 * i)) & 0xff) as i32;
-                *e = entry(
-                    byte(read.width),
-                    byte(read.order1),
-                    sum as i32 + byte(start),
-                );
-            }
+            let e = entry(
+                bytes_to_lanes(read.width),
+                bytes_to_lanes(read.order1),
+                i32x8::splat(sum as i32) + bytes_to_lanes(start),
+            );
+            self.entry[lanes].copy_from_slice(&e.to_array());
             sum += (sums >> 56) as usize;
             // A top bit where a width is above GATHER_WIDTH.
             wide |= read.width + (0x80 - 1 - u64::from(GATHER_WIDTH)) * BYTES;
