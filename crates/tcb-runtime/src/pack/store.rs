@@ -501,11 +501,18 @@ impl PackCache {
     /// Decode until keys `lo ..= hi` (at most 4, `hi` in the segment after
     /// `lo`'s at most) have rows: on from the segment decoded last, or
     /// from the start of `lo`'s block.
+    #[inline(always)]
     fn ensure(&mut self, g: &PackedKeys, lo: usize, hi: usize) {
         let to = hi / SEGMENT_KEYS;
-        if self.cur == to && lo >= self.valid {
-            return;
+        if self.cur != to || lo < self.valid {
+            self.decode_to(g, lo, to);
         }
+    }
+
+    /// [`ensure`](Self::ensure)'s decoding, out of line: segments up to
+    /// `to`, from the one after `cur` or from the start of `lo`'s block.
+    #[inline(never)]
+    fn decode_to(&mut self, g: &PackedKeys, lo: usize, to: usize) {
         // A block's first segment needs nothing before it.
         let restart = (lo - lo % g.packed.block) / SEGMENT_KEYS;
         let from = if self.cur < to && self.cur + 1 >= restart {
