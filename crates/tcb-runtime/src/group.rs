@@ -99,7 +99,9 @@ impl Group {
         sample_segment::<true>(self, f, controls, values, velocities);
     }
 
-    /// The rotation planes of the pose (`values`).
+    /// The rotation planes of the pose (`values`). (`sample_segment`
+    /// computes the same range in line: through this function the dense
+    /// kernels' code took 0.2% to 0.5% more instructions.)
     #[inline(always)]
     fn rotation_planes(&self) -> std::ops::Range<usize> {
         let hq_out = self.vec_out + self.vec_blocks;

@@ -235,7 +235,8 @@ fn the_avx2_kernels_give_the_baselines_bits() {
 }
 
 /// The packed decoder's instances: the CMU capture quantized (the AVX2
-/// instance gathers each key's residuals from the stream), and with the
+/// instance gathers the residuals from the stream, 64 bits a lane for
+/// several keys), and with the
 /// root translation's integers alternating between +-(2^24 - 1), whose
 /// residuals are 27 bits wide (too wide for the gather: that segment
 /// unpacks as the baseline does), forward, backward and with seeks.

@@ -124,7 +124,8 @@ fn plays_its_reference(source: &PackSource, block: usize) -> f32 {
     }
     let mut worst = 0.0f32;
     // Forward at 60 fps, then random access (seeks back and across blocks),
-    // then past both ends: the same bits as the f32 clip of the reference.
+    // then past both ends: the f32 clip of the reference's values (above),
+    // and a fresh instance's (a seek) bit for bit.
     let (t0, t1) = clip.time_range().unwrap();
     let mut times: Vec<f64> = (0..)
         .map(|f| t0 + f as f64 / 60.0)
@@ -161,6 +162,12 @@ fn plays_its_reference(source: &PackSource, block: usize) -> f32 {
             rows_and_velocities(&mut a, t, n),
             rows_and_velocities(&mut b, t, n),
         );
+        let seek = rows_and_velocities(&mut Instance::new(clip.clone()).with_velocities(), t, n);
+        let same = ra
+            .iter()
+            .zip(&seek)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "at {t}: forward playback differs from a seek");
         for (i, (x, y)) in ra.iter().zip(&rb).enumerate() {
             if rotation[i] && y.is_finite() {
                 let off = (x - y).abs() / y.abs().max(1.0);

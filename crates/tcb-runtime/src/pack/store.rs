@@ -180,21 +180,29 @@ impl PackedKeys {
         if a == 0 || b + 1 >= self.keys {
             return None;
         }
+        debug_assert_eq!(b, a + 1, "packed groups have no step segments");
         let (np, r) = (self.planes, self.rot_from);
+        // Every key read decoded within the bound: key `a - 1` in segment
+        // `cur`, or in the one before.
+        let bounded =
+            |c: &PackCache| c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded);
         if c.seg_vectors != a {
             c.ensure(self, a - 1, b + 1);
+            // The rows may have moved: the rotations' tangents of `c.seg`
+            // are not what `segment` would read with them.
+            c.seg = usize::MAX;
+            if !bounded(c) {
+                c.seg_vectors = usize::MAX;
+                return None;
+            }
             // The vector planes' tangents (a root's translation: one plane,
             // or none), here in line.
             let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
             let rows = [0, 1, 2, 3].map(|k| &keys[k * np..k * np + r]);
             let (m0, m1) = c.m.split_at_mut(np);
             interior_tangents::<f32x8>(rows, &self.weights, &mut m0[..r], &mut m1[..r]);
-            // The rows may have moved: the rotations' tangents of `c.seg`
-            // are not what `segment` would read with them.
-            (c.seg, c.seg_vectors) = (usize::MAX, a);
-        }
-        // Key `a - 1` in segment `cur`, or in the one before.
-        if !(c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded)) {
+            c.seg_vectors = a;
+        } else if !bounded(c) {
             return None;
         }
         let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
@@ -279,9 +287,11 @@ pub(crate) fn key_row(h: [f32; 4], w: [f32; 4]) -> [f32; 4] {
     .map(|x| x as f32)
 }
 
-/// `|P|^2` of every key that an interior segment's key form reads is at
-/// most this (checked as keys are decoded; the centers at compile time),
-/// and the form plays only where `|p|^2` is above [`KEY_FORM_LOW`]: then
+/// `|P|^2` of every key that an interior segment's key form reads, before
+/// its center, is at most this (checked as keys are decoded), and so is
+/// `|c|^2` of every center (checked at compile time): after the center,
+/// at most about 1.04. The form plays only where `|p|^2` is above
+/// [`KEY_FORM_LOW`]: then
 /// its roundings, and the reference's, move the normalized rotation by a
 /// few 1e-7 (weights at most 1, so that `key_row`'s coefficients sum to
 /// at most 1.6 in magnitude).
@@ -451,7 +461,8 @@ pub(crate) struct PackCache {
     /// [`ROWS`]); while a segment is decoded, a row holds its residuals
     /// (as `i32`) until the prediction replaces them with the key.
     rows: Vec<f32x8>,
-    /// `TO_a` then `TI_b` of the segment `seg`.
+    /// `TO_a` then `TI_b` of the segment `seg` (of `seg_vectors` in the
+    /// vector planes).
     m: Vec<f32x8>,
 }
 
