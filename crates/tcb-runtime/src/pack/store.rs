@@ -182,27 +182,23 @@ impl PackedKeys {
         }
         debug_assert_eq!(b, a + 1, "packed groups have no step segments");
         let (np, r) = (self.planes, self.rot_from);
-        // Every key read decoded within the bound: key `a - 1` in segment
-        // `cur`, or in the one before.
-        let bounded =
-            |c: &PackCache| c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded);
         if c.seg_vectors != a {
             c.ensure(self, a - 1, b + 1);
-            // The rows may have moved: the rotations' tangents of `c.seg`
-            // are not what `segment` would read with them.
-            c.seg = usize::MAX;
-            if !bounded(c) {
-                c.seg_vectors = usize::MAX;
-                return None;
-            }
             // The vector planes' tangents (a root's translation: one plane,
             // or none), here in line.
             let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
             let rows = [0, 1, 2, 3].map(|k| &keys[k * np..k * np + r]);
             let (m0, m1) = c.m.split_at_mut(np);
             interior_tangents::<f32x8>(rows, &self.weights, &mut m0[..r], &mut m1[..r]);
-            c.seg_vectors = a;
-        } else if !bounded(c) {
+            // The rows may have moved: the rotations' tangents of `c.seg`
+            // are not what `segment` would read with them.
+            (c.seg, c.seg_vectors) = (usize::MAX, a);
+        }
+        // Every key read decoded within the bound: key `a - 1` in segment
+        // `cur`, or in the one before. (Checked after the vector planes'
+        // tangents, which `segment` then computes again: checked before
+        // them, the common path took 3% more instructions.)
+        if !(c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded)) {
             return None;
         }
         let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
