@@ -833,9 +833,11 @@ mod v3 {
     use std::arch::x86_64::{
         __m256, __m256i, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32, _mm256_add_epi32,
         _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128,
-        _mm256_cvtepu32_epi64, _mm256_extracti128_si256, _mm256_i32gather_epi32,
-        _mm256_i64gather_epi64, _mm256_mullo_epi32, _mm256_permute4x64_epi64, _mm256_set1_epi32,
-        _mm256_shuffle_ps, _mm256_srli_epi32, _mm256_srlv_epi32, _mm256_srlv_epi64,
+        _mm256_cvtepi32_ps, _mm256_extracti128_si256, _mm256_i32gather_epi32,
+        _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_set1_epi32,
+        _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps, _mm256_srli_epi32,
+        _mm256_srlv_epi32, _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32,
+        _mm256_unpacklo_epi32,
     };
     use tcb_core::simd::w8::{I8, W8};
     use wide::{f32x8, i32x8};
@@ -1061,55 +1063,156 @@ mod v3 {
         let base = _mm256_set1_epi32(base);
         let n = rows.len() / np;
         let keys = _mm256_set1_epi32(n as i32);
-        let seven = _mm256_set1_epi32(7);
-        for &p in &g.stored_planes {
-            let p = p as usize;
+        // A plane's coding, first bit and first 64 bits per lane. The
+        // next plane's are read before the current plane's keys run, so
+        // that its gathers (the entries, then the residuals at the bits
+        // they give) wait behind work rather than ahead of it.
+        let setup = |p: usize| {
             // SAFETY: the caller's, every index inside `h.entry`.
             #[allow(unsafe_code)]
             let e = unsafe { _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p])) };
             let [width, trend, start] = entry_fields(I8(bytemuck::cast(e)));
-            let start = m(start.0);
+            let bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(start.0), keys));
+            // SAFETY: as below.
+            #[allow(unsafe_code)]
+            let words = unsafe { read_shifted(bytes, bit) };
+            (width, trend, bit, words)
+        };
+        let planes = &g.stored_planes;
+        let mut next = planes.first().map(|&p| setup(p as usize));
+        for (i, &p) in planes.iter().enumerate() {
+            let p = p as usize;
+            let Some((width, trend, mut bit, mut words)) = next else {
+                break;
+            };
+            next = planes.get(i + 1).map(|&p| setup(p as usize));
             let (low, bias) = width_lanes(width);
-            let code = [trend, low, bias];
+            let code = [trend, low, bias].map(|x| V(m(x.0)));
             let width = m(width.0);
             // Keys whose residuals every lane has in the 57 bits after the
             // first one's byte: one 8-byte read per lane serves them all.
             let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
             let width_q = halves(width);
-            let (mut a, mut b) = (I8(x0[p].to_array()), I8(x1[p].to_array()));
-            let step = block_step(W8(g.step[p].to_array()), W8([factor; 8]));
-            let mut bit = _mm256_add_epi32(base, _mm256_mullo_epi32(start, keys));
-            let mut chunks = rows.chunks_exact_mut(np);
+            let (mut a, mut b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
+            let step = block_step(F(bytemuck::cast(g.step[p])), F(_mm256_set1_ps(factor)));
+            // Row `r`'s vector of plane `p`: `rows[r * np + p]`.
+            assert!(p < np, "a stored plane");
+            let mut at = p;
             let mut left = n;
-            while left > 0 {
+            // The next key, from the low bits of `words`, then `words`
+            // past it.
+            let key = |words: &mut [__m256i; 2], a: V, b: V| {
+                let x = predict(a, b, V(low_words(*words)), code);
+                for (w, s) in words.iter_mut().zip(width_q) {
+                    *w = _mm256_srlv_epi64(*w, s);
+                }
+                x
+            };
+            loop {
                 let k = per.min(left);
                 left -= k;
-                // Each lane's 64 bits from the byte of its bit, shifted to
-                // it, in two halves of 4 lanes (as u64s).
-                let byte = halves(_mm256_srli_epi32::<3>(bit));
-                let shift = halves(_mm256_and_si256(bit, seven));
+                // Two keys a turn, so that the predictor's last two keys
+                // stay where they are.
+                for _ in 0..k / 2 {
+                    let x = key(&mut words, a, b);
+                    let y = key(&mut words, b, x);
+                    // SAFETY: `at` is `p` plus `np` times a row below
+                    // `n` (the rows' count), `p < np`: inside `rows`.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        *rows.get_unchecked_mut(at) = bytemuck::cast(dequantize_lanes(x, step).0);
+                        *rows.get_unchecked_mut(at + np) =
+                            bytemuck::cast(dequantize_lanes(y, step).0);
+                    }
+                    (a, b, at) = (x, y, at + 2 * np);
+                }
+                if k % 2 == 1 {
+                    let x = key(&mut words, a, b);
+                    // SAFETY: as above.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        *rows.get_unchecked_mut(at) = bytemuck::cast(dequantize_lanes(x, step).0);
+                    }
+                    (a, b, at) = (b, x, at + np);
+                }
+                if left == 0 {
+                    break;
+                }
+                let k = _mm256_set1_epi32(k as i32);
+                bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
                 // SAFETY: every lane's bit is below the bound of
                 // `predict_gathered_here`'s contract, 64 bits before the
                 // end of `bytes`, so each 8-byte read is inside it.
                 #[allow(unsafe_code)]
-                let mut words = unsafe { [0, 1].map(|i| read64(bytes, byte[i])) };
-                for (w, s) in words.iter_mut().zip(shift) {
-                    *w = _mm256_srlv_epi64(*w, s);
+                {
+                    words = unsafe { read_shifted(bytes, bit) };
                 }
-                for row in chunks.by_ref().take(k) {
-                    let z = I8(bytemuck::cast(low_words(words)));
-                    let x = predict(a, b, z, code);
-                    (a, b) = (b, x);
-                    row[p] = f32x8::new(dequantize_lanes(x, step).0);
-                    for (w, s) in words.iter_mut().zip(width_q) {
-                        *w = _mm256_srlv_epi64(*w, s);
-                    }
-                }
-                let k = _mm256_set1_epi32(k as i32);
-                bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
             }
-            (x0[p], x1[p]) = (i32x8::new(a.0), i32x8::new(b.0));
+            (x0[p], x1[p]) = (bytemuck::cast(a.0), bytemuck::cast(b.0));
         }
+    }
+
+    /// Eight `i32` lanes in an AVX register, for [`predict`] and
+    /// `dequantize_lanes` in the decoder's loop over keys: `I8`'s arrays
+    /// there leave LLVM rebuilding loop-invariant vectors lane by lane.
+    /// Each operation is the one AVX2 instruction of `I8`'s (wrapping).
+    #[derive(Clone, Copy)]
+    struct V(__m256i);
+
+    /// Eight `f32` lanes in an AVX register, `V`'s floats.
+    #[derive(Clone, Copy)]
+    struct F(__m256);
+
+    /// `$t`'s operator `$tr` as the AVX2 intrinsic `$f`. The intrinsics
+    /// need AVX2, which every caller (inlined into `predict_gathered`)
+    /// has.
+    macro_rules! avx_op {
+        ($t:ident, $tr:ident, $m:ident, $f:ident) => {
+            impl std::ops::$tr for $t {
+                type Output = $t;
+                #[inline(always)]
+                fn $m(self, o: $t) -> $t {
+                    // SAFETY: only used inside `predict_gathered`, which
+                    // runs where AVX2 does.
+                    #[allow(unsafe_code)]
+                    $t(unsafe { $f(self.0, o.0) })
+                }
+            }
+        };
+    }
+    avx_op!(V, Add, add, _mm256_add_epi32);
+    avx_op!(V, Sub, sub, _mm256_sub_epi32);
+    avx_op!(V, BitAnd, bitand, _mm256_and_si256);
+    avx_op!(F, Mul, mul, _mm256_mul_ps);
+
+    impl crate::pack::IntLanes for V {
+        type Float = F;
+        #[inline(always)]
+        fn to_float(self) -> F {
+            // SAFETY: as `avx_op`'s.
+            #[allow(unsafe_code)]
+            F(unsafe { _mm256_cvtepi32_ps(self.0) })
+        }
+    }
+
+    /// Each lane's 64 bits from the byte of its bit `bit`, shifted to it,
+    /// in two halves of 4 lanes (as u64s).
+    ///
+    /// # Safety
+    ///
+    /// Each lane's `bit / 8 + 8` is at most `bytes.len()`.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(unsafe_code)]
+    unsafe fn read_shifted(bytes: &[u8], bit: __m256i) -> [__m256i; 2] {
+        let byte = halves(_mm256_srli_epi32::<3>(bit));
+        let shift = halves(_mm256_and_si256(bit, _mm256_set1_epi32(7)));
+        // SAFETY: the caller's.
+        let words = unsafe { [read64(bytes, byte[0]), read64(bytes, byte[1])] };
+        [
+            _mm256_srlv_epi64(words[0], shift[0]),
+            _mm256_srlv_epi64(words[1], shift[1]),
+        ]
     }
 
     /// How many residuals of a width (at most 25) 57 bits hold: 64 bits
@@ -1134,25 +1237,27 @@ mod v3 {
         _mm_cvtsi128_si32(x) as u32
     }
 
-    /// The 8 lanes of `x` as two halves of 4 lanes, each widened to u64.
+    /// The 8 lanes of `x` as two halves of 4 lanes, each widened to u64:
+    /// lanes 0, 1, 4 and 5, then 2, 3, 6 and 7 (the order in which
+    /// [`low_words`] takes them back with one shuffle).
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn halves(x: __m256i) -> [__m256i; 2] {
+        let zero = _mm256_setzero_si256();
         [
-            _mm256_cvtepu32_epi64(_mm256_castsi256_si128(x)),
-            _mm256_cvtepu32_epi64(_mm256_extracti128_si256::<1>(x)),
+            _mm256_unpacklo_epi32(x, zero),
+            _mm256_unpackhi_epi32(x, zero),
         ]
     }
 
-    /// The low 32 bits of each u64 of two halves, as 8 lanes.
+    /// The low 32 bits of each u64 of two [`halves`], as 8 lanes.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn low_words([lo, hi]: [__m256i; 2]) -> __m256i {
-        // Per 128 bits: lo's two low words, then hi's; then the 64-bit
-        // pairs in lane order.
+        // Per 128 bits: lo's two low words, then hi's.
         let mixed =
             _mm256_shuffle_ps::<0b10_00_10_00>(_mm256_castsi256_ps(lo), _mm256_castsi256_ps(hi));
-        _mm256_permute4x64_epi64::<0b11_01_10_00>(_mm256_castps_si256(mixed))
+        _mm256_castps_si256(mixed)
     }
 
     /// 8 bytes from `bytes` at each of 4 byte offsets (`at`, as u64).
