@@ -329,16 +329,22 @@ fn interior_tangents<L: Plane>(
     }
 }
 
-/// The key predicted from the last two (`a`, then `b`) and the residual `z`
-/// as stored (its low bits, whatever lies above them), for a plane's
-/// coding `[trend, low, bias]`: `trend` from the order, `low` and `bias`
-/// from the width (`super::width_lanes`).
+/// The predictor one key on: from the last key `x`, its step `d` (`x`
+/// minus the key before it) and the residual `z` as stored (its low bits,
+/// whatever lies above them), for a plane's coding `[trend, low, bias]`
+/// (`trend` from the order, `low` and `bias` from the width,
+/// `super::width_lanes`), the next key and its step. Order 2 (`trend` -1)
+/// predicts the line through the last two keys, the last step again;
+/// order 1 (`trend` 0) the last key. Wrapping arithmetic: the key is
+/// `x + (d & trend) + residual` whatever the grouping, and carrying the
+/// step makes each key one addition after the last.
 #[inline(always)]
-fn predict<I>(a: I, b: I, z: I, [trend, low, bias]: [I; 3]) -> I
+fn predict<I>(x: I, d: I, z: I, [trend, low, bias]: [I; 3]) -> (I, I)
 where
     I: Copy + Add<Output = I> + Sub<Output = I> + BitAnd<Output = I>,
 {
-    b + ((b - a) & trend) + ((z & low) - bias)
+    let d = (d & trend) + ((z & low) - bias);
+    (x + d, d)
 }
 
 /// A block's first two keys (the predictor's state after them) from its
@@ -628,18 +634,18 @@ impl PackCache {
         if !gather {
             for &p in &g.stored_planes {
                 let p = p as usize;
-                let (mut a, mut b) = (self.x0[p], self.x1[p]);
+                // The last key and its step.
+                let (mut x, mut d) = (self.x1[p], self.x1[p] - self.x0[p]);
                 let c = &self.coding[p];
                 let (low, bias) = super::width_lanes(i32x8::from(c.width));
                 let coding = [i32x8::from(c.trend), low, bias];
                 let step = block_step(g.step[p], f32x8::splat(self.factor));
                 for row in rows.chunks_exact_mut(np) {
                     let v = &mut row[p];
-                    let x = predict(a, b, bytemuck::cast(*v), coding);
-                    (a, b) = (b, x);
+                    (x, d) = predict(x, d, bytemuck::cast(*v), coding);
                     *v = super::dequantize_lanes(x, step);
                 }
-                (self.x0[p], self.x1[p]) = (a, b);
+                (self.x0[p], self.x1[p]) = (x - d, x);
             }
         }
         self.rebuild(g, first..keys);
@@ -1093,47 +1099,29 @@ mod v3 {
             // first one's byte: one 8-byte read per lane serves them all.
             let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
             let width_q = halves(width);
-            let (mut a, mut b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
+            // The last key and its step.
+            let (a, b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
+            let (mut x, mut d) = (b, b - a);
             let step = block_step(F(bytemuck::cast(g.step[p])), F(_mm256_set1_ps(factor)));
             // Row `r`'s vector of plane `p`: `rows[r * np + p]`.
             assert!(p < np, "a stored plane");
             let mut at = p;
             let mut left = n;
-            // The next key, from the low bits of `words`, then `words`
-            // past it.
-            let key = |words: &mut [__m256i; 2], a: V, b: V| {
-                let x = predict(a, b, V(low_words(*words)), code);
-                for (w, s) in words.iter_mut().zip(width_q) {
-                    *w = _mm256_srlv_epi64(*w, s);
-                }
-                x
-            };
             loop {
                 let k = per.min(left);
                 left -= k;
-                // Two keys a turn, so that the predictor's last two keys
-                // stay where they are.
-                for _ in 0..k / 2 {
-                    let x = key(&mut words, a, b);
-                    let y = key(&mut words, b, x);
+                for _ in 0..k {
+                    (x, d) = predict(x, d, V(low_words(words)), code);
+                    for (w, s) in words.iter_mut().zip(width_q) {
+                        *w = _mm256_srlv_epi64(*w, s);
+                    }
                     // SAFETY: `at` is `p` plus `np` times a row below
                     // `n` (the rows' count), `p < np`: inside `rows`.
                     #[allow(unsafe_code)]
                     unsafe {
                         *rows.get_unchecked_mut(at) = bytemuck::cast(dequantize_lanes(x, step).0);
-                        *rows.get_unchecked_mut(at + np) =
-                            bytemuck::cast(dequantize_lanes(y, step).0);
                     }
-                    (a, b, at) = (x, y, at + 2 * np);
-                }
-                if k % 2 == 1 {
-                    let x = key(&mut words, a, b);
-                    // SAFETY: as above.
-                    #[allow(unsafe_code)]
-                    unsafe {
-                        *rows.get_unchecked_mut(at) = bytemuck::cast(dequantize_lanes(x, step).0);
-                    }
-                    (a, b, at) = (b, x, at + np);
+                    at += np;
                 }
                 if left == 0 {
                     break;
@@ -1148,7 +1136,7 @@ mod v3 {
                     words = unsafe { read_shifted(bytes, bit) };
                 }
             }
-            (x0[p], x1[p]) = (bytemuck::cast(a.0), bytemuck::cast(b.0));
+            (x0[p], x1[p]) = (bytemuck::cast((x - d).0), bytemuck::cast(x.0));
         }
     }
 
