@@ -48,7 +48,7 @@ use super::{
     window,
 };
 use crate::segment::Segment;
-use std::ops::{Add, BitAnd, Sub};
+use std::ops::{Add, BitAnd, BitOr, Sub};
 use std::sync::Arc;
 use tcb_core::simd::basis::Real;
 use tcb_core::simd::lane::{Lane, Mask};
@@ -581,10 +581,10 @@ impl PackCache {
         let read = if crate::isa::avx2() {
             v3::headers_here(&mut self.headers, words, pos, g.headed.len())
         } else {
-            self.headers.read(words, pos, g.headed.len())
+            self.headers.read::<i32x8>(words, pos, g.headed.len())
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let read = self.headers.read(words, pos, g.headed.len());
+        let read = self.headers.read::<i32x8>(words, pos, g.headed.len());
         (pos, before, narrow) = read;
         if block {
             let written = self.block_start(g, &mut pos, keys);
@@ -752,16 +752,41 @@ pub(crate) struct Headers {
 /// Lanes' entries in [`Headers::entry`]: each one's width (at most 31),
 /// `order1` (1 where the prediction order is 1, the last value; 0 for 2,
 /// the line through the last two) and its first bit in the segment (the
-/// sum of the widths before it, below 2^25: `pack::MAX_LANES`).
+/// sum of the widths before it, below 2^25: `pack::MAX_LANES`), from the
+/// bytes of a header group ([`header_group`]) and the sum of the widths
+/// of the groups before.
 #[inline(always)]
-fn entry(width: i32x8, order1: i32x8, start: i32x8) -> i32x8 {
-    width | (order1 << 5) | (start << 6)
+fn entry<L: EntryLanes>(width: u64, order1: u64, start: u64, sum: i32) -> L {
+    L::bytes(width) | L::bytes(order1).shl::<5>() | (L::splat(sum) + L::bytes(start)).shl::<6>()
 }
 
-/// The 8 bytes of `x`, little-endian, as lanes.
-#[inline(always)]
-fn bytes_to_lanes(x: u64) -> i32x8 {
-    i32x8::new(x.to_le_bytes().map(i32::from))
+/// Eight `i32` lanes [`entry`] computes in: `i32x8`, or the AVX2
+/// instance's registers.
+pub(crate) trait EntryLanes: Copy + Add<Output = Self> + BitOr<Output = Self> {
+    /// The 8 bytes of `x`, little-endian, as lanes.
+    fn bytes(x: u64) -> Self;
+    fn splat(x: i32) -> Self;
+    fn shl<const N: i32>(self) -> Self;
+    fn to_array(self) -> [i32; 8];
+}
+
+impl EntryLanes for i32x8 {
+    #[inline(always)]
+    fn bytes(x: u64) -> Self {
+        i32x8::new(x.to_le_bytes().map(i32::from))
+    }
+    #[inline(always)]
+    fn splat(x: i32) -> Self {
+        i32x8::splat(x)
+    }
+    #[inline(always)]
+    fn shl<const N: i32>(self) -> Self {
+        self << N
+    }
+    #[inline(always)]
+    fn to_array(self) -> [i32; 8] {
+        i32x8::to_array(self)
+    }
 }
 
 /// [`entry`] undone in each lane: `[width, trend, start]`, `trend` -1 for
@@ -781,7 +806,12 @@ impl Headers {
     /// them, the sum of the widths, and whether each is at most
     /// [`GATHER_WIDTH`].
     #[inline(always)]
-    fn read(&mut self, words: &[u64], pos: usize, headed: usize) -> (usize, usize, bool) {
+    fn read<L: EntryLanes>(
+        &mut self,
+        words: &[u64],
+        pos: usize,
+        headed: usize,
+    ) -> (usize, usize, bool) {
         let (mut sum, mut wide) = (0usize, 0u64);
         // The groups' fixed parts, then the widths coded whole.
         let mut tail = pos + 3 * headed;
@@ -797,11 +827,7 @@ impl Headers {
             // The sums of the widths up to each byte (at most 248).
             let sums = read.width.wrapping_mul(BYTES);
             let start = sums << 8;
-            let e = entry(
-                bytes_to_lanes(read.width),
-                bytes_to_lanes(read.order1),
-                i32x8::splat(sum as i32) + bytes_to_lanes(start),
-            );
+            let e: L = entry(read.width, read.order1, start, sum as i32);
             self.entry[lanes].copy_from_slice(&e.to_array());
             sum += (sums >> 56) as usize;
             // A top bit where a width is above GATHER_WIDTH.
@@ -837,13 +863,13 @@ mod v3 {
     };
     use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
-        __m256, __m256i, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32, _mm256_add_epi32,
-        _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_castsi256_si128,
-        _mm256_cvtepi32_ps, _mm256_extracti128_si256, _mm256_i32gather_epi32,
-        _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_set1_epi32,
-        _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps, _mm256_srli_epi32,
-        _mm256_srlv_epi32, _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32,
-        _mm256_unpacklo_epi32,
+        __m256, __m256i, _mm_cvtsi64_si128, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32,
+        _mm256_add_epi32, _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps,
+        _mm256_castsi256_si128, _mm256_cvtepi32_ps, _mm256_cvtepu8_epi32, _mm256_extracti128_si256,
+        _mm256_i32gather_epi32, _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32,
+        _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256,
+        _mm256_shuffle_ps, _mm256_slli_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
+        _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
     };
     use tcb_core::simd::w8::{I8, W8};
     use wide::{f32x8, i32x8};
@@ -916,7 +942,7 @@ mod v3 {
 
     #[target_feature(enable = "avx2,fma")]
     fn headers(h: &mut Headers, words: &[u64], pos: usize, headed: usize) -> (usize, usize, bool) {
-        h.read(words, pos, headed)
+        h.read::<V>(words, pos, headed)
     }
 
     /// [`rebuild_rows`] in AVX2.
@@ -1171,7 +1197,33 @@ mod v3 {
     avx_op!(V, Add, add, _mm256_add_epi32);
     avx_op!(V, Sub, sub, _mm256_sub_epi32);
     avx_op!(V, BitAnd, bitand, _mm256_and_si256);
+    avx_op!(V, BitOr, bitor, _mm256_or_si256);
     avx_op!(F, Mul, mul, _mm256_mul_ps);
+
+    impl super::EntryLanes for V {
+        #[inline(always)]
+        fn bytes(x: u64) -> V {
+            // SAFETY: as `avx_op`'s.
+            #[allow(unsafe_code)]
+            V(unsafe { _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x as i64)) })
+        }
+        #[inline(always)]
+        fn splat(x: i32) -> V {
+            // SAFETY: as `avx_op`'s.
+            #[allow(unsafe_code)]
+            V(unsafe { _mm256_set1_epi32(x) })
+        }
+        #[inline(always)]
+        fn shl<const N: i32>(self) -> V {
+            // SAFETY: as `avx_op`'s.
+            #[allow(unsafe_code)]
+            V(unsafe { _mm256_slli_epi32::<N>(self.0) })
+        }
+        #[inline(always)]
+        fn to_array(self) -> [i32; 8] {
+            bytemuck::cast(self.0)
+        }
+    }
 
     impl crate::pack::IntLanes for V {
         type Float = F;
