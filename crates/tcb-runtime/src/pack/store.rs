@@ -187,7 +187,7 @@ impl PackedKeys {
             // The vector planes' tangents (a root's translation: one plane,
             // or none), here in line.
             let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
-            let rows = [0, 1, 2, 3].map(|k| &keys[k * np..k * np + r]);
+            let rows = four_rows(keys, np, 0..r);
             let (m0, m1) = c.m.split_at_mut(np);
             interior_tangents::<f32x8>(rows, &self.weights, &mut m0[..r], &mut m1[..r]);
             // The rows may have moved: the rotations' tangents of `c.seg`
@@ -228,7 +228,7 @@ impl PackedKeys {
             // Both (all but the end segments): the chord P_b - P_a once,
             // from the rows of keys `a - 1 ..= b + 1`.
             let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
-            let rows = [0, 1, 2, 3].map(|k| &keys[k * np..(k + 1) * np]);
+            let rows = four_rows(keys, np, 0..np);
             let (m0, m1) = c.m.split_at_mut(np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
@@ -492,6 +492,20 @@ impl PackedKeys {
             m: vec![f32x8::ZERO; 2 * np],
         }
     }
+}
+
+/// Planes `planes` of each of the four rows of `keys` (`np` vectors a
+/// row). Written out: `[0, 1, 2, 3].map(..)` was not always inlined, and
+/// then cost a call and a loop a frame.
+#[inline(always)]
+fn four_rows(keys: &[f32x8], np: usize, planes: std::ops::Range<usize>) -> [&[f32x8]; 4] {
+    let (s, e) = (planes.start, planes.end);
+    [
+        &keys[s..e],
+        &keys[np + s..np + e],
+        &keys[2 * np + s..2 * np + e],
+        &keys[3 * np + s..3 * np + e],
+    ]
 }
 
 /// The rows of keys `k .. k + count` in a cache's `rows` (`PackCache::rows`,
