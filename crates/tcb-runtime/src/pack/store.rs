@@ -878,12 +878,13 @@ mod v3 {
     use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
     use std::arch::x86_64::{
         __m256, __m256i, _mm_cvtsi64_si128, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32,
-        _mm256_add_epi32, _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps,
-        _mm256_castsi256_si128, _mm256_cvtepi32_ps, _mm256_cvtepu8_epi32, _mm256_extracti128_si256,
-        _mm256_i32gather_epi32, _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32,
-        _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256,
-        _mm256_shuffle_ps, _mm256_slli_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
-        _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
+        _mm256_add_epi32, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps_si256,
+        _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cvtepi32_ps, _mm256_cvtepu8_epi32,
+        _mm256_extracti128_si256, _mm256_i32gather_epi32, _mm256_i64gather_epi64, _mm256_mul_ps,
+        _mm256_mullo_epi32, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
+        _mm256_setzero_si256, _mm256_shuffle_ps, _mm256_slli_epi32, _mm256_srli_epi32,
+        _mm256_srlv_epi32, _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32,
+        _mm256_unpacklo_epi32,
     };
     use tcb_core::simd::w8::{I8, W8};
     use wide::{f32x8, i32x8};
@@ -906,13 +907,17 @@ mod v3 {
         }
         #[inline(always)]
         fn blend(mask: &f32x8, a: Self, b: Self) -> Self {
-            let m: [u32; 8] = bytemuck::cast(*mask);
-            let (a, b): ([u32; 8], [u32; 8]) = (bytemuck::cast(a.0), bytemuck::cast(b.0));
-            let mut o = [0u32; 8];
-            for i in 0..8 {
-                o[i] = (m[i] & a[i]) | (!m[i] & b[i]);
-            }
-            W8(bytemuck::cast(o))
+            // The masks are all ones or all zeros per lane, so the sign
+            // bit `vblendvps` reads decides as the whole mask would.
+            let (m, a, b): (__m256, __m256, __m256) = (
+                bytemuck::cast(*mask),
+                bytemuck::cast(a.0),
+                bytemuck::cast(b.0),
+            );
+            // SAFETY: `W8`'s `Plane` runs only inside this module's AVX2
+            // functions.
+            #[allow(unsafe_code)]
+            W8(bytemuck::cast(unsafe { _mm256_blendv_ps(b, a, m) }))
         }
     }
 
