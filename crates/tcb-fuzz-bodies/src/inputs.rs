@@ -32,6 +32,36 @@ pub(crate) fn assert_rotation(got: &[f32], want: &[f32], name: &str, t: f64) {
     );
 }
 
+/// A rotation's velocity (`[value, velocity]` of the runtime and of the
+/// reference) against the reference's, as [`assert_rotation`] holds its
+/// value: the same sign (a quaternion and its negation are one rotation),
+/// within 1e-4 of the larger of 1, the velocity's largest component and
+/// `rate`, the key rate times the playback speed (per second of play).
+/// An error of the contract's size in the keys' rows moves a velocity by
+/// about `rate` times it.
+pub(crate) fn assert_rotation_velocity(
+    [got, got_v]: [&[f32]; 2],
+    [want, want_v]: [&[f32]; 2],
+    rate: f64,
+    name: &str,
+    t: f64,
+) {
+    if want.iter().chain(want_v).any(|x| !x.is_finite()) || !rate.is_finite() {
+        return;
+    }
+    let dot: f32 = got.iter().zip(want).map(|(g, w)| g * w).sum();
+    let sign = if dot < 0.0 { -1.0 } else { 1.0 };
+    let largest = want_v.iter().fold(1.0f64, |m, w| m.max(f64::from(w.abs())));
+    let allowed = 1e-4 * largest.max(rate);
+    assert!(
+        got_v
+            .iter()
+            .zip(want_v)
+            .all(|(g, w)| f64::from(g * sign - w).abs() <= allowed),
+        "{name} at {t}: runtime velocity {got_v:?}, reference {want_v:?} (allowed {allowed:e})"
+    );
+}
+
 /// Mostly nice numbers (where the interesting paths are), sometimes any f32.
 pub(crate) fn arbitrary_f32(u: &mut Unstructured) -> arbitrary::Result<f32> {
     Ok(match u.int_in_range(0..=7u8)? {

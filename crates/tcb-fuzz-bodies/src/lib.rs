@@ -761,7 +761,14 @@ fn play_packed(clip: tcb_runtime::Clip, reference: &tcb_core::SourceClip, u: &mu
             let r = c..c + slot.kind().dim();
             c = r.end;
             if slot.kind() == TrackKind::Quat {
-                assert_rotation(&got.0[r.clone()], &want.0[r], slot.name(), t);
+                assert_rotation(&got.0[r.clone()], &want.0[r.clone()], slot.name(), t);
+                assert_rotation_velocity(
+                    [&got.0[r.clone()], &got.1[r.clone()]],
+                    [&want.0[r.clone()], &want.1[r]],
+                    speed.abs() / interval,
+                    slot.name(),
+                    t,
+                );
                 continue;
             }
             for (what, g, w) in [("value", &got.0, &want.0), ("velocity", &got.1, &want.1)] {
