@@ -1197,16 +1197,21 @@ mod v3 {
     struct F(__m256);
 
     /// `$t`'s operator `$tr` as the AVX2 intrinsic `$f`. The intrinsics
-    /// need AVX2, which every caller (inlined into `predict_gathered`)
-    /// has.
+    /// need AVX2, which every caller has: a `V` or an `F` (private types
+    /// with private fields) is made and used only inside this module's
+    /// `#[target_feature(enable = "avx2,fma")]` functions,
+    /// `predict_gathered` and `headers` (through `Headers::read::<V>`),
+    /// into which these methods inline. Keep it so: the methods are safe
+    /// to call, so a new caller outside such a function would compile and
+    /// run AVX2 instructions on any CPU.
     macro_rules! avx_op {
         ($t:ident, $tr:ident, $m:ident, $f:ident) => {
             impl std::ops::$tr for $t {
                 type Output = $t;
                 #[inline(always)]
                 fn $m(self, o: $t) -> $t {
-                    // SAFETY: only used inside `predict_gathered`, which
-                    // runs where AVX2 does.
+                    // SAFETY: only used inside `predict_gathered` and
+                    // `headers`, which run where AVX2 does (above).
                     #[allow(unsafe_code)]
                     $t(unsafe { $f(self.0, o.0) })
                 }
