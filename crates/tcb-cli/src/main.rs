@@ -425,6 +425,25 @@ fn extension(path: &std::path::Path) -> String {
         .unwrap_or_default()
 }
 
+/// Refuses, before anything is read, a clip path that the commands which
+/// also play packed clips cannot read: a directory, or a name of no type
+/// they know (the message lists `.tcbc` with `tcb_io`'s types).
+fn playable(path: &std::path::Path) -> Result<(), BoxError> {
+    if path.is_dir() {
+        return Err(format!("{}: a directory, not a clip file", path.display()).into());
+    }
+    let what = match extension(path).as_str() {
+        "json" | "bvh" | "gltf" | "glb" | "tcbc" => return Ok(()),
+        "" => "no file extension to tell its type".to_string(),
+        ext => format!("unknown file type '.{ext}'"),
+    };
+    Err(format!(
+        "{}: {what} (expected .json, .bvh, .gltf, .glb or .tcbc)",
+        path.display()
+    )
+    .into())
+}
+
 /// `path` loaded (BVH, glTF or clip JSON) with the import options of
 /// `rotation` and `animation`, its warnings printed.
 fn load_input(
@@ -471,6 +490,9 @@ fn import(args: &ImportArgs) -> Result<(), BoxError> {
         )
         .into());
     }
+    if extension(&args.output) != "json" {
+        return Err(format!("{}: the output must end in .json", args.output.display()).into());
+    }
     let loaded = load_input(&args.file, args.rotation, args.animation.as_ref())?;
     tcb_io::write_clip_doc(&loaded.doc, &args.output)?;
     let keys: usize = loaded.doc.tracks.iter().map(|t| t.times.len()).sum();
@@ -484,6 +506,7 @@ fn import(args: &ImportArgs) -> Result<(), BoxError> {
 }
 
 fn export(args: &ExportArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     if !(args.max_error > 0.0 && args.max_error.is_finite()) {
         return Err(format!(
             "--max-error must be a positive number, got {}",
@@ -892,6 +915,7 @@ fn mb(bytes: usize) -> String {
 }
 
 fn info(args: &InfoArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     if extension(&args.clip) == "tcbc" {
         return info_tcbc(args);
     }
@@ -1173,6 +1197,7 @@ fn write_load(
 }
 
 fn bench(args: &BenchArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 100_000.0) {
         return Err(format!("--fps {}: must be in (0, 100000]", args.fps).into());
     }
@@ -1246,6 +1271,7 @@ fn bench(args: &BenchArgs) -> Result<(), BoxError> {
 }
 
 fn plot(args: &PlotArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     if extension(&args.output) != "svg" {
         return Err(format!("{}: the output must end in .svg", args.output.display()).into());
     }
@@ -1304,6 +1330,7 @@ fn plot(args: &PlotArgs) -> Result<(), BoxError> {
 }
 
 fn view_page(args: &ViewArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     let file = args.clip.file_name().map_or_else(
         || args.clip.display().to_string(),
         |f| f.to_string_lossy().into_owned(),
@@ -1369,6 +1396,7 @@ fn figures(args: &FiguresArgs) -> Result<(), BoxError> {
 }
 
 fn sample(args: &SampleArgs) -> Result<(), BoxError> {
+    playable(&args.clip)?;
     let (clip, packed) = if extension(&args.clip) == "tcbc" {
         let (clip, runtime) = load_tcbc(&args.clip)?;
         (clip, Some(runtime))

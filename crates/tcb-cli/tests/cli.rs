@@ -493,6 +493,33 @@ fn every_bad_input_is_one_clear_line_and_no_csv() {
     }
 }
 
+/// The commands that play `.tcbc` too name it among the types they read,
+/// and say so of a directory.
+#[test]
+fn unknown_inputs_name_every_type_the_command_reads() {
+    let dir = scratch("cli-unknown-input");
+    let txt = dir.join("notes.txt");
+    std::fs::write(&txt, "not a clip").unwrap();
+    let folder = dir.join("clips");
+    std::fs::create_dir_all(&folder).unwrap();
+    for args in [
+        vec!["sample", txt.to_str().unwrap(), "--at", "1"],
+        vec!["info", txt.to_str().unwrap()],
+        vec!["plot", txt.to_str().unwrap(), "-o", "never.svg"],
+    ] {
+        let o = tcb(&args);
+        assert!(!o.status.success(), "{args:?}: accepted");
+        stderr_has(
+            &o,
+            "notes.txt: unknown file type '.txt' (expected .json, .bvh, .gltf, .glb or .tcbc)",
+        );
+        assert_eq!(stderr(&o).lines().count(), 1, "{args:?}");
+    }
+    let o = tcb(&["sample", folder.to_str().unwrap(), "--at", "1"]);
+    stderr_has(&o, "clips: a directory, not a clip file");
+    assert!(!dir.join("never.svg").exists());
+}
+
 /// A name with a line break and a terminal escape in it (JSON allows
 /// both) is printed escaped: the error stays one line, and the terminal is
 /// not told anything.
@@ -586,6 +613,12 @@ fn import_and_export_errors_write_nothing() {
     assert!(!glb.exists());
     let o = tcb_to("export", example("bounce.json"), dir.join("x.fbx"), &[]);
     stderr_has(&o, "must end in .glb or .gltf");
+    // A clip file is JSON: written under another name it would not load
+    // back as what its name says.
+    let bvh = dir.join("never.bvh");
+    let o = tcb_to("import", data("simple_skin.gltf"), &bvh, &[]);
+    stderr_has(&o, "never.bvh: the output must end in .json");
+    assert!(!bvh.exists());
 }
 
 #[test]
