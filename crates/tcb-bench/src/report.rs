@@ -401,10 +401,13 @@ const COLUMNS: [(&str, usize); 11] = [
     ("MB", 7),
 ];
 
-fn table_line(cells: &[String]) -> String {
+/// One line of the table, its first column `first` wide (the longest
+/// scenario name, at least the column's own width).
+fn table_line(cells: &[String], first: usize) -> String {
     let mut line = String::new();
     for (i, (cell, (_, width))) in cells.iter().zip(COLUMNS).enumerate() {
         if i == 0 {
+            let width = first.max(width);
             let _ = write!(line, "{cell:<width$}");
         } else {
             let _ = write!(line, "  {cell:>width$}");
@@ -451,7 +454,8 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
         }
     );
     let header: Vec<String> = COLUMNS.iter().map(|c| c.0.to_string()).collect();
-    let _ = writeln!(out, "{}", table_line(&header));
+    let first = rows.iter().map(|r| r.name.len()).max().unwrap_or(0);
+    let _ = writeln!(out, "{}", table_line(&header, first));
     for r in rows {
         let cells = [
             r.name.clone(),
@@ -466,7 +470,7 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
             fmt(r.ns_per_joint, ""),
             format!("{:.3}", r.bytes as f64 / 1e6),
         ];
-        let _ = writeln!(out, "{}", table_line(&cells));
+        let _ = writeln!(out, "{}", table_line(&cells, first));
     }
     out.push_str(LEGEND);
     out
@@ -907,6 +911,34 @@ mod tests {
 
     fn saved(rows: &[Row], fp: &Fingerprint) -> Value {
         to_json(rows, fp, &Timing::FULL)
+    }
+
+    /// Every row's columns end where the header's do, whatever the
+    /// length of a scenario's name.
+    #[test]
+    fn table_columns_line_up_with_long_names() {
+        let rows = [
+            timed("wide", 1.0, 300.0),
+            timed("character-compressed-acl", 2.0, 70.0),
+        ];
+        let text = table(&rows, &Fingerprint::here(), &Timing::FULL);
+        let lines: Vec<&str> = text.lines().collect();
+        let header = lines
+            .iter()
+            .position(|l| l.starts_with("scenario"))
+            .unwrap();
+        let end = |l: &str| l.find("channels").map(|i| i + "channels".len());
+        let at = end(lines[header]).unwrap();
+        for (line, name) in lines[header + 1..]
+            .iter()
+            .zip(["wide", "character-compressed-acl"])
+        {
+            assert!(line.starts_with(name), "{line}");
+            // The channel count (127 or 0) ends under the header's word.
+            let count = line[name.len()..].trim_start();
+            let digits = count.len() - count.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+            assert_eq!(line.len() - count.len() + digits, at, "{line}");
+        }
     }
 
     #[test]
