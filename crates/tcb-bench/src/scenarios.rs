@@ -53,7 +53,13 @@ pub struct Scenario {
     pub parallel: bool,
     /// A packed clip's `.tcbc` bytes.
     pub file_bytes: Option<usize>,
+    /// A packed clip's load from those bytes, ms (the median of [`LOADS`]).
+    pub load_ms: Option<f64>,
 }
+
+/// Loads of a packed clip from its bytes that [`Scenario::load_ms`] is
+/// the median of.
+pub const LOADS: usize = 11;
 
 impl Scenario {
     fn new(name: impl Into<String>, source: tcb_core::SourceClip, times: Vec<f64>) -> Self {
@@ -69,6 +75,7 @@ impl Scenario {
             read_limit: false,
             parallel: false,
             file_bytes: None,
+            load_ms: None,
         }
     }
 
@@ -335,7 +342,17 @@ fn packed_scenario(
     path: &Path,
 ) -> Result<Scenario, tcb_io::Error> {
     let err = |e: tcb_runtime::PackError| tcb_io::Error::import(e.to_string()).in_file(path);
-    let file_bytes = packed.to_bytes().len();
+    let bytes = packed.to_bytes();
+    let file_bytes = bytes.len();
+    let mut loads: Vec<f64> = (0..LOADS)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            let clip = tcb_runtime::Clip::from_bytes(std::hint::black_box(&bytes));
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            clip.map(|_| ms).map_err(err)
+        })
+        .collect::<Result<_, _>>()?;
+    loads.sort_by(f64::total_cmp);
     let packed = Arc::new(packed);
     let source = packed.decode().and_then(|s| s.to_clip()).map_err(err)?;
     let clip = tcb_runtime::Clip::from_packed(packed).map_err(err)?;
@@ -356,6 +373,7 @@ fn packed_scenario(
     s.clip = Arc::new(clip);
     s.joints = Some(joints);
     s.file_bytes = Some(file_bytes);
+    s.load_ms = Some(loads[LOADS / 2]);
     Ok(s)
 }
 
