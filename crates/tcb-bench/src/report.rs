@@ -443,8 +443,14 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
             tcb_runtime::Simd::Avx2 if cfg!(target_feature = "avx2") => {
                 "the build's (AVX2) group kernels, the decoder's AVX2 instance"
             }
+            tcb_runtime::Simd::Avx512 if cfg!(target_feature = "avx2") => {
+                "the build's (AVX2) group kernels, the decoder's AVX-512 instance"
+            }
             tcb_runtime::Simd::Avx2 => {
                 "the AVX2 instance of the group kernels and the decoder, chosen at run time"
+            }
+            tcb_runtime::Simd::Avx512 => {
+                "the AVX2 instance of the group kernels, the decoder's AVX-512 instance, chosen at run time"
             }
             tcb_runtime::Simd::Baseline => "the build's own instructions",
         }

@@ -8,6 +8,10 @@
 //! [`tcb_core::simd::w8::W8`], `D4` and `I8`: the same
 //! formulas, the same IEEE operations per lane in the same order, so the
 //! same bits (`tests/isa.rs` compares the two on every scenario shape).
+//! Where the CPU has AVX-512 F, VL, BW and DQ too, the decoder runs an
+//! instance compiled with them ([`Simd::Avx512`]; the same code, which the
+//! compiler then gives 32 registers and AVX-512's forms of the same
+//! 256-bit operations).
 //! Builds with `-C target-cpu=x86-64-v3` or `native` have `wide` in AVX2
 //! already: their group kernels stay `wide`'s (the `W8` instance took 11%
 //! more instructions on `character-hermite` in such a build), and their
@@ -23,7 +27,7 @@
 //! assert_eq!(tcb_runtime::simd(), now);
 //! ```
 
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 /// Which instance of the kernels sampling runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +37,11 @@ pub enum Simd {
     /// AVX2 and FMA: detected at run time in a default x86-64 build, or
     /// enabled by the build.
     Avx2,
+    /// As [`Avx2`](Self::Avx2), and the packed clips' decoder compiled
+    /// with AVX-512 F, VL, BW and DQ too (the same 256-bit operations,
+    /// with 32 registers): detected at run time, unless
+    /// [`force_no_avx512`] says otherwise.
+    Avx512,
 }
 
 /// What [`avx2`] answers: not yet detected, the AVX2 instance, or the
@@ -40,11 +49,30 @@ pub enum Simd {
 const UNKNOWN: u8 = 0;
 const AVX2: u8 = 1;
 const BASELINE: u8 = 2;
+const AVX512: u8 = 3;
 static STATE: AtomicU8 = AtomicU8::new(UNKNOWN);
+/// [`force_no_avx512`]'s switch.
+static NO_AVX512: AtomicBool = AtomicBool::new(false);
 
 /// The instance sampling runs now, on this CPU and in this build.
 pub fn simd() -> Simd {
-    if avx2() { Simd::Avx2 } else { Simd::Baseline }
+    match (avx2(), avx512()) {
+        (true, true) => Simd::Avx512,
+        (true, false) => Simd::Avx2,
+        _ => Simd::Baseline,
+    }
+}
+
+/// Run the packed decoder's AVX2 instance even where AVX-512 was detected
+/// (`true`), or go back to detection (`false`), for every thread: to
+/// compare the instances, or to count instructions under valgrind, which
+/// does not decode AVX-512. A forced baseline
+/// ([`force_baseline_simd`]) stays forced.
+pub fn force_no_avx512(on: bool) {
+    NO_AVX512.store(on, Ordering::Relaxed);
+    if STATE.load(Ordering::Relaxed) != BASELINE {
+        STATE.store(detect(), Ordering::Relaxed);
+    }
 }
 
 /// Run the build's own instructions even where AVX2 was detected (`true`),
@@ -82,8 +110,19 @@ impl Avx2Kernels {
 #[inline(always)]
 pub(crate) fn avx2() -> bool {
     match STATE.load(Ordering::Relaxed) {
-        AVX2 => true,
-        UNKNOWN => first(),
+        AVX2 | AVX512 => true,
+        UNKNOWN => first() != BASELINE,
+        _ => false,
+    }
+}
+
+/// Whether the packed decoder runs its AVX-512 instance (detected with
+/// AVX2, and not forced off).
+#[inline(always)]
+pub(crate) fn avx512() -> bool {
+    match STATE.load(Ordering::Relaxed) {
+        AVX512 => true,
+        UNKNOWN => first() == AVX512,
         _ => false,
     }
 }
@@ -91,16 +130,24 @@ pub(crate) fn avx2() -> bool {
 /// The first call: detect, and remember (out of line).
 #[cold]
 #[inline(never)]
-fn first() -> bool {
+fn first() -> u8 {
     let state = detect();
     STATE.store(state, Ordering::Relaxed);
-    state == AVX2
+    state
 }
 
-/// The CPU has AVX2 and FMA (constant where the build enables them).
+/// The CPU has AVX2 and FMA (constant where the build enables them), and
+/// AVX-512 F, VL, BW and DQ besides (unless forced off).
 fn detect() -> u8 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        let avx512 = std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512dq");
+        if avx512 && !NO_AVX512.load(Ordering::Relaxed) {
+            return AVX512;
+        }
         return AVX2;
     }
     BASELINE

@@ -77,7 +77,7 @@ pub use blend::{BlendMask, blend};
 pub use clip::{Clip, ClipStats, GridStats};
 pub use compile::CompileOptions;
 pub use instance::{Instance, OutputLength, Playback, PlaybackError};
-pub use isa::{Simd, force_baseline_simd, simd};
+pub use isa::{Simd, force_baseline_simd, force_no_avx512, simd};
 pub use layout::{PoseLayout, TrackId, TrackSlot};
 pub use pack::{BlockScales, KeyValues, PackError, PackSource, PackTrack, Packed};
 

@@ -59,6 +59,20 @@ const P: usize = 0;
 const TO: usize = 1;
 const TI: usize = 2;
 
+/// `$f(args)` of the decoder instance that runs here: `v4` where
+/// `crate::isa::avx512` says so, else `v3` (callers check
+/// `crate::isa::avx2` first).
+#[cfg(target_arch = "x86_64")]
+macro_rules! instance {
+    ($f:ident($($arg:expr),* $(,)?)) => {
+        if crate::isa::avx512() {
+            v4::$f($($arg),*)
+        } else {
+            v3::$f($($arg),*)
+        }
+    };
+}
+
 /// The packed controls of one group (see the module docs).
 #[derive(Clone, Debug)]
 pub(crate) struct PackedKeys {
@@ -232,7 +246,7 @@ impl PackedKeys {
             let (m0, m1) = c.m.split_at_mut(np);
             #[cfg(target_arch = "x86_64")]
             if crate::isa::avx2() {
-                return v3::interior_tangents_here(rows, &self.weights, m0, m1);
+                return instance!(interior_tangents_here(rows, &self.weights, m0, m1));
             }
             return interior_tangents::<f32x8>(rows, &self.weights, m0, m1);
         }
@@ -593,7 +607,7 @@ impl PackCache {
         let (before, narrow);
         #[cfg(target_arch = "x86_64")]
         let read = if crate::isa::avx2() {
-            v3::headers_here(&mut self.headers, words, pos, g.headed.len())
+            instance!(headers_here(&mut self.headers, words, pos, g.headed.len()))
         } else {
             self.headers.read::<i32x8>(words, pos, g.headed.len())
         };
@@ -642,7 +656,15 @@ impl PackCache {
             #[allow(unsafe_code)]
             unsafe {
                 let (x0, x1, f) = (&mut self.x0, &mut self.x1, self.factor);
-                v3::predict_gathered_here(g, &self.headers, pos, f, x0, x1, rows);
+                instance!(predict_gathered_here(
+                    g,
+                    &self.headers,
+                    pos,
+                    f,
+                    x0,
+                    x1,
+                    rows
+                ));
             }
         }
         if !gather {
@@ -702,7 +724,7 @@ impl PackCache {
             #[allow(unsafe_code)]
             unsafe {
                 let (x0, x1, f) = (&mut self.x0, &mut self.x1, self.factor);
-                v3::block_start_gathered_here(g, *pos, f, x0, x1, rows);
+                instance!(block_start_gathered_here(g, *pos, f, x0, x1, rows));
             }
             *pos += g.start_bits;
             self.rebuild(g, 0..first);
@@ -741,7 +763,7 @@ impl PackCache {
         let rows = &mut self.rows[(BEFORE + rows.start) * np..(BEFORE + rows.end) * np];
         #[cfg(target_arch = "x86_64")]
         let bounded = if crate::isa::avx2() {
-            v3::rebuild_rows_here(g, rows)
+            instance!(rebuild_rows_here(g, rows))
         } else {
             rebuild_rows::<f32x8>(g, rows)
         };
@@ -864,479 +886,517 @@ struct PlaneCoding {
 /// The widest residual a gather of 32 bits from its first byte holds.
 pub(crate) const GATHER_WIDTH: u32 = 25;
 
-/// The AVX2 + FMA instance of the decoder (see `crate::isa`): the same
-/// formulas ([`predict`], `dequantize_lanes`, [`rebuild_rows`],
-/// [`interior_tangents`]) on `tcb_core::simd::w8`'s `I8` and `W8`, and each
-/// key's residuals of a plane gathered straight from the stream.
 #[cfg(target_arch = "x86_64")]
-mod v3 {
-    use crate::pack::SEGMENT_KEYS;
-    use crate::pack::store::{
-        Headers, PackedKeys, Plane, block_start_keys, entry_fields, interior_tangents, predict,
-        rebuild_rows,
-    };
-    use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
-    use std::arch::x86_64::{
-        __m256, __m256i, _mm_cvtsi64_si128, _mm_cvtsi128_si32, _mm_max_epu32, _mm_shuffle_epi32,
-        _mm256_add_epi32, _mm256_and_si256, _mm256_blendv_ps, _mm256_castps_si256,
-        _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cvtepi32_ps, _mm256_cvtepu8_epi32,
-        _mm256_extracti128_si256, _mm256_i32gather_epi32, _mm256_i64gather_epi64, _mm256_mul_ps,
-        _mm256_mullo_epi32, _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps,
-        _mm256_setzero_si256, _mm256_shuffle_ps, _mm256_slli_epi32, _mm256_srli_epi32,
-        _mm256_srlv_epi32, _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32,
-        _mm256_unpacklo_epi32,
-    };
-    use tcb_core::simd::w8::{I8, W8};
-    use wide::{f32x8, i32x8};
-
-    impl Plane for W8 {
-        // Through AVX vectors: a loop of these is not vectorized again
-        // across its iterations (LLVM's loop vectorizer does, on arrays,
-        // with a gather per operand), as the group kernels' rotation loop
-        // loads (`kernel::v3`; their vector loop stays on arrays, which
-        // LLVM unrolls).
-        #[inline(always)]
-        fn load(x: &f32x8) -> Self {
-            let v: __m256 = bytemuck::cast(*x);
-            W8(bytemuck::cast(v))
-        }
-        #[inline(always)]
-        fn store(self) -> f32x8 {
-            let v: __m256 = bytemuck::cast(self.0);
-            bytemuck::cast(v)
-        }
-        #[inline(always)]
-        fn blend(mask: &f32x8, a: Self, b: Self) -> Self {
-            // The masks are all ones or all zeros per lane, so the sign
-            // bit `vblendvps` reads decides as the whole mask would.
-            let (m, a, b): (__m256, __m256, __m256) = (
-                bytemuck::cast(*mask),
-                bytemuck::cast(a.0),
-                bytemuck::cast(b.0),
-            );
-            // SAFETY: `W8`'s `Plane` runs only inside this module's AVX2
-            // functions.
-            #[allow(unsafe_code)]
-            W8(bytemuck::cast(unsafe { _mm256_blendv_ps(b, a, m) }))
-        }
-    }
-
-    // SAFETY (every `_here`): `crate::isa::avx2` detected AVX2 and FMA on
-    // this CPU before the caller came here.
-
-    /// [`interior_tangents`] in AVX2.
+impl Plane for tcb_core::simd::w8::W8 {
+    // Through AVX vectors: a loop of these is not vectorized again
+    // across its iterations (LLVM's loop vectorizer does, on arrays,
+    // with a gather per operand), as the group kernels' rotation loop
+    // loads (`kernel::v3`; their vector loop stays on arrays, which
+    // LLVM unrolls).
     #[inline(always)]
-    pub(super) fn interior_tangents_here(
-        keys: [&[f32x8]; 4],
-        weights: &[[f32x8; 4]],
-        m0: &mut [f32x8],
-        m1: &mut [f32x8],
-    ) {
-        debug_assert!(crate::isa::avx2());
+    fn load(x: &f32x8) -> Self {
+        let v: std::arch::x86_64::__m256 = bytemuck::cast(*x);
+        Self(bytemuck::cast(v))
+    }
+    #[inline(always)]
+    fn store(self) -> f32x8 {
+        let v: std::arch::x86_64::__m256 = bytemuck::cast(self.0);
+        bytemuck::cast(v)
+    }
+    #[inline(always)]
+    fn blend(mask: &f32x8, a: Self, b: Self) -> Self {
+        use std::arch::x86_64::{__m256, _mm256_blendv_ps};
+        // The masks are all ones or all zeros per lane, so the sign
+        // bit `vblendvps` reads decides as the whole mask would.
+        let (m, a, b): (__m256, __m256, __m256) = (
+            bytemuck::cast(*mask),
+            bytemuck::cast(a.0),
+            bytemuck::cast(b.0),
+        );
+        // SAFETY: `W8`'s `Plane` runs only inside the decoder instances'
+        // `#[target_feature]` functions (`decoder_instance!`), all with AVX2.
         #[allow(unsafe_code)]
-        unsafe {
-            tangents(keys, weights, m0, m1)
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn tangents(keys: [&[f32x8]; 4], weights: &[[f32x8; 4]], m0: &mut [f32x8], m1: &mut [f32x8]) {
-        interior_tangents::<W8>(keys, weights, m0, m1);
-    }
-
-    /// [`Headers::read`] compiled for AVX2.
-    #[inline(always)]
-    pub(super) fn headers_here(
-        h: &mut Headers,
-        words: &[u64],
-        pos: usize,
-        headed: usize,
-    ) -> (usize, usize, bool) {
-        debug_assert!(crate::isa::avx2());
-        #[allow(unsafe_code)]
-        unsafe {
-            headers(h, words, pos, headed)
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn headers(h: &mut Headers, words: &[u64], pos: usize, headed: usize) -> (usize, usize, bool) {
-        h.read::<V>(words, pos, headed)
-    }
-
-    /// [`rebuild_rows`] in AVX2.
-    #[inline(always)]
-    pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
-        debug_assert!(crate::isa::avx2());
-        #[allow(unsafe_code)]
-        unsafe {
-            rebuild(g, rows)
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn rebuild(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
-        rebuild_rows::<W8>(g, rows)
-    }
-
-    /// The prediction and dequantization of the rows `rows` (keys
-    /// `first..keys` of the segment, `planes` vectors each), the residuals
-    /// gathered from the stream at the bits `base + start * k` (`k =
-    /// rows.len() / planes` keys), each plane's coding gathered from the
-    /// headers `h` at `g.plane_index`.
-    ///
-    /// # Safety
-    ///
-    /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
-    /// is below the length of `h.entry`, and for every lane the sum of the
-    /// widths before it and its own, times `k`, plus `base` is
-    /// at most `64 * g.packed.stream.len() - 64` and below `i32::MAX`
-    /// (each gather reads 8 bytes from the byte of a lane's bit).
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    pub(super) unsafe fn predict_gathered_here(
-        g: &PackedKeys,
-        h: &Headers,
-        base: usize,
-        factor: f32,
-        x0: &mut [i32x8],
-        x1: &mut [i32x8],
-        rows: &mut [f32x8],
-    ) {
-        debug_assert!(crate::isa::avx2());
-        // SAFETY: the caller's (above).
-        unsafe { predict_gathered(g, h, base as i32, factor, x0, x1, rows) }
-    }
-
-    #[inline(always)]
-    fn m(x: [i32; 8]) -> __m256i {
-        bytemuck::cast(x)
-    }
-
-    /// The 32 bits from each lane's bit `bit` of `bytes` (bit `p` is bit
-    /// `p % 8` of byte `p / 8`; fewer where they pass a byte's top, the
-    /// caller masks what it reads): gathered from the lane's byte, shifted
-    /// by the rest.
-    ///
-    /// # Safety
-    ///
-    /// Each lane's `bit` is at least 0 and `bit / 8 + 4` at most
-    /// `bytes.len()`.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    #[allow(unsafe_code)]
-    unsafe fn bits_at(bytes: &[u8], bit: __m256i) -> I8 {
-        // SAFETY: the caller's: each 4-byte read is inside `bytes`.
-        #[allow(unsafe_code)]
-        let word = unsafe {
-            _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
-        };
-        let seven = _mm256_set1_epi32(7);
-        I8(bytemuck::cast(_mm256_srlv_epi32(
-            word,
-            _mm256_and_si256(bit, seven),
-        )))
-    }
-
-    /// A block's first keys into `rows` (its first, and its second where
-    /// `rows` has two) and the predictor: each plane's start values and
-    /// deltas gathered from the bits `base + g.start_gather[p]`, as the
-    /// baseline's `block_start` reads them one lane at a time.
-    ///
-    /// # Safety
-    ///
-    /// `crate::isa::avx2()` is true, `g.start_gather` is not empty, and
-    /// `base + g.start_bits + 32` is at most `64 * g.packed.stream.len()`
-    /// and below `i32::MAX`.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    pub(super) unsafe fn block_start_gathered_here(
-        g: &PackedKeys,
-        base: usize,
-        factor: f32,
-        x0: &mut [i32x8],
-        x1: &mut [i32x8],
-        rows: &mut [f32x8],
-    ) {
-        debug_assert!(crate::isa::avx2() && !g.start_gather.is_empty());
-        // SAFETY: the caller's (above).
-        unsafe { block_start_gathered(g, base as i32, factor, x0, x1, rows) }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn block_start_gathered(
-        g: &PackedKeys,
-        base: i32,
-        factor: f32,
-        x0: &mut [i32x8],
-        x1: &mut [i32x8],
-        rows: &mut [f32x8],
-    ) {
-        let np = g.planes;
-        let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
-        let base = _mm256_set1_epi32(base);
-        let keys = rows.len() / np;
-        let (row0, row1) = rows.split_at_mut(np);
-        let planes = g.start_gather.iter().zip(&g.step);
-        for (p, ([abs_at, abs_w, delta_at, delta_w], step)) in planes.enumerate() {
-            let read = |at: &[i32; 8], w: &[i32; 8]| {
-                let bit = _mm256_add_epi32(base, m(*at));
-                // SAFETY: every lane's bit ends at or before `base +
-                // start_bits`, 32 bits before the stream's end
-                // (`block_start_gathered_here`).
-                #[allow(unsafe_code)]
-                let z = unsafe { bits_at(bytes, bit) };
-                unzigzag_lanes(z & width_lanes(I8(*w)).0)
-            };
-            let (start, delta) = (read(abs_at, abs_w), read(delta_at, delta_w));
-            let step = block_step(W8(step.to_array()), W8([factor; 8]));
-            let [k0, k1] = block_start_keys(start, delta, keys);
-            row0[p] = f32x8::new(dequantize_lanes(k0, step).0);
-            if let Some(row) = row1.get_mut(p) {
-                *row = f32x8::new(dequantize_lanes(k1, step).0);
-            }
-            (x0[p], x1[p]) = (i32x8::new(k0.0), i32x8::new(k1.0));
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn predict_gathered(
-        g: &PackedKeys,
-        h: &Headers,
-        base: i32,
-        factor: f32,
-        x0: &mut [i32x8],
-        x1: &mut [i32x8],
-        rows: &mut [f32x8],
-    ) {
-        let np = g.planes;
-        let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
-        let base = _mm256_set1_epi32(base);
-        let n = rows.len() / np;
-        let keys = _mm256_set1_epi32(n as i32);
-        // A plane's coding, first bit and first 64 bits per lane. The
-        // next plane's are read before the current plane's keys run, so
-        // that its gathers (the entries, then the residuals at the bits
-        // they give) wait behind work rather than ahead of it.
-        let setup = |p: usize| {
-            // SAFETY: the caller's, every index inside `h.entry`.
-            #[allow(unsafe_code)]
-            let e = unsafe { _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p])) };
-            let [width, trend, start] = entry_fields(I8(bytemuck::cast(e)));
-            let bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(start.0), keys));
-            // SAFETY: as below.
-            #[allow(unsafe_code)]
-            let words = unsafe { read_shifted(bytes, bit) };
-            (width, trend, bit, words)
-        };
-        let planes = &g.stored_planes;
-        let mut next = planes.first().map(|&p| setup(p as usize));
-        for (i, &p) in planes.iter().enumerate() {
-            let p = p as usize;
-            let Some((width, trend, mut bit, mut words)) = next else {
-                break;
-            };
-            next = planes.get(i + 1).map(|&p| setup(p as usize));
-            let (low, bias) = width_lanes(width);
-            let code = [trend, low, bias].map(|x| V(m(x.0)));
-            let width = m(width.0);
-            // Keys whose residuals every lane has in the 57 bits after the
-            // first one's byte: one 8-byte read per lane serves them all.
-            let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
-            let width_q = halves(width);
-            // The last key and its step.
-            let (a, b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
-            let (mut x, mut d) = (b, b - a);
-            let step = block_step(F(bytemuck::cast(g.step[p])), F(_mm256_set1_ps(factor)));
-            // Row `r`'s vector of plane `p`: `rows[r * np + p]`.
-            assert!(p < np, "a stored plane");
-            let mut at = p;
-            let mut left = n;
-            loop {
-                let k = per.min(left);
-                left -= k;
-                for _ in 0..k {
-                    (x, d) = predict(x, d, V(low_words(words)), code);
-                    for (w, s) in words.iter_mut().zip(width_q) {
-                        *w = _mm256_srlv_epi64(*w, s);
-                    }
-                    // SAFETY: `at` is `p` plus `np` times a row below
-                    // `n` (the rows' count), `p < np`: inside `rows`.
-                    #[allow(unsafe_code)]
-                    unsafe {
-                        *rows.get_unchecked_mut(at) = bytemuck::cast(dequantize_lanes(x, step).0);
-                    }
-                    at += np;
-                }
-                if left == 0 {
-                    break;
-                }
-                let k = _mm256_set1_epi32(k as i32);
-                bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
-                // SAFETY: every lane's bit is below the bound of
-                // `predict_gathered_here`'s contract, 64 bits before the
-                // end of `bytes`, so each 8-byte read is inside it.
-                #[allow(unsafe_code)]
-                {
-                    words = unsafe { read_shifted(bytes, bit) };
-                }
-            }
-            (x0[p], x1[p]) = (bytemuck::cast((x - d).0), bytemuck::cast(x.0));
-        }
-    }
-
-    /// Eight `i32` lanes in an AVX register, for [`predict`] and
-    /// `dequantize_lanes` in the decoder's loop over keys: `I8`'s arrays
-    /// there leave LLVM rebuilding loop-invariant vectors lane by lane.
-    /// Each operation is the one AVX2 instruction of `I8`'s (wrapping).
-    #[derive(Clone, Copy)]
-    struct V(__m256i);
-
-    /// Eight `f32` lanes in an AVX register, `V`'s floats.
-    #[derive(Clone, Copy)]
-    struct F(__m256);
-
-    /// `$t`'s operator `$tr` as the AVX2 intrinsic `$f`. The intrinsics
-    /// need AVX2, which every caller has: a `V` or an `F` (private types
-    /// with private fields) is made and used only inside this module's
-    /// `#[target_feature(enable = "avx2,fma")]` functions,
-    /// `predict_gathered` and `headers` (through `Headers::read::<V>`),
-    /// into which these methods inline. Keep it so: the methods are safe
-    /// to call, so a new caller outside such a function would compile and
-    /// run AVX2 instructions on any CPU.
-    macro_rules! avx_op {
-        ($t:ident, $tr:ident, $m:ident, $f:ident) => {
-            impl std::ops::$tr for $t {
-                type Output = $t;
-                #[inline(always)]
-                fn $m(self, o: $t) -> $t {
-                    // SAFETY: only used inside `predict_gathered` and
-                    // `headers`, which run where AVX2 does (above).
-                    #[allow(unsafe_code)]
-                    $t(unsafe { $f(self.0, o.0) })
-                }
-            }
-        };
-    }
-    avx_op!(V, Add, add, _mm256_add_epi32);
-    avx_op!(V, Sub, sub, _mm256_sub_epi32);
-    avx_op!(V, BitAnd, bitand, _mm256_and_si256);
-    avx_op!(V, BitOr, bitor, _mm256_or_si256);
-    avx_op!(F, Mul, mul, _mm256_mul_ps);
-
-    impl super::EntryLanes for V {
-        #[inline(always)]
-        fn bytes(x: u64) -> V {
-            // SAFETY: as `avx_op`'s.
-            #[allow(unsafe_code)]
-            V(unsafe { _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x as i64)) })
-        }
-        #[inline(always)]
-        fn splat(x: i32) -> V {
-            // SAFETY: as `avx_op`'s.
-            #[allow(unsafe_code)]
-            V(unsafe { _mm256_set1_epi32(x) })
-        }
-        #[inline(always)]
-        fn shl<const N: i32>(self) -> V {
-            // SAFETY: as `avx_op`'s.
-            #[allow(unsafe_code)]
-            V(unsafe { _mm256_slli_epi32::<N>(self.0) })
-        }
-        #[inline(always)]
-        fn to_array(self) -> [i32; 8] {
-            bytemuck::cast(self.0)
-        }
-    }
-
-    impl crate::pack::IntLanes for V {
-        type Float = F;
-        #[inline(always)]
-        fn to_float(self) -> F {
-            // SAFETY: as `avx_op`'s.
-            #[allow(unsafe_code)]
-            F(unsafe { _mm256_cvtepi32_ps(self.0) })
-        }
-    }
-
-    /// Each lane's 64 bits from the byte of its bit `bit`, shifted to it,
-    /// in two halves of 4 lanes (as u64s).
-    ///
-    /// # Safety
-    ///
-    /// Each lane's `bit / 8 + 8` is at most `bytes.len()`.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    #[allow(unsafe_code)]
-    unsafe fn read_shifted(bytes: &[u8], bit: __m256i) -> [__m256i; 2] {
-        let byte = halves(_mm256_srli_epi32::<3>(bit));
-        let shift = halves(_mm256_and_si256(bit, _mm256_set1_epi32(7)));
-        // SAFETY: the caller's.
-        let words = unsafe { [read64(bytes, byte[0]), read64(bytes, byte[1])] };
-        [
-            _mm256_srlv_epi64(words[0], shift[0]),
-            _mm256_srlv_epi64(words[1], shift[1]),
-        ]
-    }
-
-    /// How many residuals of a width (at most 25) 57 bits hold: 64 bits
-    /// read from the byte of the first one's bit hold at least 57 after it.
-    const KEYS_IN_57_BITS: [u8; 32] = {
-        let mut t = [SEGMENT_KEYS as u8; 32];
-        let mut w = 1;
-        while w < 32 {
-            t[w] = (57 / w) as u8;
-            w += 1;
-        }
-        t
-    };
-
-    /// The largest of the 8 lanes of `x` (as u32).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn widest(x: __m256i) -> u32 {
-        let x = _mm_max_epu32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
-        let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b01_00_11_10>(x));
-        let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b10_11_00_01>(x));
-        _mm_cvtsi128_si32(x) as u32
-    }
-
-    /// The 8 lanes of `x` as two halves of 4 lanes, each widened to u64:
-    /// lanes 0, 1, 4 and 5, then 2, 3, 6 and 7 (the order in which
-    /// [`low_words`] takes them back with one shuffle).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn halves(x: __m256i) -> [__m256i; 2] {
-        let zero = _mm256_setzero_si256();
-        [
-            _mm256_unpacklo_epi32(x, zero),
-            _mm256_unpackhi_epi32(x, zero),
-        ]
-    }
-
-    /// The low 32 bits of each u64 of two [`halves`], as 8 lanes.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn low_words([lo, hi]: [__m256i; 2]) -> __m256i {
-        // Per 128 bits: lo's two low words, then hi's.
-        let mixed =
-            _mm256_shuffle_ps::<0b10_00_10_00>(_mm256_castsi256_ps(lo), _mm256_castsi256_ps(hi));
-        _mm256_castps_si256(mixed)
-    }
-
-    /// 8 bytes from `bytes` at each of 4 byte offsets (`at`, as u64).
-    ///
-    /// # Safety
-    ///
-    /// Each offset plus 8 is at most `bytes.len()`.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    #[allow(unsafe_code)]
-    unsafe fn read64(bytes: &[u8], at: __m256i) -> __m256i {
-        // SAFETY: the caller's: each 8-byte read is inside `bytes`.
-        unsafe { _mm256_i64gather_epi64::<1>(bytes.as_ptr().cast(), at) }
+        Self(bytemuck::cast(unsafe { _mm256_blendv_ps(b, a, m) }))
     }
 }
+
+/// `$t`'s operator `$tr` as the AVX2 intrinsic `$f`. The intrinsics
+/// need AVX2, which every caller has: a `V` or an `F` (private types
+/// with private fields, one pair per [`decoder_instance!`]) is made and
+/// used only inside its instance's `#[target_feature]` functions (AVX2
+/// and FMA at least), `predict_gathered` and `headers` (through
+/// `Headers::read::<V>`), into which these methods inline. Keep it so: the methods are safe
+/// to call, so a new caller outside such a function would compile and
+/// run AVX2 instructions on any CPU.
+macro_rules! avx_op {
+    ($t:ident, $tr:ident, $m:ident, $f:ident) => {
+        impl std::ops::$tr for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn $m(self, o: $t) -> $t {
+                // SAFETY: only used inside `predict_gathered` and
+                // `headers`, which run where AVX2 does (above).
+                #[allow(unsafe_code)]
+                $t(unsafe { $f(self.0, o.0) })
+            }
+        }
+    };
+}
+
+/// The decoder compiled for x86-64 features `$features` (AVX2 and FMA at
+/// least), run where `$detected()` says the CPU has them (`crate::isa`):
+/// the same formulas ([`predict`], `dequantize_lanes`, [`rebuild_rows`],
+/// [`interior_tangents`]) on `tcb_core::simd::w8`'s `I8` and `W8`, and
+/// each key's residuals of a plane gathered straight from the stream.
+/// One body, instantiated per feature set, so the instances are the same
+/// code.
+macro_rules! decoder_instance {
+    ($name:ident, $features:literal, $detected:path) => {
+        mod $name {
+            use crate::pack::SEGMENT_KEYS;
+            use crate::pack::store::{
+                Headers, PackedKeys, block_start_keys, entry_fields, interior_tangents, predict,
+                rebuild_rows,
+            };
+            use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
+            use std::arch::x86_64::{
+                __m256, __m256i, _mm_cvtsi64_si128, _mm_cvtsi128_si32, _mm_max_epu32,
+                _mm_shuffle_epi32, _mm256_add_epi32, _mm256_and_si256, _mm256_castps_si256,
+                _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cvtepi32_ps,
+                _mm256_cvtepu8_epi32, _mm256_extracti128_si256, _mm256_i32gather_epi32,
+                _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_or_si256,
+                _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps,
+                _mm256_slli_epi32, _mm256_srli_epi32, _mm256_srlv_epi32, _mm256_srlv_epi64,
+                _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
+            };
+            use tcb_core::simd::w8::{I8, W8};
+            use wide::{f32x8, i32x8};
+
+            // SAFETY (every `_here`): `$detected` found this instance's
+            // features on this CPU before the caller came here.
+
+            /// [`interior_tangents`] in AVX2.
+            #[inline(always)]
+            pub(super) fn interior_tangents_here(
+                keys: [&[f32x8]; 4],
+                weights: &[[f32x8; 4]],
+                m0: &mut [f32x8],
+                m1: &mut [f32x8],
+            ) {
+                debug_assert!($detected());
+                #[allow(unsafe_code)]
+                unsafe {
+                    tangents(keys, weights, m0, m1)
+                }
+            }
+
+            #[target_feature(enable = $features)]
+            fn tangents(
+                keys: [&[f32x8]; 4],
+                weights: &[[f32x8; 4]],
+                m0: &mut [f32x8],
+                m1: &mut [f32x8],
+            ) {
+                interior_tangents::<W8>(keys, weights, m0, m1);
+            }
+
+            /// [`Headers::read`] compiled for AVX2.
+            #[inline(always)]
+            pub(super) fn headers_here(
+                h: &mut Headers,
+                words: &[u64],
+                pos: usize,
+                headed: usize,
+            ) -> (usize, usize, bool) {
+                debug_assert!($detected());
+                #[allow(unsafe_code)]
+                unsafe {
+                    headers(h, words, pos, headed)
+                }
+            }
+
+            #[target_feature(enable = $features)]
+            fn headers(
+                h: &mut Headers,
+                words: &[u64],
+                pos: usize,
+                headed: usize,
+            ) -> (usize, usize, bool) {
+                h.read::<V>(words, pos, headed)
+            }
+
+            /// [`rebuild_rows`] in AVX2.
+            #[inline(always)]
+            pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
+                debug_assert!($detected());
+                #[allow(unsafe_code)]
+                unsafe {
+                    rebuild(g, rows)
+                }
+            }
+
+            #[target_feature(enable = $features)]
+            fn rebuild(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
+                rebuild_rows::<W8>(g, rows)
+            }
+
+            /// The prediction and dequantization of the rows `rows` (keys
+            /// `first..keys` of the segment, `planes` vectors each), the residuals
+            /// gathered from the stream at the bits `base + start * k` (`k =
+            /// rows.len() / planes` keys), each plane's coding gathered from the
+            /// headers `h` at `g.plane_index`.
+            ///
+            /// # Safety
+            ///
+            /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
+            /// is below the length of `h.entry`, and for every lane the sum of the
+            /// widths before it and its own, times `k`, plus `base` is
+            /// at most `64 * g.packed.stream.len() - 64` and below `i32::MAX`
+            /// (each gather reads 8 bytes from the byte of a lane's bit).
+            #[inline(always)]
+            #[allow(unsafe_code)]
+            pub(super) unsafe fn predict_gathered_here(
+                g: &PackedKeys,
+                h: &Headers,
+                base: usize,
+                factor: f32,
+                x0: &mut [i32x8],
+                x1: &mut [i32x8],
+                rows: &mut [f32x8],
+            ) {
+                debug_assert!($detected());
+                // SAFETY: the caller's (above).
+                unsafe { predict_gathered(g, h, base as i32, factor, x0, x1, rows) }
+            }
+
+            #[inline(always)]
+            fn m(x: [i32; 8]) -> __m256i {
+                bytemuck::cast(x)
+            }
+
+            /// The 32 bits from each lane's bit `bit` of `bytes` (bit `p` is bit
+            /// `p % 8` of byte `p / 8`; fewer where they pass a byte's top, the
+            /// caller masks what it reads): gathered from the lane's byte, shifted
+            /// by the rest.
+            ///
+            /// # Safety
+            ///
+            /// Each lane's `bit` is at least 0 and `bit / 8 + 4` at most
+            /// `bytes.len()`.
+            #[inline]
+            #[target_feature(enable = $features)]
+            #[allow(unsafe_code)]
+            unsafe fn bits_at(bytes: &[u8], bit: __m256i) -> I8 {
+                // SAFETY: the caller's: each 4-byte read is inside `bytes`.
+                #[allow(unsafe_code)]
+                let word = unsafe {
+                    _mm256_i32gather_epi32::<1>(bytes.as_ptr().cast(), _mm256_srli_epi32::<3>(bit))
+                };
+                let seven = _mm256_set1_epi32(7);
+                I8(bytemuck::cast(_mm256_srlv_epi32(
+                    word,
+                    _mm256_and_si256(bit, seven),
+                )))
+            }
+
+            /// A block's first keys into `rows` (its first, and its second where
+            /// `rows` has two) and the predictor: each plane's start values and
+            /// deltas gathered from the bits `base + g.start_gather[p]`, as the
+            /// baseline's `block_start` reads them one lane at a time.
+            ///
+            /// # Safety
+            ///
+            /// `crate::isa::avx2()` is true, `g.start_gather` is not empty, and
+            /// `base + g.start_bits + 32` is at most `64 * g.packed.stream.len()`
+            /// and below `i32::MAX`.
+            #[inline(always)]
+            #[allow(unsafe_code)]
+            pub(super) unsafe fn block_start_gathered_here(
+                g: &PackedKeys,
+                base: usize,
+                factor: f32,
+                x0: &mut [i32x8],
+                x1: &mut [i32x8],
+                rows: &mut [f32x8],
+            ) {
+                debug_assert!($detected() && !g.start_gather.is_empty());
+                // SAFETY: the caller's (above).
+                unsafe { block_start_gathered(g, base as i32, factor, x0, x1, rows) }
+            }
+
+            #[target_feature(enable = $features)]
+            fn block_start_gathered(
+                g: &PackedKeys,
+                base: i32,
+                factor: f32,
+                x0: &mut [i32x8],
+                x1: &mut [i32x8],
+                rows: &mut [f32x8],
+            ) {
+                let np = g.planes;
+                let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
+                let base = _mm256_set1_epi32(base);
+                let keys = rows.len() / np;
+                let (row0, row1) = rows.split_at_mut(np);
+                let planes = g.start_gather.iter().zip(&g.step);
+                for (p, ([abs_at, abs_w, delta_at, delta_w], step)) in planes.enumerate() {
+                    let read = |at: &[i32; 8], w: &[i32; 8]| {
+                        let bit = _mm256_add_epi32(base, m(*at));
+                        // SAFETY: every lane's bit ends at or before `base +
+                        // start_bits`, 32 bits before the stream's end
+                        // (`block_start_gathered_here`).
+                        #[allow(unsafe_code)]
+                        let z = unsafe { bits_at(bytes, bit) };
+                        unzigzag_lanes(z & width_lanes(I8(*w)).0)
+                    };
+                    let (start, delta) = (read(abs_at, abs_w), read(delta_at, delta_w));
+                    let step = block_step(W8(step.to_array()), W8([factor; 8]));
+                    let [k0, k1] = block_start_keys(start, delta, keys);
+                    row0[p] = f32x8::new(dequantize_lanes(k0, step).0);
+                    if let Some(row) = row1.get_mut(p) {
+                        *row = f32x8::new(dequantize_lanes(k1, step).0);
+                    }
+                    (x0[p], x1[p]) = (i32x8::new(k0.0), i32x8::new(k1.0));
+                }
+            }
+
+            #[target_feature(enable = $features)]
+            fn predict_gathered(
+                g: &PackedKeys,
+                h: &Headers,
+                base: i32,
+                factor: f32,
+                x0: &mut [i32x8],
+                x1: &mut [i32x8],
+                rows: &mut [f32x8],
+            ) {
+                let np = g.planes;
+                let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
+                let base = _mm256_set1_epi32(base);
+                let n = rows.len() / np;
+                let keys = _mm256_set1_epi32(n as i32);
+                // A plane's coding, first bit and first 64 bits per lane. The
+                // next plane's are read before the current plane's keys run, so
+                // that its gathers (the entries, then the residuals at the bits
+                // they give) wait behind work rather than ahead of it.
+                let setup = |p: usize| {
+                    // SAFETY: the caller's, every index inside `h.entry`.
+                    #[allow(unsafe_code)]
+                    let e = unsafe {
+                        _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p]))
+                    };
+                    let [width, trend, start] = entry_fields(I8(bytemuck::cast(e)));
+                    let bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(start.0), keys));
+                    // SAFETY: as below.
+                    #[allow(unsafe_code)]
+                    let words = unsafe { read_shifted(bytes, bit) };
+                    (width, trend, bit, words)
+                };
+                let planes = &g.stored_planes;
+                let mut next = planes.first().map(|&p| setup(p as usize));
+                for (i, &p) in planes.iter().enumerate() {
+                    let p = p as usize;
+                    let Some((width, trend, mut bit, mut words)) = next else {
+                        break;
+                    };
+                    next = planes.get(i + 1).map(|&p| setup(p as usize));
+                    let (low, bias) = width_lanes(width);
+                    let code = [trend, low, bias].map(|x| V(m(x.0)));
+                    let width = m(width.0);
+                    // Keys whose residuals every lane has in the 57 bits after the
+                    // first one's byte: one 8-byte read per lane serves them all.
+                    let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
+                    let width_q = halves(width);
+                    // The last key and its step.
+                    let (a, b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
+                    let (mut x, mut d) = (b, b - a);
+                    let step = block_step(F(bytemuck::cast(g.step[p])), F(_mm256_set1_ps(factor)));
+                    // Row `r`'s vector of plane `p`: `rows[r * np + p]`.
+                    assert!(p < np, "a stored plane");
+                    let mut at = p;
+                    let mut left = n;
+                    loop {
+                        let k = per.min(left);
+                        left -= k;
+                        for _ in 0..k {
+                            (x, d) = predict(x, d, V(low_words(words)), code);
+                            for (w, s) in words.iter_mut().zip(width_q) {
+                                *w = _mm256_srlv_epi64(*w, s);
+                            }
+                            // SAFETY: `at` is `p` plus `np` times a row below
+                            // `n` (the rows' count), `p < np`: inside `rows`.
+                            #[allow(unsafe_code)]
+                            unsafe {
+                                *rows.get_unchecked_mut(at) =
+                                    bytemuck::cast(dequantize_lanes(x, step).0);
+                            }
+                            at += np;
+                        }
+                        if left == 0 {
+                            break;
+                        }
+                        let k = _mm256_set1_epi32(k as i32);
+                        bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
+                        // SAFETY: every lane's bit is below the bound of
+                        // `predict_gathered_here`'s contract, 64 bits before the
+                        // end of `bytes`, so each 8-byte read is inside it.
+                        #[allow(unsafe_code)]
+                        {
+                            words = unsafe { read_shifted(bytes, bit) };
+                        }
+                    }
+                    (x0[p], x1[p]) = (bytemuck::cast((x - d).0), bytemuck::cast(x.0));
+                }
+            }
+
+            /// Eight `i32` lanes in an AVX register, for [`predict`] and
+            /// `dequantize_lanes` in the decoder's loop over keys: `I8`'s arrays
+            /// there leave LLVM rebuilding loop-invariant vectors lane by lane.
+            /// Each operation is the one AVX2 instruction of `I8`'s (wrapping).
+            #[derive(Clone, Copy)]
+            struct V(__m256i);
+
+            /// Eight `f32` lanes in an AVX register, `V`'s floats.
+            #[derive(Clone, Copy)]
+            struct F(__m256);
+
+            avx_op!(V, Add, add, _mm256_add_epi32);
+            avx_op!(V, Sub, sub, _mm256_sub_epi32);
+            avx_op!(V, BitAnd, bitand, _mm256_and_si256);
+            avx_op!(V, BitOr, bitor, _mm256_or_si256);
+            avx_op!(F, Mul, mul, _mm256_mul_ps);
+
+            impl super::EntryLanes for V {
+                #[inline(always)]
+                fn bytes(x: u64) -> V {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    V(unsafe { _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x as i64)) })
+                }
+                #[inline(always)]
+                fn splat(x: i32) -> V {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    V(unsafe { _mm256_set1_epi32(x) })
+                }
+                #[inline(always)]
+                fn shl<const N: i32>(self) -> V {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    V(unsafe { _mm256_slli_epi32::<N>(self.0) })
+                }
+                #[inline(always)]
+                fn to_array(self) -> [i32; 8] {
+                    bytemuck::cast(self.0)
+                }
+            }
+
+            impl crate::pack::IntLanes for V {
+                type Float = F;
+                #[inline(always)]
+                fn to_float(self) -> F {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    F(unsafe { _mm256_cvtepi32_ps(self.0) })
+                }
+            }
+
+            /// Each lane's 64 bits from the byte of its bit `bit`, shifted to it,
+            /// in two halves of 4 lanes (as u64s).
+            ///
+            /// # Safety
+            ///
+            /// Each lane's `bit / 8 + 8` is at most `bytes.len()`.
+            #[inline]
+            #[target_feature(enable = $features)]
+            #[allow(unsafe_code)]
+            unsafe fn read_shifted(bytes: &[u8], bit: __m256i) -> [__m256i; 2] {
+                let byte = halves(_mm256_srli_epi32::<3>(bit));
+                let shift = halves(_mm256_and_si256(bit, _mm256_set1_epi32(7)));
+                // SAFETY: the caller's.
+                let words = unsafe { [read64(bytes, byte[0]), read64(bytes, byte[1])] };
+                [
+                    _mm256_srlv_epi64(words[0], shift[0]),
+                    _mm256_srlv_epi64(words[1], shift[1]),
+                ]
+            }
+
+            /// How many residuals of a width (at most 25) 57 bits hold: 64 bits
+            /// read from the byte of the first one's bit hold at least 57 after it.
+            const KEYS_IN_57_BITS: [u8; 32] = {
+                let mut t = [SEGMENT_KEYS as u8; 32];
+                let mut w = 1;
+                while w < 32 {
+                    t[w] = (57 / w) as u8;
+                    w += 1;
+                }
+                t
+            };
+
+            /// The largest of the 8 lanes of `x` (as u32).
+            #[inline]
+            #[target_feature(enable = $features)]
+            fn widest(x: __m256i) -> u32 {
+                let x = _mm_max_epu32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+                let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b01_00_11_10>(x));
+                let x = _mm_max_epu32(x, _mm_shuffle_epi32::<0b10_11_00_01>(x));
+                _mm_cvtsi128_si32(x) as u32
+            }
+
+            /// The 8 lanes of `x` as two halves of 4 lanes, each widened to u64:
+            /// lanes 0, 1, 4 and 5, then 2, 3, 6 and 7 (the order in which
+            /// [`low_words`] takes them back with one shuffle).
+            #[inline]
+            #[target_feature(enable = $features)]
+            fn halves(x: __m256i) -> [__m256i; 2] {
+                let zero = _mm256_setzero_si256();
+                [
+                    _mm256_unpacklo_epi32(x, zero),
+                    _mm256_unpackhi_epi32(x, zero),
+                ]
+            }
+
+            /// The low 32 bits of each u64 of two [`halves`], as 8 lanes.
+            #[inline]
+            #[target_feature(enable = $features)]
+            fn low_words([lo, hi]: [__m256i; 2]) -> __m256i {
+                // Per 128 bits: lo's two low words, then hi's.
+                let mixed = _mm256_shuffle_ps::<0b10_00_10_00>(
+                    _mm256_castsi256_ps(lo),
+                    _mm256_castsi256_ps(hi),
+                );
+                _mm256_castps_si256(mixed)
+            }
+
+            /// 8 bytes from `bytes` at each of 4 byte offsets (`at`, as u64).
+            ///
+            /// # Safety
+            ///
+            /// Each offset plus 8 is at most `bytes.len()`.
+            #[inline]
+            #[target_feature(enable = $features)]
+            #[allow(unsafe_code)]
+            unsafe fn read64(bytes: &[u8], at: __m256i) -> __m256i {
+                // SAFETY: the caller's: each 8-byte read is inside `bytes`.
+                unsafe { _mm256_i64gather_epi64::<1>(bytes.as_ptr().cast(), at) }
+            }
+        }
+    };
+}
+
+// AVX2 and FMA (`crate::isa::avx2`).
+#[cfg(target_arch = "x86_64")]
+decoder_instance!(v3, "avx2,fma", crate::isa::avx2);
+// The same code where AVX-512 F, VL, BW and DQ were detected too
+// (`crate::isa::avx512`): the same 256-bit operations, with 32 registers
+// and AVX-512's forms of them to compile to (7% less time a frame on
+// `character-compressed-acl` on Zen 4).
+#[cfg(target_arch = "x86_64")]
+decoder_instance!(
+    v4,
+    "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq",
+    crate::isa::avx512
+);
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
 /// stream into `out[i * stride]`, as stored (`super::width_lanes`' bias above their
