@@ -452,7 +452,7 @@ pub fn table(rows: &[Row], here: &Fingerprint, timing: &Timing) -> String {
             tcb_runtime::Simd::Avx512 => {
                 "the AVX2 instance of the group kernels, the decoder's AVX-512 instance, chosen at run time"
             }
-            tcb_runtime::Simd::Baseline => "the build's own instructions",
+            _ => "the build's own instructions",
         }
     );
     let _ = writeln!(

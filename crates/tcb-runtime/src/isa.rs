@@ -29,8 +29,10 @@
 
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
-/// Which instance of the kernels sampling runs.
+/// Which instance of the kernels sampling runs (more may come: match
+/// with a wildcard arm).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Simd {
     /// The build's own instructions (`wide` as compiled).
     Baseline,
@@ -65,14 +67,13 @@ pub fn simd() -> Simd {
 
 /// Run the packed decoder's AVX2 instance even where AVX-512 was detected
 /// (`true`), or go back to detection (`false`), for every thread: to
-/// compare the instances, or to count instructions under valgrind, which
-/// does not decode AVX-512. A forced baseline
-/// ([`force_baseline_simd`]) stays forced.
+/// compare the instances, to count instructions under valgrind (which
+/// does not decode AVX-512), or where AVX-512 costs clock speed. A
+/// forced baseline ([`force_baseline_simd`]) stays forced.
 pub fn force_no_avx512(on: bool) {
+    // Only the switch: `avx512` reads it beside the detected state, so no
+    // call here can undo another thread's `force_baseline_simd`.
     NO_AVX512.store(on, Ordering::Relaxed);
-    if STATE.load(Ordering::Relaxed) != BASELINE {
-        STATE.store(detect(), Ordering::Relaxed);
-    }
 }
 
 /// Run the build's own instructions even where AVX2 was detected (`true`),
@@ -117,14 +118,16 @@ pub(crate) fn avx2() -> bool {
 }
 
 /// Whether the packed decoder runs its AVX-512 instance (detected with
-/// AVX2, and not forced off).
+/// AVX2, and not forced off by [`force_no_avx512`]). True only where the
+/// CPU has AVX-512 F, VL, BW and DQ: only `detect` finds `AVX512`.
 #[inline(always)]
 pub(crate) fn avx512() -> bool {
-    match STATE.load(Ordering::Relaxed) {
+    let detected = match STATE.load(Ordering::Relaxed) {
         AVX512 => true,
         UNKNOWN => first() == AVX512,
         _ => false,
-    }
+    };
+    detected && !NO_AVX512.load(Ordering::Relaxed)
 }
 
 /// The first call: detect, and remember (out of line).
@@ -137,7 +140,7 @@ fn first() -> u8 {
 }
 
 /// The CPU has AVX2 and FMA (constant where the build enables them), and
-/// AVX-512 F, VL, BW and DQ besides (unless forced off).
+/// AVX-512 F, VL, BW and DQ besides.
 fn detect() -> u8 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
@@ -145,10 +148,7 @@ fn detect() -> u8 {
             && std::arch::is_x86_feature_detected!("avx512vl")
             && std::arch::is_x86_feature_detected!("avx512bw")
             && std::arch::is_x86_feature_detected!("avx512dq");
-        if avx512 && !NO_AVX512.load(Ordering::Relaxed) {
-            return AVX512;
-        }
-        return AVX2;
+        return if avx512 { AVX512 } else { AVX2 };
     }
     BASELINE
 }

@@ -645,7 +645,8 @@ impl PackCache {
         let rows = &mut self.rows[(BEFORE + first) * np..(BEFORE + keys) * np];
         #[cfg(target_arch = "x86_64")]
         if gather {
-            // SAFETY: `gather` holds only where AVX2 runs, and every lane's
+            // SAFETY: `gather` holds only where AVX2 runs (and `instance!`
+            // takes `v4` only where AVX-512 does), and every lane's
             // residuals end at or before `last` (each lane's start is the
             // sum of the widths before it times `keys - first` bits after
             // `pos`, and `last` is `pos` plus the sum over all; lanes
@@ -717,7 +718,8 @@ impl PackCache {
             && *pos + g.start_bits + 32 <= (64 * words.len()).min(i32::MAX as usize)
         {
             let rows = &mut self.rows[BEFORE * np..(BEFORE + first) * np];
-            // SAFETY: AVX2 runs, and every lane's start value and delta end
+            // SAFETY: AVX2 runs (AVX-512 too where `instance!` takes
+            // `v4`), and every lane's start value and delta end
             // at or before `pos + start_bits` (`start_gather`'s bits are
             // sums of the widths before them), which is 32 bits before the
             // stream's end and below i32::MAX.
@@ -975,7 +977,7 @@ macro_rules! decoder_instance {
             // SAFETY (every `_here`): `$detected` found this instance's
             // features on this CPU before the caller came here.
 
-            /// [`interior_tangents`] in AVX2.
+            /// [`interior_tangents`] in this instance.
             #[inline(always)]
             pub(super) fn interior_tangents_here(
                 keys: [&[f32x8]; 4],
@@ -1000,7 +1002,7 @@ macro_rules! decoder_instance {
                 interior_tangents::<W8>(keys, weights, m0, m1);
             }
 
-            /// [`Headers::read`] compiled for AVX2.
+            /// [`Headers::read`] compiled for this instance.
             #[inline(always)]
             pub(super) fn headers_here(
                 h: &mut Headers,
@@ -1025,7 +1027,7 @@ macro_rules! decoder_instance {
                 h.read::<V>(words, pos, headed)
             }
 
-            /// [`rebuild_rows`] in AVX2.
+            /// [`rebuild_rows`] in this instance.
             #[inline(always)]
             pub(super) fn rebuild_rows_here(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
                 debug_assert!($detected());
@@ -1048,7 +1050,7 @@ macro_rules! decoder_instance {
             ///
             /// # Safety
             ///
-            /// `crate::isa::avx2()` is true, every index `i` of `g.plane_index`
+            /// `$detected()` is true (the CPU has this instance's features), every index `i` of `g.plane_index`
             /// is below the length of `h.entry`, and for every lane the sum of the
             /// widths before it and its own, times `k`, plus `base` is
             /// at most `64 * g.packed.stream.len() - 64` and below `i32::MAX`
@@ -1106,7 +1108,7 @@ macro_rules! decoder_instance {
             ///
             /// # Safety
             ///
-            /// `crate::isa::avx2()` is true, `g.start_gather` is not empty, and
+            /// `$detected()` is true (the CPU has this instance's features), `g.start_gather` is not empty, and
             /// `base + g.start_bits + 32` is at most `64 * g.packed.stream.len()`
             /// and below `i32::MAX`.
             #[inline(always)]
