@@ -502,10 +502,11 @@ fn unknown_inputs_name_every_type_the_command_reads() {
     std::fs::write(&txt, "not a clip").unwrap();
     let folder = dir.join("clips");
     std::fs::create_dir_all(&folder).unwrap();
+    let svg = dir.join("never.svg");
     for args in [
         vec!["sample", txt.to_str().unwrap(), "--at", "1"],
         vec!["info", txt.to_str().unwrap()],
-        vec!["plot", txt.to_str().unwrap(), "-o", "never.svg"],
+        vec!["plot", txt.to_str().unwrap(), "-o", svg.to_str().unwrap()],
     ] {
         let o = tcb(&args);
         assert!(!o.status.success(), "{args:?}: accepted");
@@ -517,7 +518,7 @@ fn unknown_inputs_name_every_type_the_command_reads() {
     }
     let o = tcb(&["sample", folder.to_str().unwrap(), "--at", "1"]);
     stderr_has(&o, "clips: a directory, not a clip file");
-    assert!(!dir.join("never.svg").exists());
+    assert!(!svg.exists());
 }
 
 /// A name with a line break and a terminal escape in it (JSON allows

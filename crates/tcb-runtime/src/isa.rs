@@ -9,9 +9,9 @@
 //! formulas, the same IEEE operations per lane in the same order, so the
 //! same bits (`tests/isa.rs` compares the two on every scenario shape).
 //! Where the CPU has AVX-512 F, VL, BW and DQ too, the decoder runs an
-//! instance compiled with them ([`Simd::Avx512`]; the same code, which the
-//! compiler then gives 32 registers and AVX-512's forms of the same
-//! 256-bit operations).
+//! instance compiled with them ([`Simd::Avx512`]; the same source, which
+//! the compiler then gives 32 registers and AVX-512's instructions, a few
+//! of them on 512-bit registers).
 //! Builds with `-C target-cpu=x86-64-v3` or `native` have `wide` in AVX2
 //! already: their group kernels stay `wide`'s (the `W8` instance took 11%
 //! more instructions on `character-hermite` in such a build), and their
@@ -40,8 +40,9 @@ pub enum Simd {
     /// enabled by the build.
     Avx2,
     /// As [`Avx2`](Self::Avx2), and the packed clips' decoder compiled
-    /// with AVX-512 F, VL, BW and DQ too (the same 256-bit operations,
-    /// with 32 registers): detected at run time, unless
+    /// with AVX-512 F, VL, BW and DQ too (the same source; the compiler
+    /// then has 32 registers and AVX-512's instructions, and uses 512-bit
+    /// registers in a few places): detected at run time, unless
     /// [`force_no_avx512`] says otherwise.
     Avx512,
 }
