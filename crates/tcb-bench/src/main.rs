@@ -89,6 +89,10 @@ struct Args {
     /// without it; the instruction counts (--icount) always do
     #[arg(long, conflicts_with = "icount")]
     baseline_simd: bool,
+    /// Time the decoder's AVX2 instance even where the CPU has AVX-512
+    /// (`tcb_runtime::force_no_avx512`), to compare with a run without it
+    #[arg(long, conflicts_with = "icount")]
+    no_avx512: bool,
     /// Run one scenario's pass and exit (what --icount runs under valgrind).
     #[arg(long, value_name = "NAME", hide = true)]
     icount_pass: Option<String>,
@@ -304,6 +308,7 @@ fn run(args: &Args) -> Result<bool, Box<dyn std::error::Error>> {
         return run_icount(args);
     }
     tcb_runtime::force_baseline_simd(args.baseline_simd);
+    tcb_runtime::force_no_avx512(args.no_avx512);
     let timing = timing(args)?;
     // Find and read the saved report first: a bad name or file should fail
     // before a minute of timing.

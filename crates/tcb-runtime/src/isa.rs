@@ -10,8 +10,9 @@
 //! same bits (`tests/isa.rs` compares the two on every scenario shape).
 //! Where the CPU has AVX-512 F, VL, BW and DQ too, the decoder runs an
 //! instance compiled with them ([`Simd::Avx512`]; the same source, which
-//! the compiler then gives 32 registers and AVX-512's instructions, a few
-//! of them on 512-bit registers).
+//! the compiler then gives 32 registers and AVX-512's instructions on
+//! 256-bit registers: no 512-bit ones, which slow the work beside them on
+//! Intel cores; `tools/check/no-512-bit.sh` checks the binary).
 //! Builds with `-C target-cpu=x86-64-v3` or `native` have `wide` in AVX2
 //! already: their group kernels stay `wide`'s (the `W8` instance took 11%
 //! more instructions on `character-hermite` in such a build), and their
@@ -41,8 +42,8 @@ pub enum Simd {
     Avx2,
     /// As [`Avx2`](Self::Avx2), and the packed clips' decoder compiled
     /// with AVX-512 F, VL, BW and DQ too (the same source; the compiler
-    /// then has 32 registers and AVX-512's instructions, and uses 512-bit
-    /// registers in a few places): detected at run time, unless
+    /// then has 32 registers and AVX-512's instructions, on 256-bit
+    /// registers): detected at run time, unless
     /// [`force_no_avx512`] says otherwise.
     Avx512,
 }

@@ -968,8 +968,9 @@ macro_rules! decoder_instance {
                 _mm256_cvtepu8_epi32, _mm256_extracti128_si256, _mm256_i32gather_epi32,
                 _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_or_si256,
                 _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps,
-                _mm256_slli_epi32, _mm256_srli_epi32, _mm256_srlv_epi32, _mm256_srlv_epi64,
-                _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
+                _mm256_slli_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
+                _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
+                _mm256_xor_si256,
             };
             use tcb_core::simd::w8::{I8, W8};
             use wide::{f32x8, i32x8};
@@ -1189,8 +1190,8 @@ macro_rules! decoder_instance {
                     let e = unsafe {
                         _mm256_i32gather_epi32::<4>(h.entry.as_ptr(), m(g.plane_index[p]))
                     };
-                    let [width, trend, start] = entry_fields(I8(bytemuck::cast(e)));
-                    let bit = _mm256_add_epi32(base, _mm256_mullo_epi32(m(start.0), keys));
+                    let [width, trend, start] = entry_fields(V(e));
+                    let bit = _mm256_add_epi32(base, _mm256_mullo_epi32(start.0, keys));
                     // SAFETY: as below.
                     #[allow(unsafe_code)]
                     let words = unsafe { read_shifted(bytes, bit) };
@@ -1205,8 +1206,8 @@ macro_rules! decoder_instance {
                     };
                     next = planes.get(i + 1).map(|&p| setup(p as usize));
                     let (low, bias) = width_lanes(width);
-                    let code = [trend, low, bias].map(|x| V(m(x.0)));
-                    let width = m(width.0);
+                    let code = [trend, low, bias];
+                    let width = width.0;
                     // Keys whose residuals every lane has in the 57 bits after the
                     // first one's byte: one 8-byte read per lane serves them all.
                     let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
@@ -1268,6 +1269,7 @@ macro_rules! decoder_instance {
             avx_op!(V, Sub, sub, _mm256_sub_epi32);
             avx_op!(V, BitAnd, bitand, _mm256_and_si256);
             avx_op!(V, BitOr, bitor, _mm256_or_si256);
+            avx_op!(V, BitXor, bitxor, _mm256_xor_si256);
             avx_op!(F, Mul, mul, _mm256_mul_ps);
 
             impl super::EntryLanes for V {
@@ -1292,6 +1294,44 @@ macro_rules! decoder_instance {
                 #[inline(always)]
                 fn to_array(self) -> [i32; 8] {
                     bytemuck::cast(self.0)
+                }
+            }
+
+            // A plane's coding computed on `V` rather than `I8`: on `I8`'s
+            // arrays LLVM's vectorizer joined the three fields of
+            // `entry_fields` into 512-bit operations in the AVX-512
+            // instance, and one 512-bit instruction in a loop slows the
+            // 256-bit work around it on Intel cores (their vector port 1
+            // stops while 512-bit work is in flight).
+            impl crate::pack::BitLanes for V {
+                // SAFETY: plain bits, the layout of `__m256i`.
+                #[allow(unsafe_code)]
+                const ZERO: V = V(unsafe { std::mem::transmute::<[i32; 8], __m256i>([0; 8]) });
+                #[allow(unsafe_code)]
+                const ONE: V = V(unsafe { std::mem::transmute::<[i32; 8], __m256i>([1; 8]) });
+                #[inline(always)]
+                fn splat(x: i32) -> V {
+                    <V as super::EntryLanes>::splat(x)
+                }
+                #[inline(always)]
+                fn shr<const N: u32>(self) -> V {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    V(unsafe { _mm256_srlv_epi32(self.0, _mm256_set1_epi32(N as i32)) })
+                }
+                #[inline(always)]
+                fn half(self) -> V {
+                    self.shr::<1>()
+                }
+                #[inline(always)]
+                fn shl_each(self, n: V) -> V {
+                    // SAFETY: as `avx_op`'s.
+                    #[allow(unsafe_code)]
+                    V(unsafe { _mm256_sllv_epi32(self.0, n.0) })
+                }
+                #[inline(always)]
+                fn sub_wrapping(self, o: V) -> V {
+                    self - o
                 }
             }
 
@@ -1393,9 +1433,9 @@ macro_rules! decoder_instance {
 decoder_instance!(v3, "avx2,fma", crate::isa::avx2);
 // The same code where AVX-512 F, VL, BW and DQ were detected too
 // (`crate::isa::avx512`): 32 registers and AVX-512's instructions to
-// compile to (a few operations of `predict_gathered`'s setup land on
-// 512-bit registers); about 8% less time a frame on
-// `character-compressed-acl` on Zen 4.
+// compile to, on 256-bit registers only (`tools/check/no-512-bit.sh`);
+// about 8% less time a frame on `character-compressed-acl` on Zen 4, the
+// same as the AVX2 instance on an Intel Xeon with AVX-512.
 #[cfg(target_arch = "x86_64")]
 decoder_instance!(
     v4,
