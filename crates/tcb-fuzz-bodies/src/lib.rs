@@ -33,6 +33,20 @@ pub use quantize::quantize;
 pub use reduce_readback::reduce_readback;
 pub use roundtrip::roundtrip;
 
+/// The instruction set an input runs on, from its last byte (read apart
+/// from the rest, so that the corpus parses as before): bit 1 the
+/// baseline kernels and decoder (`force_baseline_simd`), else bit 0 the
+/// decoder's AVX2 instance where the CPU has AVX-512 (`force_no_avx512`),
+/// so that one host fuzzes every instance it can run. Global switches:
+/// every instance gives the same bits (`tcb-runtime/tests/isa.rs`), so an
+/// input replayed beside another one (the corpus test's threads) checks
+/// the same things whichever runs.
+fn choose_simd(data: &[u8]) {
+    let b = data.last().copied().unwrap_or(0);
+    tcb_runtime::force_baseline_simd(b & 2 != 0);
+    tcb_runtime::force_no_avx512(b & 1 != 0);
+}
+
 /// `tcb-clip/1` JSON: parse, build, then play what builds.
 pub fn clip_json(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
@@ -75,6 +89,7 @@ pub fn gltf(data: &[u8]) {
 /// A structured clip (every kind, rule, end, ease, interpolation,
 /// extrapolation and rotation mode, sane or not) and arbitrary times.
 pub fn runtime(data: &[u8]) {
+    choose_simd(data);
     let mut u = Unstructured::new(data);
     let Ok(doc) = arbitrary_doc(&mut u) else {
         return;
@@ -165,6 +180,7 @@ pub fn reduce(data: &[u8]) {
 /// the checksum. What reads back writes the same bytes; what compiles plays
 /// as its reference (the decoded integers' `to_clip`, compiled) does.
 pub fn tcbc(data: &[u8]) {
+    choose_simd(data);
     let claimed = data
         .get(12..20)
         .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")));
@@ -232,6 +248,7 @@ pub fn tcbc(data: &[u8]) {
 /// the reference's controls: quantize and encode accepted the clip, so the
 /// runtime's tangents or decoding disagree with the reference.
 pub fn pack(data: &[u8]) {
+    choose_simd(data);
     let mut u = Unstructured::new(data);
     let Ok(input) = arbitrary_pack(&mut u) else {
         return;
@@ -323,6 +340,7 @@ pub fn pack(data: &[u8]) {
 /// (`Clip::from_bytes`), and measured again from them, at every check
 /// time of the contract, it is within the tolerance too.
 pub fn compress(data: &[u8]) {
+    choose_simd(data);
     let mut u = Unstructured::new(data);
     let Ok(input) = arbitrary_pack(&mut u) else {
         return;

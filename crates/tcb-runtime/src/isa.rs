@@ -132,6 +132,20 @@ pub(crate) fn avx512() -> bool {
     detected && !NO_AVX512.load(Ordering::Relaxed)
 }
 
+/// Whether this CPU has the decoder's AVX2 instance's features (AVX2 and
+/// FMA), and the AVX-512 instance's, whatever is forced: what the
+/// instances' debug checks read, since a switch that another thread
+/// flips while one runs does not make it run on a CPU without them.
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn cpu_avx2() -> bool {
+    detect() != BASELINE
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn cpu_avx512() -> bool {
+    detect() == AVX512
+}
+
 /// The first call: detect, and remember (out of line).
 #[cold]
 #[inline(never)]

@@ -946,7 +946,8 @@ macro_rules! avx_op {
 }
 
 /// The decoder compiled for x86-64 features `$features` (AVX2 and FMA at
-/// least), run where `$detected()` says the CPU has them (`crate::isa`):
+/// least), run where `crate::isa` chose it (`instance!`); `$detected()`
+/// says whether the CPU has them (what the debug checks read):
 /// the same formulas ([`predict`], `dequantize_lanes`, [`rebuild_rows`],
 /// [`interior_tangents`]) on `tcb_core::simd::w8`'s `I8` and `W8`, and
 /// each key's residuals of a plane gathered straight from the stream.
@@ -975,8 +976,9 @@ macro_rules! decoder_instance {
             use tcb_core::simd::w8::{I8, W8};
             use wide::{f32x8, i32x8};
 
-            // SAFETY (every `_here`): `$detected` found this instance's
-            // features on this CPU before the caller came here.
+            // SAFETY (every `_here`): the caller came here where
+            // `crate::isa` chose this instance, which it does only where the
+            // CPU has its features (`$detected`).
 
             /// [`interior_tangents`] in this instance.
             #[inline(always)]
@@ -1430,7 +1432,7 @@ macro_rules! decoder_instance {
 
 // AVX2 and FMA (`crate::isa::avx2`).
 #[cfg(target_arch = "x86_64")]
-decoder_instance!(v3, "avx2,fma", crate::isa::avx2);
+decoder_instance!(v3, "avx2,fma", crate::isa::cpu_avx2);
 // The same code where AVX-512 F, VL, BW and DQ were detected too
 // (`crate::isa::avx512`): 32 registers and AVX-512's instructions to
 // compile to, on 256-bit registers only (`tools/check/no-512-bit.sh`);
@@ -1440,7 +1442,7 @@ decoder_instance!(v3, "avx2,fma", crate::isa::avx2);
 decoder_instance!(
     v4,
     "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq",
-    crate::isa::avx512
+    crate::isa::cpu_avx512
 );
 
 /// Unpacks 16 values of one width (the index) from a bit position of a
