@@ -155,11 +155,19 @@ fn first() -> u8 {
     state
 }
 
-/// The CPU has AVX2 and FMA (constant where the build enables them), and
+/// The CPU has AVX2 and FMA (constant where the build enables them) and
+/// the scalar bit instructions every such CPU has (x86-64-v3's BMI1, BMI2,
+/// LZCNT and POPCNT, which the decoder's instances compile with), and
 /// AVX-512 F, VL, BW and DQ besides.
 fn detect() -> u8 {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+        && std::arch::is_x86_feature_detected!("popcnt")
+    {
         let avx512 = std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512vl")
             && std::arch::is_x86_feature_detected!("avx512bw")

@@ -1332,6 +1332,30 @@ fn spread2(x: u64) -> u64 {
     (x | (x << 6)) & (3 * BYTES)
 }
 
+/// How [`header_group`] spreads bit fields into bytes: [`Portable`]'s
+/// shifts and masks, or BMI2's `pdep` in the decoder's instances (the
+/// same function: their tests compare every input).
+pub(crate) trait Spread {
+    /// Bit `i` of `x` (`i < 8`) into byte `i`.
+    fn spread1(x: u64) -> u64;
+    /// The 2-bit field `i` of `x` (`i < 8`) into byte `i`.
+    fn spread2(x: u64) -> u64;
+}
+
+/// [`Spread`] in shifts and masks, on any CPU.
+pub(crate) struct Portable;
+
+impl Spread for Portable {
+    #[inline(always)]
+    fn spread1(x: u64) -> u64 {
+        spread1(x)
+    }
+    #[inline(always)]
+    fn spread2(x: u64) -> u64 {
+        spread2(x)
+    }
+}
+
 /// One header group as read ([`header_group`]), a byte per component.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct HeaderGroup {
@@ -1351,10 +1375,15 @@ pub(crate) struct HeaderGroup {
 /// a step per width coded whole: the one rule of the reference reader and
 /// of both decoders.
 #[inline(always)]
-pub(crate) fn header_group(fixed: u64, tails: u64, k: usize, before: u64) -> HeaderGroup {
+pub(crate) fn header_group<S: Spread>(
+    fixed: u64,
+    tails: u64,
+    k: usize,
+    before: u64,
+) -> HeaderGroup {
     debug_assert!((1..=GROUP).contains(&k));
-    let order1 = spread1(fixed & ((1 << k) - 1));
-    let code = spread2((fixed >> k) & ((1 << (2 * k)) - 1));
+    let order1 = S::spread1(fixed & ((1 << k) - 1));
+    let code = S::spread2((fixed >> k) & ((1 << (2 * k)) - 1));
     let (lo, hi) = (code & BYTES, (code >> 1) & BYTES);
     let whole = lo & hi;
     // Codes 1 and 2 (one more, one less), each byte kept from its
@@ -1691,7 +1720,7 @@ impl Packed {
             *b = widths[l].min(63) as u8;
         }
         let (fixed, tails) = (window(&self.stream, at[0]), window(&self.stream, at[1]));
-        let read = header_group(fixed, tails, group.len(), u64::from_le_bytes(before));
+        let read = header_group::<Portable>(fixed, tails, group.len(), u64::from_le_bytes(before));
         let (width, order1) = (read.width.to_le_bytes(), read.order1.to_le_bytes());
         for (i, &l) in group.iter().enumerate() {
             if width[i] >= 1 << WIDTH_BITS {
@@ -1820,7 +1849,7 @@ pub(crate) mod store;
 
 #[cfg(test)]
 mod tests {
-    use super::{BitWriter, GROUP, WIDTH_BITS, header_group, put_headers, width_lanes};
+    use super::{BitWriter, GROUP, Portable, WIDTH_BITS, header_group, put_headers, width_lanes};
     use tcb_core::simd::w8::I8;
 
     /// Headers of 1 to 24 components (up to 3 groups), as written, read
@@ -1867,7 +1896,7 @@ mod tests {
                     *b = h.2 as u8;
                 }
                 let (fixed, tails) = (super::window(&words, at[0]), super::window(&words, at[1]));
-                let read = header_group(fixed, tails, k, u64::from_le_bytes(before));
+                let read = header_group::<Portable>(fixed, tails, k, u64::from_le_bytes(before));
                 let (o, wd) = (read.order1.to_le_bytes(), read.width.to_le_bytes());
                 for (i, h) in group.iter().enumerate() {
                     assert_eq!((o[i], wd[i]), ((2 - h.0) as u8, h.1 as u8), "{headers:?}");
@@ -1886,7 +1915,7 @@ mod tests {
     fn a_header_group_out_of_range_shows() {
         // Three lanes: one less than 0, one more than 31, the same 5.
         let v = (2 << 3) | (1 << 5);
-        let read = header_group(v, 0, 3, u64::from_le_bytes([0, 31, 5, 0, 0, 0, 0, 0]));
+        let read = header_group::<Portable>(v, 0, 3, u64::from_le_bytes([0, 31, 5, 0, 0, 0, 0, 0]));
         let wd = read.width.to_le_bytes();
         assert!(wd[0] > 31 && wd[1] > 31, "{wd:?}");
         assert_eq!(wd[2..], [5, 0, 0, 0, 0, 0]);

@@ -609,10 +609,13 @@ impl PackCache {
         let read = if crate::isa::avx2() {
             instance!(headers_here(&mut self.headers, words, pos, g.headed.len()))
         } else {
-            self.headers.read::<i32x8>(words, pos, g.headed.len())
+            self.headers
+                .read::<i32x8, super::Portable>(words, pos, g.headed.len())
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let read = self.headers.read::<i32x8>(words, pos, g.headed.len());
+        let read = self
+            .headers
+            .read::<i32x8, super::Portable>(words, pos, g.headed.len());
         (pos, before, narrow) = read;
         if block {
             let written = self.block_start(g, &mut pos, keys);
@@ -844,7 +847,7 @@ impl Headers {
     /// them, the sum of the widths, and whether each is at most
     /// [`GATHER_WIDTH`].
     #[inline(always)]
-    fn read<L: EntryLanes>(
+    fn read<L: EntryLanes, S: super::Spread>(
         &mut self,
         words: &[u64],
         pos: usize,
@@ -859,7 +862,7 @@ impl Headers {
             let width = &mut self.width[lanes.clone()];
             let before = u64::from_le_bytes(width.try_into().expect("8 lanes"));
             let fixed = window(words, pos + 3 * at);
-            let read = header_group(fixed, window(words, tail), k, before);
+            let read = header_group::<S>(fixed, window(words, tail), k, before);
             tail += super::WIDTH_BITS as usize * read.whole;
             width.copy_from_slice(&read.width.to_le_bytes());
             // The sums of the widths up to each byte (at most 248).
@@ -971,7 +974,7 @@ macro_rules! decoder_instance {
                 _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps,
                 _mm256_slli_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
                 _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
-                _mm256_xor_si256,
+                _mm256_xor_si256, _pdep_u64,
             };
             use tcb_core::simd::w8::{I8, W8};
             use wide::{f32x8, i32x8};
@@ -1027,7 +1030,7 @@ macro_rules! decoder_instance {
                 pos: usize,
                 headed: usize,
             ) -> (usize, usize, bool) {
-                h.read::<V>(words, pos, headed)
+                h.read::<V, Pdep>(words, pos, headed)
             }
 
             /// [`rebuild_rows`] in this instance.
@@ -1214,36 +1217,56 @@ macro_rules! decoder_instance {
                     // first one's byte: one 8-byte read per lane serves them all.
                     let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
                     let width_q = halves(width);
+                    // The bits a chunk of `per` keys takes (each chunk that
+                    // ends before the last key has `per`).
+                    let chunk_bits = _mm256_mullo_epi32(width, _mm256_set1_epi32(per as i32));
                     // The last key and its step.
                     let (a, b) = (V(bytemuck::cast(x0[p])), V(bytemuck::cast(x1[p])));
                     let (mut x, mut d) = (b, b - a);
                     let step = block_step(F(bytemuck::cast(g.step[p])), F(_mm256_set1_ps(factor)));
-                    // Row `r`'s vector of plane `p`: `rows[r * np + p]`.
-                    assert!(p < np, "a stored plane");
-                    let mut at = p;
-                    let mut left = n;
-                    loop {
-                        let k = per.min(left);
-                        left -= k;
-                        for _ in 0..k {
+                    // Row `r`'s vector of plane `p`: `rows[r * np + p]`,
+                    // written through `out`, `np` vectors on per key.
+                    assert!(p < np && rows.len() == n * np, "a stored plane");
+                    // SAFETY: `p < rows.len()` (`p < np`, `n >= 1`).
+                    #[allow(unsafe_code)]
+                    let mut out = unsafe { rows.as_mut_ptr().add(p) };
+                    // One key: the prediction, the residuals' window on, the
+                    // key written. SAFETY (of `out`'s write and step): `out`
+                    // is at row `r < n` of plane `p` (at most `n` keys are
+                    // written, each one row on), inside `rows`; after the
+                    // last key it is one row past, as `add` allows (at most
+                    // `np - p` vectors past the end).
+                    macro_rules! key {
+                        () => {
                             (x, d) = predict(x, d, V(low_words(words)), code);
                             for (w, s) in words.iter_mut().zip(width_q) {
                                 *w = _mm256_srlv_epi64(*w, s);
                             }
-                            // SAFETY: `at` is `p` plus `np` times a row below
-                            // `n` (the rows' count), `p < np`: inside `rows`.
                             #[allow(unsafe_code)]
                             unsafe {
-                                *rows.get_unchecked_mut(at) =
-                                    bytemuck::cast(dequantize_lanes(x, step).0);
+                                out.write(bytemuck::cast(dequantize_lanes(x, step).0));
+                                out = out.wrapping_add(np);
                             }
-                            at += np;
+                        };
+                    }
+                    let mut left = n;
+                    loop {
+                        let k = per.min(left);
+                        left -= k;
+                        // Two keys an iteration: the loop's count and branch
+                        // once for both.
+                        for _ in 0..k / 2 {
+                            key!();
+                            key!();
+                        }
+                        if k % 2 == 1 {
+                            key!();
                         }
                         if left == 0 {
                             break;
                         }
-                        let k = _mm256_set1_epi32(k as i32);
-                        bit = _mm256_add_epi32(bit, _mm256_mullo_epi32(width, k));
+                        debug_assert_eq!(k, per, "a chunk before the last");
+                        bit = _mm256_add_epi32(bit, chunk_bits);
                         // SAFETY: every lane's bit is below the bound of
                         // `predict_gathered_here`'s contract, 64 bits before the
                         // end of `bytes`, so each 8-byte read is inside it.
@@ -1334,6 +1357,53 @@ macro_rules! decoder_instance {
                 #[inline(always)]
                 fn sub_wrapping(self, o: V) -> V {
                     self - o
+                }
+            }
+
+            /// [`crate::pack::Spread`] with BMI2's `pdep`, for `headers`
+            /// (which runs where this instance's features, BMI2 among them,
+            /// are: as `avx_op`'s).
+            struct Pdep;
+
+            impl crate::pack::Spread for Pdep {
+                #[inline(always)]
+                fn spread1(x: u64) -> u64 {
+                    // SAFETY: as `avx_op`'s (BMI2).
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        _pdep_u64(x, crate::pack::BYTES)
+                    }
+                }
+                #[inline(always)]
+                fn spread2(x: u64) -> u64 {
+                    // SAFETY: as `avx_op`'s (BMI2).
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        _pdep_u64(x, 3 * crate::pack::BYTES)
+                    }
+                }
+            }
+
+            /// `Pdep` is `Portable` on every input either takes.
+            #[cfg(test)]
+            #[test]
+            fn pdep_spreads_as_the_portable_code() {
+                use crate::pack::{Portable, Spread};
+                #[target_feature(enable = $features)]
+                fn check() {
+                    for x in 0..1u64 << 8 {
+                        assert_eq!(Pdep::spread1(x), Portable::spread1(x), "{x:#x}");
+                    }
+                    for x in 0..1u64 << 16 {
+                        assert_eq!(Pdep::spread2(x), Portable::spread2(x), "{x:#x}");
+                    }
+                }
+                if $detected() {
+                    // SAFETY: the CPU has this instance's features.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        check()
+                    }
                 }
             }
 
@@ -1430,9 +1500,9 @@ macro_rules! decoder_instance {
     };
 }
 
-// AVX2 and FMA (`crate::isa::avx2`).
+// AVX2, FMA and the bit instructions of x86-64-v3 (`crate::isa::avx2`).
 #[cfg(target_arch = "x86_64")]
-decoder_instance!(v3, "avx2,fma", crate::isa::cpu_avx2);
+decoder_instance!(v3, "avx2,fma,bmi1,bmi2,lzcnt,popcnt", crate::isa::cpu_avx2);
 // The same code where AVX-512 F, VL, BW and DQ were detected too
 // (`crate::isa::avx512`): 32 registers and AVX-512's instructions to
 // compile to, on 256-bit registers only (`tools/check/no-512-bit.sh`);
@@ -1441,7 +1511,7 @@ decoder_instance!(v3, "avx2,fma", crate::isa::cpu_avx2);
 #[cfg(target_arch = "x86_64")]
 decoder_instance!(
     v4,
-    "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq",
+    "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq",
     crate::isa::cpu_avx512
 );
 
