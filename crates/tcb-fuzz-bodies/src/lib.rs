@@ -42,9 +42,26 @@ pub use roundtrip::roundtrip;
 /// input replayed beside another one (the corpus test's threads) checks
 /// the same things whichever runs.
 fn choose_simd(data: &[u8]) {
-    let b = data.last().copied().unwrap_or(0);
+    let b = match FIXED_SIMD.load(std::sync::atomic::Ordering::Relaxed) {
+        FROM_INPUT => data.last().copied().unwrap_or(0),
+        fixed => fixed,
+    };
     tcb_runtime::force_baseline_simd(b & 2 != 0);
     tcb_runtime::force_no_avx512(b & 1 != 0);
+}
+
+/// [`fix_simd`]'s "from the input".
+const FROM_INPUT: u8 = u8::MAX;
+static FIXED_SIMD: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(FROM_INPUT);
+
+/// Play every input on one instruction set, `Some(b)` as an input whose
+/// last byte is `b` would choose it (0 what the CPU has, 1 the AVX2
+/// instance where it has AVX-512 too, 2 the baseline), or `None`: each
+/// input's own choice again. For the corpus replay, which runs each
+/// committed input on every instance whatever its last byte says.
+pub fn fix_simd(mode: Option<u8>) {
+    let m = mode.map_or(FROM_INPUT, |b| b & 3);
+    FIXED_SIMD.store(m, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// `tcb-clip/1` JSON: parse, build, then play what builds.

@@ -23,6 +23,23 @@ fn replay(target: &str, body: fn(&[u8])) {
     }
 }
 
+/// [`replay`] of a target whose body chooses the instruction set from
+/// each input's last byte (`tcb_fuzz_bodies::fix_simd`): every input on
+/// every instance the host runs (what the CPU has, the AVX2 instance
+/// where it has AVX-512, the baseline), whatever its last byte says. The
+/// switches are global: one such target at a time.
+fn replay_on_every_instance(target: &str, body: fn(&[u8])) {
+    static SWITCHES: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one = SWITCHES.lock().unwrap_or_else(|e| e.into_inner());
+    for mode in [0, 1, 2] {
+        bodies::fix_simd(Some(mode));
+        replay(target, body);
+    }
+    bodies::fix_simd(None);
+    tcb_runtime::force_baseline_simd(false);
+    tcb_runtime::force_no_avx512(false);
+}
+
 #[test]
 fn clip_json_corpus() {
     replay("clip_json", bodies::clip_json);
@@ -40,7 +57,7 @@ fn gltf_corpus() {
 
 #[test]
 fn runtime_corpus() {
-    replay("runtime", bodies::runtime);
+    replay_on_every_instance("runtime", bodies::runtime);
 }
 
 #[test]
@@ -50,7 +67,7 @@ fn blend_corpus() {
 
 #[test]
 fn compress_corpus() {
-    replay("compress", bodies::compress);
+    replay_on_every_instance("compress", bodies::compress);
 }
 
 #[test]
@@ -60,12 +77,12 @@ fn reduce_corpus() {
 
 #[test]
 fn tcbc_corpus() {
-    replay("tcbc", bodies::tcbc);
+    replay_on_every_instance("tcbc", bodies::tcbc);
 }
 
 #[test]
 fn pack_corpus() {
-    replay("pack", bodies::pack);
+    replay_on_every_instance("pack", bodies::pack);
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! The instruction set of the sampling kernels, chosen at run time.
 //!
 //! A default x86-64 build runs `wide`'s `f32x8` as two SSE2 halves. Where
-//! the CPU has AVX2 and FMA, the group kernels (vector channels, and
+//! the CPU has AVX2 and FMA (and BMI1, BMI2, LZCNT and POPCNT, which
+//! every such CPU has: x86-64-v3's set), the group kernels (vector channels, and
 //! rotation values), the expansion of 16-bit controls, the loose
 //! tracks' blocks and the packed clips' decoder run an instance compiled
 //! for them instead, on
@@ -37,8 +38,9 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 pub enum Simd {
     /// The build's own instructions (`wide` as compiled).
     Baseline,
-    /// AVX2 and FMA: detected at run time in a default x86-64 build, or
-    /// enabled by the build.
+    /// AVX2 and FMA (with x86-64-v3's BMI1, BMI2, LZCNT and POPCNT):
+    /// detected at run time in a default x86-64 build, or enabled by the
+    /// build.
     Avx2,
     /// As [`Avx2`](Self::Avx2), and the packed clips' decoder compiled
     /// with AVX-512 F, VL, BW and DQ too (the same source; the compiler
@@ -144,6 +146,46 @@ pub(crate) fn cpu_avx2() -> bool {
 #[cfg(target_arch = "x86_64")]
 pub(crate) fn cpu_avx512() -> bool {
     detect() == AVX512
+}
+
+/// Whether BMI2's `pdep` is one fast instruction here, as on Intel and
+/// on AMD from Zen 3 on; on Zen 1 and Zen 2 (AMD family 0x17, Hygon 0x18)
+/// it is microcoded, at a cost per set bit of its mask, and the decoder's
+/// headers spread their fields with shifts and masks instead.
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn fast_pdep() -> bool {
+    static FAST: AtomicU8 = AtomicU8::new(UNKNOWN);
+    match FAST.load(Ordering::Relaxed) {
+        UNKNOWN => {
+            let fast = !slow_pdep_cpu();
+            FAST.store(if fast { AVX2 } else { BASELINE }, Ordering::Relaxed);
+            fast
+        }
+        s => s == AVX2,
+    }
+}
+
+/// AMD or Hygon before family 0x19 (`cpuid` leaves 0 and 1).
+#[cfg(target_arch = "x86_64")]
+#[cold]
+fn slow_pdep_cpu() -> bool {
+    use std::arch::x86_64::__cpuid;
+    let v = __cpuid(0);
+    let mut vendor = [0u8; 12];
+    for (out, r) in vendor.chunks_exact_mut(4).zip([v.ebx, v.edx, v.ecx]) {
+        out.copy_from_slice(&r.to_le_bytes());
+    }
+    if &vendor != b"AuthenticAMD" && &vendor != b"HygonGenuine" {
+        return false;
+    }
+    let eax = __cpuid(1).eax;
+    let base = (eax >> 8) & 0xf;
+    let family = if base == 0xf {
+        base + ((eax >> 20) & 0xff)
+    } else {
+        base
+    };
+    family < 0x19
 }
 
 /// The first call: detect, and remember (out of line).

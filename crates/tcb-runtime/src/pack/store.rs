@@ -1030,7 +1030,11 @@ macro_rules! decoder_instance {
                 pos: usize,
                 headed: usize,
             ) -> (usize, usize, bool) {
-                h.read::<V, Pdep>(words, pos, headed)
+                if crate::isa::fast_pdep() {
+                    h.read::<V, Pdep>(words, pos, headed)
+                } else {
+                    h.read::<V, crate::pack::Portable>(words, pos, headed)
+                }
             }
 
             /// [`rebuild_rows`] in this instance.
@@ -1181,9 +1185,15 @@ macro_rules! decoder_instance {
                 rows: &mut [f32x8],
             ) {
                 let np = g.planes;
+                let n = rows.len() / np;
+                if n == 0 {
+                    // A block's segment of at most two keys: its start
+                    // values and deltas gave them all (the predictor as it
+                    // was).
+                    return;
+                }
                 let bytes: &[u8] = bytemuck::cast_slice(&g.packed.stream);
                 let base = _mm256_set1_epi32(base);
-                let n = rows.len() / np;
                 let keys = _mm256_set1_epi32(n as i32);
                 // A plane's coding, first bit and first 64 bits per lane. The
                 // next plane's are read before the current plane's keys run, so
@@ -1227,15 +1237,15 @@ macro_rules! decoder_instance {
                     // Row `r`'s vector of plane `p`: `rows[r * np + p]`,
                     // written through `out`, `np` vectors on per key.
                     assert!(p < np && rows.len() == n * np, "a stored plane");
-                    // SAFETY: `p < rows.len()` (`p < np`, `n >= 1`).
+                    // SAFETY: `p < np <= rows.len()` (`n >= 1` above).
                     #[allow(unsafe_code)]
                     let mut out = unsafe { rows.as_mut_ptr().add(p) };
                     // One key: the prediction, the residuals' window on, the
-                    // key written. SAFETY (of `out`'s write and step): `out`
-                    // is at row `r < n` of plane `p` (at most `n` keys are
-                    // written, each one row on), inside `rows`; after the
-                    // last key it is one row past, as `add` allows (at most
-                    // `np - p` vectors past the end).
+                    // key written. SAFETY (of `out`'s write): before key `r`
+                    // (`r < n`: the chunks' keys add up to `n`), `out` is
+                    // `rows[r * np + p]`, inside `rows`. After the last key
+                    // it points `p` vectors past the end and is not read:
+                    // `wrapping_add` makes no claim about where it points.
                     macro_rules! key {
                         () => {
                             (x, d) = predict(x, d, V(low_words(words)), code);
