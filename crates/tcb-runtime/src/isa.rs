@@ -175,10 +175,17 @@ fn slow_pdep_cpu() -> bool {
     for (out, r) in vendor.chunks_exact_mut(4).zip([v.ebx, v.edx, v.ecx]) {
         out.copy_from_slice(&r.to_le_bytes());
     }
-    if &vendor != b"AuthenticAMD" && &vendor != b"HygonGenuine" {
+    slow_pdep(&vendor, __cpuid(1).eax)
+}
+
+/// [`slow_pdep_cpu`] from the vendor string (`cpuid` leaf 0's `ebx edx
+/// ecx`) and leaf 1's `eax` (the family: base, plus extended where base
+/// is 0xf).
+#[cfg(target_arch = "x86_64")]
+fn slow_pdep(vendor: &[u8; 12], eax: u32) -> bool {
+    if vendor != b"AuthenticAMD" && vendor != b"HygonGenuine" {
         return false;
     }
-    let eax = __cpuid(1).eax;
     let base = (eax >> 8) & 0xf;
     let family = if base == 0xf {
         base + ((eax >> 20) & 0xff)
@@ -217,4 +224,24 @@ fn detect() -> u8 {
         return if avx512 { AVX512 } else { AVX2 };
     }
     BASELINE
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::slow_pdep;
+
+    /// Leaf 1's `eax` of real parts: Zen 1, Zen 2 and Hygon Dhyana have a
+    /// microcoded `pdep`; Zen 3 and later, and Intel, do not.
+    #[test]
+    fn pdep_is_slow_on_zen_1_and_2_only() {
+        let (amd, hygon, intel) = (b"AuthenticAMD", b"HygonGenuine", b"GenuineIntel");
+        assert!(slow_pdep(amd, 0x0080_0F12), "Zen 1 (family 0x17)");
+        assert!(slow_pdep(amd, 0x0083_0F10), "Zen 2 (family 0x17)");
+        assert!(slow_pdep(hygon, 0x0090_0F01), "Hygon (family 0x18)");
+        assert!(!slow_pdep(amd, 0x00A0_0F11), "Zen 3 (family 0x19)");
+        assert!(!slow_pdep(amd, 0x00A1_0F11), "Zen 4 (family 0x19)");
+        assert!(!slow_pdep(amd, 0x00B4_0F40), "Zen 5 (family 0x1A)");
+        assert!(!slow_pdep(intel, 0x0008_06F8), "Sapphire Rapids");
+        assert!(!slow_pdep(intel, 0x0000_0F41), "an Intel family 0xf part");
+    }
 }
