@@ -226,14 +226,14 @@ fn detect() -> u8 {
     BASELINE
 }
 
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
 mod tests {
-    use super::slow_pdep;
-
     /// Leaf 1's `eax` of real parts: Zen 1, Zen 2 and Hygon Dhyana have a
     /// microcoded `pdep`; Zen 3 and later, and Intel, do not.
+    #[cfg(target_arch = "x86_64")]
     #[test]
     fn pdep_is_slow_on_zen_1_and_2_only() {
+        use super::slow_pdep;
         let (amd, hygon, intel) = (b"AuthenticAMD", b"HygonGenuine", b"GenuineIntel");
         assert!(slow_pdep(amd, 0x0080_0F12), "Zen 1 (family 0x17)");
         assert!(slow_pdep(amd, 0x0083_0F10), "Zen 2 (family 0x17)");
