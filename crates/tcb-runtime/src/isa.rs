@@ -154,15 +154,8 @@ pub(crate) fn cpu_avx512() -> bool {
 /// headers spread their fields with shifts and masks instead.
 #[cfg(target_arch = "x86_64")]
 pub(crate) fn fast_pdep() -> bool {
-    static FAST: AtomicU8 = AtomicU8::new(UNKNOWN);
-    match FAST.load(Ordering::Relaxed) {
-        UNKNOWN => {
-            let fast = !slow_pdep_cpu();
-            FAST.store(if fast { AVX2 } else { BASELINE }, Ordering::Relaxed);
-            fast
-        }
-        s => s == AVX2,
-    }
+    static FAST: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *FAST.get_or_init(|| !slow_pdep_cpu())
 }
 
 /// AMD or Hygon before family 0x19 (`cpuid` leaves 0 and 1).
