@@ -4,7 +4,6 @@
 use crate::exact::ExactTable;
 use crate::grid::{Cursor, FrameBasis, TimeGrid};
 use crate::kernel;
-use crate::pack::store::{KEY_FORM_LOW, key_row};
 use crate::segment::Segment;
 use crate::store::{KeyCache, KeyStore};
 use wide::f32x8;
@@ -50,17 +49,17 @@ impl Group {
         let f = self.grid.frame(time, cursor);
         let (ka, kb) = self.grid.key_pair(f.segment);
         let controls = self.keys.segment(ka, kb, cache);
-        sample_segment::<true>(self, f, controls, values, velocities);
+        sample_segment(self, f, controls, values, velocities);
     }
 
     /// [`sample`](Self::sample) for a group whose keys are packed
     /// (`crate::pack`): its controls come from decoded keys. Inside the
     /// keys, where the group has the key form
-    /// (`PackedKeys::segment_keys`), its rotations play from their four
-    /// keys with [`key_row`] of the frame's
-    /// basis, without their tangents (unless a lane's `|p|^2` is at most
-    /// [`KEY_FORM_LOW`]: then as elsewhere, from the tangents). Out of line,
-    /// so that the f32 groups' loop stays as it was.
+    /// (`PackedKeys::play_keys`), its rotations play from their four
+    /// keys with `key_row` of the frame's basis, without their tangents
+    /// (unless a lane's `|p|^2` is at most `KEY_FORM_LOW`: then as
+    /// elsewhere, from the tangents). Out of line, so that the f32 groups'
+    /// loop stays as it was.
     #[inline(never)]
     pub fn sample_packed(
         &self,
@@ -74,45 +73,25 @@ impl Group {
             unreachable!("every group of a packed clip is packed")
         };
         let f = self.grid.frame(time, cursor);
-        let (ka, kb) = self.grid.key_pair(f.segment);
         let mut velocities = velocities;
-        if !f.reset
-            && let Some((cv, cq, w)) = keys.segment_keys(ka, kb, state)
-        {
+        if !f.reset && f.cycles == 0.0 && !self.unbounded {
             debug_assert!(self.exact.entries.is_empty(), "packed clips have none");
-            let range = self.rotation_planes();
-            let h = key_row(f.h, w);
-            // The derivative's row only where velocities are asked for.
-            let dh = if velocities.is_some() {
-                key_row(f.dh, w)
-            } else {
-                h
-            };
-            let out = &mut values[range.clone()];
-            let vel = velocities.as_deref_mut().map(|v| &mut v[range]);
-            const LOW: u32 = KEY_FORM_LOW.to_bits();
-            if kernel::quats_above::<LOW, false>(cq, h, dh, f.rate, out, vel) {
-                return sample_segment::<false>(self, f, cv, values, velocities);
+            let planes = self.vec_out..self.vec_out + self.vec_blocks + 4 * self.hq_blocks;
+            let vel = velocities.as_deref_mut().map(|v| &mut v[planes.clone()]);
+            if keys.play_keys(&f, state, &mut values[planes], vel) {
+                return;
             }
         }
+        let (ka, kb) = self.grid.key_pair(f.segment);
         let controls = keys.segment(ka, kb, state);
-        sample_segment::<true>(self, f, controls, values, velocities);
-    }
-
-    /// The rotation planes of the pose (`values`). (`sample_segment`
-    /// computes the same range in line: through this function the dense
-    /// kernels' code took 0.2% to 0.5% more instructions.)
-    #[inline(always)]
-    fn rotation_planes(&self) -> std::ops::Range<usize> {
-        let hq_out = self.vec_out + self.vec_blocks;
-        hq_out..hq_out + 4 * self.hq_blocks
+        sample_segment(self, f, controls, values, velocities);
     }
 }
 
-/// One group's kernels on its segment's controls: vectors, then, with
-/// `ROTATIONS`, rotations and exact squad lanes.
+/// One group's kernels on its segment's controls: vectors, then
+/// rotations and exact squad lanes.
 #[inline(always)]
-fn sample_segment<const ROTATIONS: bool>(
+fn sample_segment(
     g: &Group,
     f: FrameBasis,
     controls: Segment,
@@ -137,7 +116,7 @@ fn sample_segment<const ROTATIONS: bool>(
             kernel::vector_velocities(cv, dh, rate, &mut v[g.vec_out..g.vec_out + g.vec_blocks]);
         }
     }
-    if ROTATIONS && g.hq_blocks > 0 {
+    if g.hq_blocks > 0 {
         let hq_out = g.vec_out + g.vec_blocks;
         let range = hq_out..hq_out + 4 * g.hq_blocks;
         if f.reset {

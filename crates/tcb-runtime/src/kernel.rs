@@ -3,7 +3,7 @@
 
 use crate::exact::{Exact, SQ_STRIDE};
 use crate::segment::Segment;
-use tcb_core::simd::basis::hermite;
+use tcb_core::simd::basis::{Real, hermite};
 use tcb_core::simd::lane::Lane;
 use wide::{f32x8, f64x4};
 
@@ -46,8 +46,14 @@ pub(crate) fn vector_velocities(c: Segment, dh: [f32; 4], rate: f32, out: &mut [
     let (dh, rate) = (&splat4(dh), f32x8::splat(rate));
     let keys = c.p0.iter().zip(c.p1).zip(c.m0).zip(c.m1);
     for ((((p0, p1), m0), m1), o) in keys.zip(out) {
-        *o = hermite(dh, *p0, *p1, *m0, *m1) * rate;
+        *o = velocity(dh, *p0, *p1, *m0, *m1, rate);
     }
+}
+
+/// A vector channel's velocity from its controls: `rate (dh . controls)`.
+#[inline(always)]
+pub(crate) fn velocity<L: Real>(dh: &[L; 4], p0: L, p1: L, m0: L, m1: L, rate: L) -> L {
+    hermite(dh, p0, p1, m0, m1) * rate
 }
 
 /// `value += cycles * delta` (offset-repeat).
@@ -358,6 +364,9 @@ pub(crate) fn identity(out: &mut [f32x8]) {
 /// AVX instruction each here. Arrays are written out rather than built
 /// with closures (see `tcb_core::simd::w8`).
 #[cfg(target_arch = "x86_64")]
+pub(crate) use v3::quats_inline;
+
+#[cfg(target_arch = "x86_64")]
 mod v3 {
     use crate::isa::Avx2Kernels;
     use crate::kernel::{in_range, normalize, quat_keys};
@@ -434,6 +443,13 @@ mod v3 {
     /// [`crate::kernel::in_range`]'s range from `f32::from_bits(LOW)`.
     #[target_feature(enable = "avx2,fma")]
     fn quats<const LOW: u32>(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
+        quats_inline::<LOW>(c, h, out)
+    }
+
+    /// [`quats`]' body, inlined into a caller that runs with AVX2 and FMA
+    /// (a `#[target_feature]` function; elsewhere it runs, on arrays).
+    #[inline(always)]
+    pub(crate) fn quats_inline<const LOW: u32>(c: Segment, h: [f32; 4], out: &mut [f32x8]) -> bool {
         let low = f32::from_bits(LOW);
         let h = rows(h);
         let mut ok = M8([u32::MAX; 8]);

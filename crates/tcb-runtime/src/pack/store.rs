@@ -47,10 +47,11 @@ use super::{
     BYTES, BitLanes, GROUP, Packed, SEGMENT_KEYS, block_step, header_group, read_bits, unzigzag,
     window,
 };
+use crate::grid::FrameBasis;
 use crate::segment::Segment;
 use std::ops::{Add, BitAnd, BitOr, Sub};
 use std::sync::Arc;
-use tcb_core::simd::basis::Real;
+use tcb_core::simd::basis::{Real, hermite};
 use tcb_core::simd::lane::{Lane, Mask};
 use wide::{f32x8, i32x8};
 
@@ -102,7 +103,7 @@ pub(crate) struct PackedKeys {
     /// The weights (`in_a in_b out_a out_b`) every rotation of the group
     /// shares, where they do, each at most 1 in magnitude, and every
     /// center's `|c|^2` is at most [`KEY_LENGTH2`]: then interior segments
-    /// play their rotations from their keys ([`PackedKeys::segment_keys`]).
+    /// play their rotations from their keys ([`PackedKeys::play_keys`]).
     pub key_weights: Option<[f32; 4]>,
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
@@ -163,7 +164,7 @@ impl PackedKeys {
             let (lo, hi) = (a.saturating_sub(1), (b + 1).min(n - 1));
             c.ensure(self, lo, hi);
             self.tangents(a, b, c);
-            (c.seg, c.seg_vectors) = (a, a);
+            c.seg = a;
         }
         let np = self.planes;
         let (m0, m1) = c.m.split_at(np);
@@ -175,64 +176,44 @@ impl PackedKeys {
         }
     }
 
-    /// The controls of interior segment `a` to `b` (`0 < a`, `b < n - 1`)
-    /// in the key form, where the group has it ([`key_weights`](Self::key_weights)):
-    /// the vector planes' controls as [`segment`](Self::segment) gives
-    /// them; the rotation planes' four keys as a segment's `P0` (`P_a`),
-    /// `P1` (`P_b`), `M0` (`P_{a-1}`) and `M1` (`P_{b+1}`), played with
-    /// [`key_row`] of the frame's basis and the weights returned. `None`
-    /// at the ends and the sentinels, and where a key of the four may be
-    /// longer than [`KEY_LENGTH2`] allows (then [`segment`](Self::segment)).
+    /// Plays interior segment `a` to `a + 1` (`0 < a`, `a + 2 < n`; `a`
+    /// is `f.segment - 1`) in the key form, where the group has it
+    /// ([`key_weights`](Self::key_weights)), into `out` (the group's planes,
+    /// vectors then rotations) and `vel` (the same, where velocities are
+    /// asked for): the vector planes from the reference's controls (the
+    /// tangent rule on the rows of keys `a - 1 ..= a + 2`), the rotation
+    /// planes from the four keys with [`key_row`] of the frame's rows.
+    /// `false`, with `out` and `vel` not final, at the ends and the
+    /// sentinels, where a key of the four may be longer than
+    /// [`KEY_LENGTH2`] allows, and where a rotation's `|p|^2` is at most
+    /// [`KEY_FORM_LOW`]: then [`segment`](Self::segment) plays it.
     #[inline(always)]
-    pub fn segment_keys<'a>(
-        &'a self,
-        a: usize,
-        b: usize,
-        c: &'a mut PackCache,
-    ) -> Option<(Segment<'a>, Segment<'a>, [f32; 4])> {
-        let w = self.key_weights?;
-        if a == 0 || b + 1 >= self.keys {
-            return None;
+    pub fn play_keys(
+        &self,
+        f: &FrameBasis,
+        c: &mut PackCache,
+        out: &mut [f32x8],
+        vel: Option<&mut [f32x8]>,
+    ) -> bool {
+        let Some(w) = self.key_weights else {
+            return false;
+        };
+        let a = f.segment.wrapping_sub(1);
+        if a.wrapping_sub(1) >= self.keys.saturating_sub(3) {
+            return false;
         }
-        debug_assert_eq!(b, a + 1, "packed groups have no step segments");
-        let (np, r) = (self.planes, self.rot_from);
-        if c.seg_vectors != a {
-            c.ensure(self, a - 1, b + 1);
-            // The vector planes' tangents (a root's translation: one plane,
-            // or none), here in line.
-            let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
-            let rows = four_rows(keys, np, 0..r);
-            let (m0, m1) = c.m.split_at_mut(np);
-            interior_tangents::<f32x8>(rows, &self.weights, &mut m0[..r], &mut m1[..r]);
-            // The rows may have moved: the rotations' tangents of `c.seg`
-            // are not what `segment` would read with them.
-            (c.seg, c.seg_vectors) = (usize::MAX, a);
-        }
+        c.ensure(self, a - 1, a + 2);
         // Every key read decoded within the bound: key `a - 1` in segment
-        // `cur`, or in the one before. (Checked after the vector planes'
-        // tangents, which `segment` then computes again: checked before
-        // them, the common path took 3% more instructions.)
+        // `cur`, or in the one before.
         if !(c.seg_bounded && (a > SEGMENT_KEYS * c.cur || c.before_bounded)) {
-            return None;
+            return false;
         }
-        let keys = key_rows(&c.rows, c.cur, a - 1, 4, np);
-        let (before, rest) = keys.split_at(np);
-        let (pa, rest) = rest.split_at(np);
-        let (pb, after) = rest.split_at(np);
-        let (m0, m1) = c.m.split_at(np);
-        let vectors = Segment {
-            p0: &pa[..r],
-            m0: &m0[..r],
-            p1: &pb[..r],
-            m1: &m1[..r],
-        };
-        let rotations = Segment {
-            p0: &pa[r..],
-            m0: &before[r..],
-            p1: &pb[r..],
-            m1: &after[r..],
-        };
-        Some((vectors, rotations, w))
+        let win = key_rows(&c.rows, c.cur, a - 1, 4, self.planes);
+        #[cfg(target_arch = "x86_64")]
+        if crate::isa::avx2() {
+            return instance!(play_keys_here(self, win, f, w, out, vel));
+        }
+        play_keys_on::<f32x8>(self, win, f, w, out, vel)
     }
 
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
@@ -271,7 +252,7 @@ impl PackedKeys {
 }
 
 /// The basis row that plays an interior segment from its four keys
-/// ([`PackedKeys::segment_keys`]: `P_a`, `P_b`, `P_{a-1}`, `P_{b+1}`, in
+/// ([`PackedKeys::play_keys`]: `P_a`, `P_b`, `P_{a-1}`, `P_{b+1}`, in
 /// a segment's `P0 P1 M0 M1`): the hermite row `h` (`P0 P1 M0 M1`) with
 /// each tangent written out as [`tangent`] of its chords, weights `w` (`in_a
 /// in_b out_a out_b`):
@@ -337,10 +318,84 @@ fn interior_tangents<L: Plane>(
             L::load(&w[2]),
             L::load(&w[3]),
         ];
-        let chord = y - x;
-        *m0 = tangent(x - v, chord, out_a, out_b).store();
-        *m1 = tangent(chord, z - y, in_a, in_b).store();
+        let (to, ti) = chord_tangents([v, x, y, z], [in_a, in_b, out_a, out_b]);
+        *m0 = to.store();
+        *m1 = ti.store();
     }
+}
+
+/// `TO_a` and `TI_b` of the keys `[v x y z]` (`P_{a-1} ..= P_{b+1}`) with
+/// their weights (`in_a in_b out_a out_b`): the chord `P_b - P_a` once.
+#[inline(always)]
+fn chord_tangents<L: Real>([v, x, y, z]: [L; 4], [in_a, in_b, out_a, out_b]: [L; 4]) -> (L, L) {
+    let chord = y - x;
+    (
+        tangent(x - v, chord, out_a, out_b),
+        tangent(chord, z - y, in_a, in_b),
+    )
+}
+
+/// [`PackedKeys::play_keys`] on the rows `win` of keys `a - 1 ..= a + 2`
+/// (`planes` vectors each) with the group's shared weights `w`.
+#[inline(always)]
+fn play_keys_on<L: Plane>(
+    g: &PackedKeys,
+    win: &[f32x8],
+    f: &FrameBasis,
+    w: [f32; 4],
+    out: &mut [f32x8],
+    vel: Option<&mut [f32x8]>,
+) -> bool {
+    let (np, r) = (g.planes, g.rot_from);
+    let (before, rest) = win.split_at(np);
+    let (pa, rest) = rest.split_at(np);
+    let (pb, after) = rest.split_at(np);
+    let (out_v, out_q) = out.split_at_mut(r);
+    let (vel_v, vel_q) = match vel {
+        Some(v) => {
+            let (v, q) = v.split_at_mut(r);
+            (Some(v), Some(q))
+        }
+        None => (None, None),
+    };
+    // Rotations first: where the key form does not hold, nothing else
+    // was computed for nothing.
+    let rotations = Segment {
+        p0: &pa[r..],
+        m0: &before[r..],
+        p1: &pb[r..],
+        m1: &after[r..],
+    };
+    let h = key_row(f.h, w);
+    // The derivative's row only where velocities are asked for.
+    let dh = if vel_q.is_some() { key_row(f.dh, w) } else { h };
+    const LOW: u32 = KEY_FORM_LOW.to_bits();
+    if !L::quats::<LOW>(rotations, h, dh, f.rate, out_q, vel_q) {
+        return false;
+    }
+    // Vectors: the reference's controls and kernel formula.
+    let rows = before.iter().zip(pa).zip(pb.iter().zip(after));
+    let planes = rows.zip(&g.weights).zip(out_v);
+    let h = f.h.map(L::splat);
+    match vel_v {
+        None => {
+            for ((((v, x), (y, z)), w), o) in planes {
+                let keys = [L::load(v), L::load(x), L::load(y), L::load(z)];
+                let (to, ti) = chord_tangents(keys, w.each_ref().map(L::load));
+                *o = hermite(&h, keys[1], keys[2], to, ti).store();
+            }
+        }
+        Some(vel_v) => {
+            let (dh, rate) = (f.dh.map(L::splat), L::splat(f.rate));
+            for (((((v, x), (y, z)), w), o), d) in planes.zip(vel_v) {
+                let keys = [L::load(v), L::load(x), L::load(y), L::load(z)];
+                let (to, ti) = chord_tangents(keys, w.each_ref().map(L::load));
+                *o = hermite(&h, keys[1], keys[2], to, ti).store();
+                *d = crate::kernel::velocity(&dh, keys[1], keys[2], to, ti, rate).store();
+            }
+        }
+    }
+    true
 }
 
 /// The predictor one key on: from the last key `x`, its step `d` (`x`
@@ -418,6 +473,19 @@ trait Plane: Lane {
     fn store(self) -> f32x8;
     /// `a` in the lanes where `mask` has every bit set, else `b`.
     fn blend(mask: &f32x8, a: Self, b: Self) -> Self;
+    /// [`crate::kernel::quats_above`] without its rescaling, in this lane
+    /// type's instance.
+    #[inline(always)]
+    fn quats<const LOW: u32>(
+        c: Segment,
+        h: [f32; 4],
+        dh: [f32; 4],
+        rate: f32,
+        out: &mut [f32x8],
+        vel: Option<&mut [f32x8]>,
+    ) -> bool {
+        crate::kernel::quats_above::<LOW, false>(c, h, dh, rate, out, vel)
+    }
 }
 
 impl Plane for f32x8 {
@@ -449,11 +517,9 @@ pub(crate) struct PackCache {
     /// The first key whose row is valid (the three before `cur`'s first
     /// key, or, after a seek, the first key decoded).
     valid: usize,
-    /// The first key of the segment whose tangents `m` holds, and of the
-    /// one whose tangents its vector planes hold
-    /// ([`PackedKeys::segment_keys`] computes only those).
+    /// The first key of the segment whose tangents `m` holds (`usize::MAX`
+    /// once the rows move: `decode_to`).
     seg: usize,
-    seg_vectors: usize,
     /// Whether every rotation key of segment `cur` (decoded so far) has
     /// `|P|^2` at most [`KEY_LENGTH2`], and whether every key of segment
     /// `cur - 1` has, where the rows hold its last keys. Per segment, so
@@ -477,8 +543,7 @@ pub(crate) struct PackCache {
     /// [`ROWS`]); while a segment is decoded, a row holds its residuals
     /// (as `i32`) until the prediction replaces them with the key.
     rows: Vec<f32x8>,
-    /// `TO_a` then `TI_b` of the segment `seg` (of `seg_vectors` in the
-    /// vector planes).
+    /// `TO_a` then `TI_b` of the segment `seg`.
     m: Vec<f32x8>,
 }
 
@@ -490,7 +555,6 @@ impl PackedKeys {
             cur: usize::MAX,
             valid: 0,
             seg: usize::MAX,
-            seg_vectors: usize::MAX,
             seg_bounded: false,
             before_bounded: false,
             pos: 0,
@@ -554,6 +618,9 @@ impl PackCache {
     /// `to`, from the one after `cur` or from the start of `lo`'s block.
     #[inline(never)]
     fn decode_to(&mut self, g: &PackedKeys, lo: usize, to: usize) {
+        // The rows move: the tangents `m` hold may be of keys no longer in
+        // them.
+        self.seg = usize::MAX;
         // A block's first segment needs nothing before it.
         let restart = (lo - lo % g.packed.block) / SEGMENT_KEYS;
         let from = if self.cur < to && self.cur + 1 >= restart {
@@ -923,6 +990,23 @@ impl Plane for tcb_core::simd::w8::W8 {
         #[allow(unsafe_code)]
         Self(bytemuck::cast(unsafe { _mm256_blendv_ps(b, a, m) }))
     }
+    /// Without velocities, the AVX2 kernel's loop in line (in the
+    /// instances, which have AVX2 and FMA): its call took about 35
+    /// instructions a frame.
+    #[inline(always)]
+    fn quats<const LOW: u32>(
+        c: Segment,
+        h: [f32; 4],
+        dh: [f32; 4],
+        rate: f32,
+        out: &mut [f32x8],
+        vel: Option<&mut [f32x8]>,
+    ) -> bool {
+        match vel {
+            None => crate::kernel::quats_inline::<LOW>(c, h, out),
+            vel => crate::kernel::quats_above::<LOW, false>(c, h, dh, rate, out, vel),
+        }
+    }
 }
 
 /// `$t`'s operator `$tr` as the AVX2 intrinsic `$f`. The intrinsics
@@ -959,10 +1043,11 @@ macro_rules! avx_op {
 macro_rules! decoder_instance {
     ($name:ident, $features:literal, $detected:path) => {
         mod $name {
+            use crate::grid::FrameBasis;
             use crate::pack::SEGMENT_KEYS;
             use crate::pack::store::{
-                Headers, PackedKeys, block_start_keys, entry_fields, interior_tangents, predict,
-                rebuild_rows,
+                Headers, PackedKeys, block_start_keys, entry_fields, interior_tangents,
+                play_keys_on, predict, rebuild_rows,
             };
             use crate::pack::{block_step, dequantize_lanes, unzigzag_lanes, width_lanes};
             use std::arch::x86_64::{
@@ -1006,6 +1091,35 @@ macro_rules! decoder_instance {
                 m1: &mut [f32x8],
             ) {
                 interior_tangents::<W8>(keys, weights, m0, m1);
+            }
+
+            /// [`play_keys_on`] in this instance.
+            #[inline(always)]
+            pub(super) fn play_keys_here(
+                g: &PackedKeys,
+                win: &[f32x8],
+                f: &FrameBasis,
+                w: [f32; 4],
+                out: &mut [f32x8],
+                vel: Option<&mut [f32x8]>,
+            ) -> bool {
+                debug_assert!($detected());
+                #[allow(unsafe_code)]
+                unsafe {
+                    play(g, win, f, w, out, vel)
+                }
+            }
+
+            #[target_feature(enable = $features)]
+            fn play(
+                g: &PackedKeys,
+                win: &[f32x8],
+                f: &FrameBasis,
+                w: [f32; 4],
+                out: &mut [f32x8],
+                vel: Option<&mut [f32x8]>,
+            ) -> bool {
+                play_keys_on::<W8>(g, win, f, w, out, vel)
             }
 
             /// [`Headers::read`] compiled for this instance.
