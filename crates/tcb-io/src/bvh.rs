@@ -107,15 +107,43 @@ impl<'a> Tokens<'a> {
     }
 }
 
-/// The first token: `HIERARCHY`.
-fn expect_hierarchy(t: &mut Tokens) -> Result<(), Error> {
-    match t.next() {
-        Some((_, "HIERARCHY")) => Ok(()),
-        Some((line, tok)) => Err(Error::syntax(
-            line,
-            format!("expected HIERARCHY, found '{tok}'"),
-        )),
-        None => Err(Error::syntax(1, "expected HIERARCHY")),
+/// A byte-order mark, which some Windows editors write before `HIERARCHY`.
+const BOM: &str = "\u{feff}";
+
+/// `bytes` as BVH text. Bytes that are not UTF-8 are "not a BVH file"
+/// unless the file starts with `HIERARCHY` (after a byte-order mark and
+/// white space): then they are an error at their line (a Latin-1 joint
+/// name, say).
+pub(crate) fn text(bytes: &[u8]) -> Result<&str, Error> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let what = format!("byte 0x{:02X} at offset {at} is not UTF-8", bytes[at]);
+        let start = bytes.strip_prefix(BOM.as_bytes()).unwrap_or(bytes);
+        let start = start.trim_ascii_start();
+        if start.starts_with(b"HIERARCHY") {
+            let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+            Error::syntax(line, format!("{what} (BVH is read as UTF-8 text)"))
+        } else {
+            Error::import(format!("not a BVH file: not text ({what})"))
+        }
+    })
+}
+
+/// The first word of `text` is `HIERARCHY`, or the text is "not a BVH
+/// file" (rather than, say, "no MOTION section" for a JSON file).
+fn check_hierarchy_first(text: &str) -> Result<(), Error> {
+    match text.split_whitespace().next() {
+        Some("HIERARCHY") => Ok(()),
+        Some(word) => {
+            let mut shown: String = word.chars().take(20).collect();
+            if shown.len() < word.len() {
+                shown.push('…');
+            }
+            Err(Error::import(format!(
+                "not a BVH file: it starts with '{shown}', not HIERARCHY"
+            )))
+        }
+        None => Err(Error::import("not a BVH file: it is empty")),
     }
 }
 
@@ -212,8 +240,10 @@ fn end_site(t: &mut Tokens) -> Result<Vec3, Error> {
 }
 
 impl Bvh {
-    /// Parse BVH text.
+    /// Parse BVH text (a leading byte-order mark is skipped).
     pub fn parse(text: &str) -> Result<Bvh, Error> {
+        let text = text.strip_prefix(BOM).unwrap_or(text);
+        check_hierarchy_first(text)?;
         let lines: Vec<&str> = text.lines().collect();
         let motion = lines
             .iter()
@@ -243,7 +273,8 @@ impl Bvh {
 
     /// The `HIERARCHY` section: joints, their offsets and channels, End Sites.
     fn parse_hierarchy(&mut self, t: &mut Tokens) -> Result<(), Error> {
-        expect_hierarchy(t)?;
+        // `HIERARCHY`, checked by `parse`.
+        t.next();
         // Joints open and not yet closed.
         let mut stack: Vec<usize> = Vec::new();
         // Names so far (a search of the joints per joint is quadratic in a

@@ -226,7 +226,7 @@ fn read_doc(
     Ok(match format {
         Format::Json => (ClipDoc::parse(text()?)?, Vec::new()),
         Format::Bvh => {
-            let bvh = bvh::Bvh::parse(text()?)?;
+            let bvh = bvh::Bvh::parse(bvh::text(bytes)?)?;
             let doc = bvh.to_clip_doc(name, options.rotation)?;
             (doc, bvh.warnings().to_vec())
         }

@@ -4,7 +4,7 @@
 use glam::{DQuat, Quat};
 use std::path::{Path, PathBuf};
 use tcb_io::bvh::Bvh;
-use tcb_io::{ErrorKind, ImportOptions, load_with};
+use tcb_io::{ErrorKind, Format, ImportOptions, load_bytes, load_with};
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -236,10 +236,100 @@ fn damaged_files_are_clear_errors_naming_the_line() {
         error(&SMALL.replace("JOINT knee", "JOINT hip")),
         "line 6: a second joint named 'hip'"
     );
-    assert_eq!(error(""), "line 1: no MOTION section");
-    assert_eq!(error("MOTION\n"), "line 1: expected HIERARCHY");
+    assert_eq!(error(""), "not a BVH file: it is empty");
+    assert_eq!(
+        error("MOTION\n"),
+        "not a BVH file: it starts with 'MOTION', not HIERARCHY"
+    );
     let header_only = &SMALL[..SMALL.find("Frames").unwrap()];
     assert_eq!(error(header_only), "line 16: 'Frames' missing after MOTION");
+}
+
+/// Bytes that are not text: xorshift noise, the same on every run.
+fn noise(len: usize) -> Vec<u8> {
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    (0..len)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 24) as u8
+        })
+        .collect()
+}
+
+/// A file that is not text, or text that does not start with HIERARCHY,
+/// is "not a BVH file", saying why (not UTF-8's own wording, nor "no
+/// MOTION section" for a file that never was one).
+#[test]
+fn files_that_are_not_bvh_say_so() {
+    let dir = std::env::temp_dir().join(format!("tcb-not-bvh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("x.bvh");
+    std::fs::write(&path, noise(512)).unwrap();
+    let err = tcb_io::load(&path).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Import(_)), "{err:?}");
+    let text = err.to_string();
+    let want = format!("{}: not a BVH file: not text (byte 0x", path.display());
+    assert!(text.starts_with(&want), "{text}");
+    assert!(text.ends_with(" is not UTF-8)"), "{text}");
+    assert_eq!(text.lines().count(), 1, "{text}");
+    // A zip archive: ASCII, then a byte that is not UTF-8.
+    let options = ImportOptions::default();
+    let zip = b"PK\x03\x04\x14\0\0\0\x08\0\xa5\x5b";
+    let err = load_bytes(zip, Format::Bvh, "x", &options).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "not a BVH file: not text (byte 0xA5 at offset 10 is not UTF-8)"
+    );
+    // Text, but not BVH.
+    let json = r#"{"format": "tcb-clip/1", "tracks": []}"#;
+    assert_eq!(
+        error(json),
+        "not a BVH file: it starts with '{\"format\":', not HIERARCHY"
+    );
+    assert_eq!(
+        error(&"x".repeat(100)),
+        "not a BVH file: it starts with 'xxxxxxxxxxxxxxxxxxxx…', not HIERARCHY"
+    );
+    assert_eq!(error(" \r\n\t"), "not a BVH file: it is empty");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A BVH file with a byte that is not UTF-8 (a Latin-1 joint name) is a
+/// BVH file: the error names the line and the byte.
+#[test]
+fn a_bvh_file_with_a_byte_that_is_not_utf8_names_its_line() {
+    let at = SMALL.find("knee").unwrap() + 2;
+    let mut bytes = SMALL.as_bytes().to_vec();
+    bytes[at] = 0xe9; // 'é' in Latin-1
+    let err = load_bytes(&bytes, Format::Bvh, "x", &ImportOptions::default()).unwrap_err();
+    assert!(
+        matches!(err.kind, ErrorKind::Syntax { line: 6, .. }),
+        "{err:?}"
+    );
+    assert_eq!(
+        err.to_string(),
+        format!("line 6: byte 0xE9 at offset {at} is not UTF-8 (BVH is read as UTF-8 text)")
+    );
+}
+
+/// A byte-order mark before HIERARCHY (Windows editors write one) is skipped.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    let with_bom = format!("\u{feff}{SMALL}");
+    let a = Bvh::parse(SMALL).unwrap();
+    let b = Bvh::parse(&with_bom).unwrap();
+    assert_eq!(a.values(), b.values());
+    assert_eq!(a.skeleton(), b.skeleton());
+    let loaded = load_bytes(
+        with_bom.as_bytes(),
+        Format::Bvh,
+        "x",
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(loaded.clip.channel_count(), 3 + 2 * 4);
 }
 
 #[test]
