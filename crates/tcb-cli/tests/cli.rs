@@ -537,6 +537,37 @@ fn control_characters_in_names_are_escaped_in_errors() {
     assert!(err.contains(r"bad\nname\u{1b}[31m"), "{err}");
 }
 
+/// Random bytes named `.bvh` or `.glb` are "not a BVH file" or "not a glTF
+/// file", one line, rather than a UTF-8 or JSON parser's wording.
+#[test]
+fn random_bytes_are_not_a_bvh_or_gltf_file() {
+    let dir = scratch("cli-not-a-clip");
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let noise: Vec<u8> = (0..512)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 24) as u8
+        })
+        .collect();
+    for (name, message) in [
+        ("x.bvh", "x.bvh: not a BVH file: not text (byte 0x"),
+        (
+            "x.glb",
+            "x.glb: not a glTF file: neither binary glTF (no \"glTF\" magic) nor glTF JSON",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, &noise).unwrap();
+        let o = tcb(&["sample", path.to_str().unwrap(), "--fps", "10"]);
+        assert!(!o.status.success(), "{name}: accepted");
+        assert!(o.stdout.is_empty(), "{name}: wrote {}", stdout(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{name}: {}", stderr(&o));
+        stderr_has(&o, message);
+    }
+}
+
 #[test]
 fn tcb_beyond_one_is_allowed() {
     let text = clip_with(

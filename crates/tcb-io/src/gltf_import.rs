@@ -146,6 +146,15 @@ pub fn import_with(
 fn parse(bytes: &[u8]) -> Result<gltf::Gltf, Error> {
     let invalid =
         |e: &dyn std::fmt::Display| Error::import(format!("not a valid glTF 2.0 file: {e}"));
+    // Neither the GLB magic nor a JSON object first (white space and a
+    // byte-order mark skipped, so that JSON gets the parser's own words):
+    // say so, not serde_json's "expected value at line 1 column 1".
+    let json = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if !bytes.starts_with(b"glTF") && !json.trim_ascii_start().starts_with(b"{") {
+        return Err(Error::import(
+            "not a glTF file: neither binary glTF (no \"glTF\" magic) nor glTF JSON (no '{' first)",
+        ));
+    }
     // The `gltf` crate (1.4.1) subtracts the header's 12 bytes from the
     // GLB length field before it checks it (an overflow, a panic in debug
     // builds): check it here first.

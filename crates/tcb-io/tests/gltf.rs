@@ -198,9 +198,17 @@ fn absurd_files_are_errors_not_panics() {
         err.contains("32 bytes, but the file says 4000000000"),
         "{err}"
     );
-    // Not glTF at all; a GLB cut short.
-    assert!(import(b"{\"asset\": 1}", None, None, "t").is_err());
-    assert!(import(b"glTF\x02\x00\x00\x00\xff\xff\xff\xff", None, None, "t").is_err());
+    // JSON that is not glTF; a GLB cut short: the parser's own words.
+    let err = import(b"{\"asset\": 1}", None, None, "t").unwrap_err();
+    assert!(
+        err.to_string().starts_with("not a valid glTF 2.0 file: "),
+        "{err}"
+    );
+    let err = import(b"glTF\x02\x00\x00\x00\xff\xff\xff\xff", None, None, "t").unwrap_err();
+    assert!(
+        err.to_string().starts_with("not a valid glTF 2.0 file: "),
+        "{err}"
+    );
     // An animation that is not there.
     let ok = gltf_with(cases[0].0.replace("1000000000", "2").as_str(), &buf);
     let err = import(ok.as_bytes(), None, Some("run"), "t")
@@ -466,4 +474,50 @@ fn a_glb_length_below_its_header_is_an_error_not_a_panic() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("says the file is 11 bytes"), "{err}");
+}
+
+/// Bytes that are neither JSON nor binary glTF: xorshift noise, the same
+/// on every run.
+fn noise(len: usize) -> Vec<u8> {
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    (0..len)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 24) as u8
+        })
+        .collect()
+}
+
+/// A file with neither the GLB magic nor a JSON object's `{` first is "not
+/// a glTF file", rather than the JSON parser's "expected value at line 1
+/// column 1" for bytes that were never JSON.
+#[test]
+fn files_that_are_not_gltf_say_so() {
+    const NOT_GLTF: &str =
+        "not a glTF file: neither binary glTF (no \"glTF\" magic) nor glTF JSON (no '{' first)";
+    let dir = std::env::temp_dir().join(format!("tcb-not-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("x.glb");
+    std::fs::write(&path, noise(512)).unwrap();
+    let err = tcb_io::load(&path).unwrap_err().to_string();
+    assert_eq!(err, format!("{}: {NOT_GLTF}", path.display()));
+    for bytes in [
+        &b""[..],
+        b" \n",
+        b"HIERARCHY\nROOT hip\n",
+        b"glT",
+        b"[1, 2]",
+    ] {
+        let err = import(bytes, None, None, "t").unwrap_err().to_string();
+        assert_eq!(err, NOT_GLTF, "{bytes:?}");
+    }
+    // JSON after whitespace or a byte-order mark is JSON: the parser says
+    // what is wrong with it.
+    for bytes in [&b" \r\n\t{\"asset\": 1}"[..], b"\xef\xbb\xbf{}"] {
+        let err = import(bytes, None, None, "t").unwrap_err().to_string();
+        assert!(err.starts_with("not a valid glTF 2.0 file: "), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
