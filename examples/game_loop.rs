@@ -91,9 +91,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         per_frame * 1e6,
         per_frame * 1e9 / (characters.len() * joints) as f64
     );
-    println!(
-        "highest head: {head_height:.2} BVH units above the origin (this capture's units: \
-         about 1/18 of the figure's height)"
-    );
+    println!("highest head: {head_height:.2} BVH units above the origin (the file's units)");
     Ok(())
 }

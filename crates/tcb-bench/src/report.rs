@@ -498,7 +498,8 @@ baseline, runtime, rayon, splines: nanoseconds per channel-sample (one value of 
   `splines` crate (Catmull-Rom, checked to agree with tcb before it is timed).
 x baseline, x splines: how many times faster the runtime is, timed in this run.
 read limit: the time merely to read the runtime's coefficient bytes, as a percentage of
-  the runtime's time (100% means as fast as memory delivers them).
+  the runtime's time (100%: the runtime takes as long as a plain loop that only sums those
+  bytes; above 100%, it reads them faster than that loop does).
 ns/joint: runtime nanoseconds per animated joint per frame. MB: the compiled clip's heap.
 ";
 
