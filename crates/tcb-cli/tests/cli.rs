@@ -653,6 +653,30 @@ fn import_and_export_errors_write_nothing() {
     assert!(!bvh.exists());
 }
 
+/// An error above `--max-error` that the f32 key times' note names is
+/// warned of once, not again as the read-back's error (the same number
+/// twice read as two problems), and in a few digits.
+#[test]
+fn export_warns_of_one_error_once() {
+    let dir = scratch("cli-test");
+    let glb = dir.join("cmu-once.glb");
+    let o = tcb_to("export", data("cmu-01_01.bvh"), &glb, &[]);
+    assert_success(&o);
+    let err = stderr(&o);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(warnings[0].contains("glTF's f32 key times"), "{err}");
+    // 4 significant digits, not 17.
+    let digits = |w: &str| {
+        w.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+            .filter(|x| x.contains('e') && x.contains('.'))
+            .map(|x| x.split('e').next().unwrap_or("").len())
+            .max()
+            .unwrap_or(0)
+    };
+    assert!(digits(&err) <= 6, "{err}");
+}
+
 #[test]
 fn export_renames_tracks_and_prints_one_summary_line() {
     let dir = scratch("cli-test");

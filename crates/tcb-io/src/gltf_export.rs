@@ -771,10 +771,10 @@ fn time_rounding_note(
         .map(|(n, r)| (*n, r.error))?;
     let what = match over.len() {
         1 => format!(
-            "track '{name}': glTF's f32 key times move its keys by up to {shift:.2e} s, which puts it {worst:e} off the clip"
+            "track '{name}': glTF's f32 key times move its keys by up to {shift:.2e} s, which puts it {worst:.4e} off the clip"
         ),
         n => format!(
-            "{n} tracks: glTF's f32 key times move their keys by up to {shift:.2e} s, which puts them up to {worst:e} off the clip (in '{name}')"
+            "{n} tracks: glTF's f32 key times move their keys by up to {shift:.2e} s, which puts them up to {worst:.4e} off the clip (in '{name}')"
         ),
     };
     Some(format!(
