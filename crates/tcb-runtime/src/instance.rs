@@ -340,8 +340,13 @@ fn sample_packed(
 ) {
     let v = velocities.as_deref_mut();
     clip.groups[0].sample_packed(time, &mut cursors[0], &mut caches[0], values, v);
-    let rest = (&mut cursors[1..], &mut caches[1..]);
-    sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
+    // Capture packs into the first group alone: then nothing else to set
+    // up (the loop's bounds and the loose lanes' checks took about 15
+    // instructions a frame).
+    if clip.groups.len() > 1 || clip.loose.blocks > 0 || clip.loose_rot.blocks > 0 {
+        let rest = (&mut cursors[1..], &mut caches[1..]);
+        sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
+    }
 }
 
 /// [`sample_into`] of `clip`'s groups from `first` on (with their cursors
