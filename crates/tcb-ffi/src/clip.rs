@@ -122,9 +122,11 @@ fn load_memory(bytes: &[u8], format: &str, flags: u32) -> Result<TcbClip> {
             (doc.build()?, doc.skeleton)
         }
         "bvh" => {
-            let bvh = tcb_io::bvh::Bvh::parse(text()?)?;
-            let doc = bvh.to_clip_doc("clip", rotation(flags))?;
-            (doc.build()?, doc.skeleton)
+            // As `tcb_clip_load_file` reads a BVH file (bytes that are not
+            // text are "not a BVH file").
+            let options = tcb_io::ImportOptions::default().rotation(rotation(flags));
+            let loaded = tcb_io::load_bytes(bytes, tcb_io::Format::Bvh, "clip", &options)?;
+            (loaded.clip, loaded.skeleton)
         }
         "gltf" | "glb" => {
             let options = tcb_io::ImportOptions::default();

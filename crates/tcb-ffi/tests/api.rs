@@ -559,6 +559,9 @@ fn bad_files_give_a_status_and_a_message() {
     assert!(clip.is_null());
     let (status, _) = load_memory(&[0xff, 0xfe], "json");
     fails(status, TcbStatus::InvalidData, "json text");
+    // Bytes that are not text are not a BVH file, as the file loader says.
+    let (status, _) = load_memory(&[0x85, 0x00, 0x13], "bvh");
+    fails(status, TcbStatus::InvalidData, "not a BVH file: not text");
     let (status, _) = load_memory(b"{}", "fbx");
     fails(status, TcbStatus::InvalidArgument, "unknown format \"fbx\"");
     let (status, _) = load_memory(b"glTF junk", "glb");
