@@ -315,6 +315,7 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
             .first()
             .copied()
             .filter(|w| key_form && rotation_weights.iter().all(|v| v == w)),
+        rebuild_all: rebuild.iter().flatten().all(|&r| r),
         rebuild: rebuild
             .into_iter()
             .map(|m| f32x8::new(m.map(|r| f32::from_bits(if r { u32::MAX } else { 0 }))))

@@ -108,6 +108,9 @@ pub(crate) struct PackedKeys {
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
     pub rebuild: Vec<f32x8>,
+    /// Every lane of every rotation block rebuilds `w` (capture's
+    /// rotations do): then `w` is written without a blend.
+    pub rebuild_all: bool,
     /// The rotation blocks with a lane whose keys are relative to a center
     /// (`PackTrack::center`): the block, and per plane the centers (the
     /// identity in lanes without one).
@@ -430,15 +433,30 @@ fn block_start_keys<I: Copy + Add<Output = I>>(start: I, delta: I, keys: usize) 
 /// `|q|^2` before its center is at most [`KEY_LENGTH2`] (not NaN).
 #[inline(always)]
 fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
+    if g.rebuild_all {
+        rebuild_rows_on::<L, true>(g, rows)
+    } else {
+        rebuild_rows_on::<L, false>(g, rows)
+    }
+}
+
+/// [`rebuild_rows`], with `ALL` where every lane rebuilds `w`
+/// ([`PackedKeys::rebuild_all`]: the stored `w` is neither read nor
+/// blended, about 3 instructions a block and key).
+#[inline(always)]
+fn rebuild_rows_on<L: Plane, const ALL: bool>(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
     let limit = L::splat(KEY_LENGTH2);
     let mut bounded = L::splat(0.0).le(limit);
     for row in rows.chunks_exact_mut(g.planes) {
         let rot = &mut row[g.rot_from..];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
             let [x, y, z] = [L::load(&block[0]), L::load(&block[1]), L::load(&block[2])];
-            let w = L::load(&block[3]);
             let rebuilt = tcb_core::quat::rebuild_w(x, y, z);
-            let w = L::blend(mask, rebuilt, w);
+            let w = if ALL {
+                rebuilt
+            } else {
+                L::blend(mask, rebuilt, L::load(&block[3]))
+            };
             block[3] = w.store();
             bounded = bounded & (x * x + y * y + z * z + w * w).le(limit);
         }
