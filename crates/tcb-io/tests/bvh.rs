@@ -1,6 +1,9 @@
 //! BVH import against the real CMU file (bundled in `data/`) and against
 //! the damaged files motion capture arrives as.
 
+mod common;
+
+use common::noise;
 use glam::{DQuat, Quat};
 use std::path::{Path, PathBuf};
 use tcb_io::bvh::Bvh;
@@ -243,19 +246,6 @@ fn damaged_files_are_clear_errors_naming_the_line() {
     );
     let header_only = &SMALL[..SMALL.find("Frames").unwrap()];
     assert_eq!(error(header_only), "line 16: 'Frames' missing after MOTION");
-}
-
-/// Bytes that are not text: xorshift noise, the same on every run.
-fn noise(len: usize) -> Vec<u8> {
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    (0..len)
-        .map(|_| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 24) as u8
-        })
-        .collect()
 }
 
 /// A file that is not text, or text that does not start with HIERARCHY,

@@ -1,6 +1,9 @@
 //! glTF import: the real Khronos sample (bundled in `data/`), and files that
 //! claim more than they hold.
 
+mod common;
+
+use common::noise;
 use glam::Quat;
 use std::path::{Path, PathBuf};
 use tcb_io::gltf_import::import;
@@ -474,20 +477,6 @@ fn a_glb_length_below_its_header_is_an_error_not_a_panic() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("says the file is 11 bytes"), "{err}");
-}
-
-/// Bytes that are neither JSON nor binary glTF: xorshift noise, the same
-/// on every run.
-fn noise(len: usize) -> Vec<u8> {
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    (0..len)
-        .map(|_| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 24) as u8
-        })
-        .collect()
 }
 
 /// A file with neither the GLB magic nor a JSON object's `{` first is "not
