@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates fuzz/corpus/tcbc/seed-*.tcbc after a .tcbc format change:
 # short pieces of the bundled CMU capture compressed by `tcb compress`
-# (at the default tolerance; one with 16-key blocks; one of the whole clip
+# (at the default tolerance; one with 32-key blocks; one of the whole clip
 # at every 8th frame, whose root rotation is stored relative to a center;
 # one of that clip reduced, with tracks on key times of their own),
 # then one of them truncated and one with a byte changed.
@@ -25,7 +25,7 @@ cut() {
 cut 40 1 > "$work/tiny.bvh"
 cut 344 8 > "$work/every8.bvh"
 $tcb compress "$work/tiny.bvh" -o "$out/seed-tiny.tcbc" > /dev/null
-$tcb compress "$work/tiny.bvh" -o "$out/seed-blocks.tcbc" --seek-keys 16 > /dev/null
+$tcb compress "$work/tiny.bvh" -o "$out/seed-blocks.tcbc" --seek-keys 32 > /dev/null
 $tcb compress "$work/every8.bvh" -o "$out/seed-centered.tcbc" --tolerance 0.05 > /dev/null
 # A reduced clip: tracks on key times of their own beside the grid's.
 $tcb reduce "$work/every8.bvh" --rotation hermite -o "$work/reduced.json" --tolerance 0.05 > /dev/null 2>&1

@@ -290,7 +290,7 @@ struct CompressArgs {
     #[command(flatten)]
     error: ErrorArgs,
     /// Keys between seek points: a seek decodes up to N - 1 keys (smaller
-    /// seeks faster and takes more bytes); a multiple of 16 up to 1024.
+    /// seeks faster and takes more bytes); a multiple of 32 up to 1024.
     #[arg(long, value_name = "N", default_value_t = 64)]
     seek_keys: usize,
     /// BVH input: how the reference plays its rotations (default hermite,

@@ -413,7 +413,7 @@ fn bad_compress_input_is_a_clear_error_and_writes_nothing() {
         (vec![input, "-o", "x.json"], "must end in .tcbc"),
         (
             vec![input, "-o", out.to_str().unwrap(), "--seek-keys", "17"],
-            "a multiple of 16",
+            "a multiple of 32",
         ),
         (
             vec![input, "-o", out.to_str().unwrap(), "--tolerance", "-1"],

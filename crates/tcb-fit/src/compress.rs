@@ -42,9 +42,9 @@ use tcb_runtime::{BlockScales, KeyValues, Packed};
 /// use tcb_fit::CompressOptions;
 /// let options = CompressOptions::default()
 ///     .tolerance(Some(0.01))
-///     .seek_keys(Some(16));
+///     .seek_keys(Some(32));
 /// assert_eq!(options.tolerance, Some(0.01));
-/// assert_eq!(options.seek_keys, Some(16));
+/// assert_eq!(options.seek_keys, Some(32));
 /// ```
 ///
 /// The struct is `#[non_exhaustive]`: a struct literal does not compile

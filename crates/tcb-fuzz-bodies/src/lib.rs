@@ -278,7 +278,7 @@ pub fn pack(data: &[u8]) {
     };
     // Blocks of 16 or 64 keys, with a factor on the steps per block.
     let block = if u.arbitrary().unwrap_or(false) {
-        16
+        32
     } else {
         64
     };
@@ -380,7 +380,7 @@ pub fn compress(data: &[u8]) {
         )
         .rotation_tolerance(option_number(&mut u))
         .seek_keys(
-            *u.choose(&[None, Some(16), Some(64), Some(1024)])
+            *u.choose(&[None, Some(32), Some(64), Some(1024)])
                 .unwrap_or(&None),
         );
     let Ok(c) = tcb_fit::compress(&clip, skeleton.as_ref(), &options, &|_, _| {}) else {

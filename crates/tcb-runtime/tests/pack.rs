@@ -32,7 +32,7 @@ fn packed_cmu_plays_its_reference() {
         .map(|t| t.name.as_str())
         .collect();
     assert_eq!(centered, ["Hips.rotation"]);
-    for block in [16, 64, 1024] {
+    for block in [32, 64, 1024] {
         let worst = plays_its_reference(&source, block);
         // Played from its keys, not bit for bit (`key_row`), but close.
         assert!(worst > 0.0 && worst < 3e-7, "{worst}");
@@ -47,7 +47,7 @@ fn blocks_with_step_factors_play_their_reference() {
     let keys = tcb_runtime::KeyValues::sample(&clip).unwrap();
     // `cmu`'s steps.
     let steps: Vec<f32> = plain.tracks.iter().map(|t| t.step).collect();
-    for block in [16, 64] {
+    for block in [32, 64] {
         // Every code somewhere (0 and 255 too), in no order.
         let blocks = clip.key_times().len().div_ceil(block);
         let scales = tcb_runtime::BlockScales {
@@ -87,7 +87,7 @@ fn blocks_with_step_factors_play_their_reference() {
     };
     let source = keys.quantize_scaled(&steps, &zeros).unwrap();
     assert_eq!(source.scales, tcb_runtime::BlockScales::default());
-    assert!(Packed::encode_with(&source, 16).is_ok());
+    assert!(Packed::encode_with(&source, 32).is_ok());
     // A step whose integers, times the largest factor, would leave f32.
     let mut huge = source.clone();
     huge.tracks[0].step = 1e31;
@@ -545,7 +545,7 @@ fn tracks_on_their_own_key_times_keep_their_keys() {
         source.to_clip().unwrap().column_names(),
         clip.column_names()
     );
-    for block in [16, 64] {
+    for block in [32, 64] {
         plays_its_reference(&source, block);
     }
     let packed = Packed::encode(&source).unwrap();

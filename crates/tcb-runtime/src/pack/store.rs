@@ -2,14 +2,14 @@
 //! reaches them, tangents derived from their neighbours.
 //!
 //! An instance keeps the decoded keys (`P`, in the group's planes) of one
-//! 16-key segment and the three keys before it, and the predictor's state;
+//! 32-key segment and the three keys before it, and the predictor's state;
 //! a segment from key `a` to `a + 1` needs keys `a - 1 ..= a + 2`. Playback
 //! decodes a segment when it first needs one of its keys: its headers, 8
 //! lanes at a time in the bytes of a `u64` (`super::header_group`; each
 //! plane's lanes then find theirs through `PackedKeys::plane_index`), then
 //! three passes that each run without a branch on the data: every lane's residuals
-//! unpacked by a function for its width (16 values, a mask and a shift
-//! each), then per plane of 8 lanes the prediction and dequantization, key
+//! unpacked by a function for its width (16 values at a time, a mask and
+//! a shift each), then per plane of 8 lanes the prediction and dequantization, key
 //! by key, with the predictor in registers, then the rebuilt `w`s. Where
 //! the AVX2 instance runs (`crate::isa`), the first two passes are one:
 //! each plane's residuals come straight from the stream, 64 bits gathered
@@ -522,8 +522,8 @@ impl Plane for f32x8 {
 }
 
 /// Rows of the decoded keys' window: the three keys before the current
-/// segment, its 16 keys, and 2 spare rows (a segment's residuals are
-/// unpacked 16 at a time, from row 2 at a block's start).
+/// segment, its [`SEGMENT_KEYS`] keys, and 2 spare rows (a segment's
+/// residuals are unpacked 16 at a time, from row 2 at a block's start).
 const BEFORE: usize = 3;
 const ROWS: usize = BEFORE + SEGMENT_KEYS + 2;
 
@@ -557,7 +557,7 @@ pub(crate) struct PackCache {
     /// The predictor: the last two keys' integers, per plane.
     x0: Vec<i32x8>,
     x1: Vec<i32x8>,
-    /// Keys `16 cur - 3 ..` in `ROWS` rows of `planes` vectors (see
+    /// Keys `SEGMENT_KEYS * cur - 3 ..` in `ROWS` rows of `planes` vectors (see
     /// [`ROWS`]); while a segment is decoded, a row holds its residuals
     /// (as `i32`) until the prediction replaces them with the key.
     rows: Vec<f32x8>,
@@ -714,7 +714,7 @@ impl PackCache {
         let gather =
             crate::isa::avx2() && narrow && last + 64 <= (64 * words.len()).min(i32::MAX as usize);
         if !gather {
-            // Residuals: 16 of each lane of a width above 0 (those past
+            // Residuals: each lane of a width above 0, 16 keys at a time (those past
             // the segment's keys land in spare rows, or in rows no key
             // reads) into the rows as i32; the width's low bits mask the
             // rest.
@@ -724,7 +724,11 @@ impl PackCache {
             let mut at = pos;
             for (&w, &slot) in self.headers.width.iter().zip(&g.headed) {
                 if w > 0 {
-                    UNPACK[w as usize](words, at, &mut rows[base + slot as usize..], stride);
+                    // 16 at a time, as many times as the segment has keys.
+                    for half in (0..keys - first).step_by(16) {
+                        let out = &mut rows[base + half * stride + slot as usize..];
+                        UNPACK[w as usize](words, at + w as usize * half, out, stride);
+                    }
                     at += w as usize * (keys - first);
                 }
             }
