@@ -1344,6 +1344,10 @@ pub(crate) trait Spread {
     fn spread1(x: u64) -> u64;
     /// The 2-bit field `i` of `x` (`i < 8`) into byte `i`.
     fn spread2(x: u64) -> u64;
+    /// The widths coded whole, `WIDTH_BITS` each from the low bits of
+    /// `tails`, one per byte where `whole` has 1, in order (`pdep` into
+    /// those bytes' low bits).
+    fn whole_widths(tails: u64, whole: u64) -> u64;
 }
 
 /// [`Spread`] in shifts and masks, on any CPU.
@@ -1357,6 +1361,16 @@ impl Spread for Portable {
     #[inline(always)]
     fn spread2(x: u64) -> u64 {
         spread2(x)
+    }
+    #[inline(always)]
+    fn whole_widths(tails: u64, whole: u64) -> u64 {
+        let (mut given, mut tails, mut lanes) = (0, tails, whole);
+        while lanes != 0 {
+            given |= (tails & ((1 << WIDTH_BITS) - 1)) << lanes.trailing_zeros();
+            tails >>= WIDTH_BITS;
+            lanes &= lanes - 1;
+        }
+        given
     }
 }
 
@@ -1395,12 +1409,7 @@ pub(crate) fn header_group<S: Spread>(
     let top = 0x80 * BYTES;
     let near = (((before | top) + (lo ^ whole)) - (hi ^ whole)) ^ top;
     // Code 3: the widths coded whole, one per such lane in order.
-    let (mut given, mut tails, mut lanes) = (0, tails, whole);
-    while lanes != 0 {
-        given |= (tails & ((1 << WIDTH_BITS) - 1)) << lanes.trailing_zeros();
-        tails >>= WIDTH_BITS;
-        lanes &= lanes - 1;
-    }
+    let given = S::whole_widths(tails, whole);
     HeaderGroup {
         width: (near & !(0xff * whole)) | given,
         order1,

@@ -1563,6 +1563,15 @@ macro_rules! decoder_instance {
                         _pdep_u64(x, 3 * crate::pack::BYTES)
                     }
                 }
+                #[inline(always)]
+                fn whole_widths(tails: u64, whole: u64) -> u64 {
+                    let mask = whole * ((1 << crate::pack::WIDTH_BITS) - 1);
+                    // SAFETY: as `avx_op`'s (BMI2).
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        _pdep_u64(tails, mask)
+                    }
+                }
             }
 
             /// `Pdep` is `Portable` on every input either takes.
@@ -1577,6 +1586,15 @@ macro_rules! decoder_instance {
                     }
                     for x in 0..1u64 << 16 {
                         assert_eq!(Pdep::spread2(x), Portable::spread2(x), "{x:#x}");
+                    }
+                    // Every set of lanes with widths coded whole, from
+                    // tails of random bits.
+                    let mut t = 0x9e37_79b9_7f4a_7c15u64;
+                    for lanes in 0..1u64 << 8 {
+                        let whole = Portable::spread1(lanes);
+                        t = t.rotate_left(23).wrapping_mul(0x2545_f491_4f6c_dd1d);
+                        let want = Portable::whole_widths(t, whole);
+                        assert_eq!(Pdep::whole_widths(t, whole), want, "{lanes:#x}");
                     }
                 }
                 if $detected() {
