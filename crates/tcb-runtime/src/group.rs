@@ -4,6 +4,7 @@
 use crate::exact::ExactTable;
 use crate::grid::{Cursor, FrameBasis, TimeGrid};
 use crate::kernel;
+use crate::pack::store::{PackCache, PackedKeys};
 use crate::segment::Segment;
 use crate::store::{KeyCache, KeyStore};
 use wide::f32x8;
@@ -82,6 +83,23 @@ impl Group {
                 return;
             }
         }
+        self.sample_packed_segment(f, keys, state, values, velocities);
+    }
+
+    /// [`sample_packed`](Self::sample_packed) from the segment's controls
+    /// (the ends, the sentinels, and rows the key form does not take).
+    /// Out of line: inlined, its kernels' stack and registers were set up
+    /// on every frame (about 20 instructions).
+    #[inline(never)]
+    fn sample_packed_segment(
+        &self,
+        f: FrameBasis,
+        keys: &PackedKeys,
+        state: &mut PackCache,
+        values: &mut [f32x8],
+        velocities: Option<&mut [f32x8]>,
+    ) {
+        let mut velocities = velocities;
         let (ka, kb) = self.grid.key_pair(f.segment);
         let controls = keys.segment(ka, kb, state);
         let reset = f.reset;

@@ -345,8 +345,26 @@ fn sample_packed(
     // instructions a frame).
     if clip.groups.len() > 1 || clip.loose.blocks > 0 || clip.loose_rot.blocks > 0 {
         let rest = (&mut cursors[1..], &mut caches[1..]);
-        sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
+        sample_rest_packed(clip, time, rest, loose, loose_rot, values, velocities);
     }
+}
+
+/// [`sample_rest`] after a packed clip's first group, out of line: inlined
+/// into [`sample_packed`], its stack and registers were set up on every
+/// frame of a clip with nothing else (about 30 instructions).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn sample_rest_packed(
+    clip: &Clip,
+    time: f64,
+    (cursors, caches): (&mut [Cursor], &mut [KeyCache]),
+    loose: &mut LooseState,
+    loose_rot: &mut LooseState,
+    values: &mut [f32x8],
+    velocities: &mut Option<Vec<f32x8>>,
+) {
+    let rest = (cursors, caches);
+    sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
 }
 
 /// [`sample_into`] of `clip`'s groups from `first` on (with their cursors
