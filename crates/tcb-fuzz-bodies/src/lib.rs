@@ -276,7 +276,7 @@ pub fn pack(data: &[u8]) {
     let Ok(keys) = tcb_runtime::KeyValues::sample(&clip) else {
         return;
     };
-    // Blocks of 16 or 64 keys, with a factor on the steps per block.
+    // Blocks of 32 or 64 keys, with a factor on the steps per block.
     let block = if u.arbitrary().unwrap_or(false) {
         32
     } else {

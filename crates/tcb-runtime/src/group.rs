@@ -99,18 +99,9 @@ impl Group {
         values: &mut [f32x8],
         velocities: Option<&mut [f32x8]>,
     ) {
-        let mut velocities = velocities;
         let (ka, kb) = self.grid.key_pair(f.segment);
         let controls = keys.segment(ka, kb, state);
-        let reset = f.reset;
-        sample_segment(self, f, controls, values, velocities.as_deref_mut());
-        if !reset && !keys.center.is_empty() {
-            // Rotations played relative to their centers, then turned.
-            let hq =
-                self.vec_out + self.vec_blocks..self.vec_out + self.vec_blocks + 4 * self.hq_blocks;
-            let vel = velocities.map(|v| &mut v[hq.clone()]);
-            keys.turn_centered(&mut values[hq], vel);
-        }
+        sample_segment(self, f, controls, values, velocities);
     }
 }
 

@@ -12,7 +12,7 @@
 use super::{CompileOptions, compile_impl};
 use crate::clip::Clip;
 use crate::grid::{KeyTimes, TimeGrid};
-use crate::pack::store::{GATHER_WIDTH, PackedKeys};
+use crate::pack::store::{GATHER_WIDTH, KEY_LENGTH2, PackedKeys};
 use crate::pack::{GROUP, PackError, Packed, err, key_weights};
 use std::sync::Arc;
 use tcb_core::TrackKind;
@@ -67,15 +67,14 @@ impl Clip {
     /// ([`crate::PackSource::to_clip`], every key decoded and validated,
     /// compiled as usual): the grid, the `offset-repeat` deltas and, for
     /// every stored segment, the four controls the decoder gives, bit for
-    /// bit (its rotations' keys relative to their centers, as the decoder
-    /// keeps them). `Ok` for clips not compiled from a packed one. Costs what a
+    /// bit. `Ok` for clips not compiled from a packed one. Costs what a
     /// full compile costs (about 30 ms for CMU 01_01): for tools and tests,
     /// not for a game's loading.
     pub fn verify_packed(&self) -> Result<(), PackError> {
         let Some(packed) = &self.packed else {
             return Ok(());
         };
-        let source = relative_to_centers(&packed.decode()?);
+        let source = packed.decode()?;
         let reference = source.to_clip()?;
         let full = compile_impl(
             &reference,
@@ -177,7 +176,7 @@ fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
         (0..END_KEYS).chain(n - END_KEYS..n).collect()
     };
     let ints = packed.decode_keys(&at)?;
-    let mut ends = relative_to_centers(head);
+    let mut ends = head.clone();
     let mut lanes = ints.into_iter();
     for t in &mut ends.tracks {
         t.values = lanes.by_ref().take(t.stored()).collect();
@@ -190,17 +189,6 @@ fn compile_ends(packed: &Packed) -> Result<Clip, PackError> {
         return err("a packed clip's keys have no eases, steps or exact segments");
     }
     Ok(clip)
-}
-
-/// `source` with its rotations' keys relative to their centers (no
-/// centers): the keys the decoder keeps. It plays the curve of these and
-/// turns it by the centers (`PackedKeys::turn_centered`).
-fn relative_to_centers(source: &crate::PackSource) -> crate::PackSource {
-    let mut plain = source.clone();
-    for t in &mut plain.tracks {
-        t.center = None;
-    }
-    plain
 }
 
 /// Check that `clip`'s first group holds the grid's tracks of `head`, and
@@ -243,7 +231,8 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
     let mut rebuild = vec![[true; 8]; g.hq_blocks];
     let mut center: Vec<Option<[[f32; 8]; 4]>> = vec![None; g.hq_blocks];
     let rot_from = g.vec_blocks;
-    // The rotations' weights, and whether they allow the key form (`PackedKeys::key_weights`).
+    // The rotations' weights, and whether they and the centers allow the
+    // key form (`PackedKeys::key_weights`).
     let mut rotation_weights = Vec::new();
     let mut key_form = true;
     for (i, t) in head.tracks.iter().enumerate() {
@@ -269,15 +258,13 @@ fn packed_keys(packed: &Arc<Packed>, clip: &Clip) -> PackedKeys {
         if t.kind == TrackKind::Quat {
             rotation_weights.push(w);
             key_form &= w.iter().all(|w| w.abs() <= 1.0);
+            if let Some(c) = t.center {
+                key_form &= c.iter().map(|x| x * x).sum::<f32>() <= KEY_LENGTH2;
+            }
             let at = index[0];
             let b = (at / 8 - rot_from) / 4;
             rebuild[b][at % 8] = t.rebuild_w;
             if let Some(r) = t.center {
-                // Normalized (in f64): the decoder turns the normalized
-                // curve by it, where the reference normalized `r q`.
-                let r64 = r.map(f64::from);
-                let norm = r64.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let r = r64.map(|x| (x / norm) as f32);
                 let identity = [[0.0; 8], [0.0; 8], [0.0; 8], [1.0; 8]];
                 let planes = center[b].get_or_insert(identity);
                 for (plane, x) in planes.iter_mut().zip(r) {

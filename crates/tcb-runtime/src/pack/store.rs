@@ -31,11 +31,7 @@
 //! sentinel pseudo-keys are kept in f32. Rotations are decoded as the
 //! reference is given them (`tcb_core::RotationTrack::new_as_given`): `w`
 //! rebuilt where the track stores three components, not normalized (the
-//! kernel normalizes the curve it plays). A rotation stored relative to a
-//! center `c` keeps its keys so, and the curve played from them is turned
-//! (`c p / |p|` where the reference has `c p / |c p|`, the same with `c`
-//! normalized): a product per block a frame rather than one per block and
-//! key decoded, two a frame at 60 fps over 120 fps capture.
+//! kernel normalizes the curve it plays).
 //!
 //! Where every rotation of the group shares its weights (a clip of one
 //! tangent rule, as capture is), interior segments play their rotations
@@ -105,9 +101,9 @@ pub(crate) struct PackedKeys {
     /// The first rotation plane; rotation blocks of 4 planes follow.
     pub rot_from: usize,
     /// The weights (`in_a in_b out_a out_b`) every rotation of the group
-    /// shares, where they do, each at most 1 in magnitude: then interior
-    /// segments play their rotations from their keys
-    /// ([`PackedKeys::play_keys`]).
+    /// shares, where they do, each at most 1 in magnitude, and every
+    /// center's `|c|^2` is at most [`KEY_LENGTH2`]: then interior segments
+    /// play their rotations from their keys ([`PackedKeys::play_keys`]).
     pub key_weights: Option<[f32; 4]>,
     /// Per rotation block: lanes whose `w` is rebuilt (and padding lanes),
     /// as a mask.
@@ -116,10 +112,8 @@ pub(crate) struct PackedKeys {
     /// rotations do): then `w` is written without a blend.
     pub rebuild_all: bool,
     /// The rotation blocks with a lane whose keys are relative to a center
-    /// (`PackTrack::center`): the block, and per plane the centers,
-    /// normalized (the identity in lanes without one). The rows keep the
-    /// keys relative to them; the played curve is turned
-    /// ([`turn_centered`]).
+    /// (`PackTrack::center`): the block, and per plane the centers (the
+    /// identity in lanes without one).
     pub center: Vec<(usize, [f32x8; 4])>,
     /// `[P TO TI]` of keys 0, n-1 and the four sentinel pseudo-keys
     /// (`n ..= n+3`), `planes` vectors each.
@@ -225,13 +219,6 @@ impl PackedKeys {
         play_keys_on::<f32x8>(self, win, f, w, out, vel)
     }
 
-    /// Turn the rotation planes `out` (and `vel`) of a frame played from
-    /// the decoded keys by their centers ([`turn_centered`]).
-    #[inline(never)]
-    pub fn turn_centered(&self, out: &mut [f32x8], vel: Option<&mut [f32x8]>) {
-        turn_centered::<f32x8>(self, out, vel);
-    }
-
     /// `TO_a` and `TI_b` of interior keys into the cache (module docs).
     fn tangents(&self, a: usize, b: usize, c: &mut PackCache) {
         let (np, n) = (self.planes, self.keys);
@@ -294,9 +281,10 @@ pub(crate) fn key_row(h: [f32; 4], w: [f32; 4]) -> [f32; 4] {
     .map(|x| x as f32)
 }
 
-/// `|P|^2` of every key that an interior segment's key form reads
-/// (relative to its center) is at most this (checked as keys are
-/// decoded). The form plays only where `|p|^2` is above
+/// `|P|^2` of every key that an interior segment's key form reads, before
+/// its center, is at most this (checked as keys are decoded), and so is
+/// `|c|^2` of every center (checked at compile time): after the center,
+/// at most about 1.04. The form plays only where `|p|^2` is above
 /// [`KEY_FORM_LOW`]: then
 /// its roundings, and the reference's, move the normalized rotation by a
 /// few 1e-7 (weights at most 1, so that `key_row`'s coefficients sum to
@@ -385,11 +373,9 @@ fn play_keys_on<L: Plane>(
     // The derivative's row only where velocities are asked for.
     let dh = if vel_q.is_some() { key_row(f.dh, w) } else { h };
     const LOW: u32 = KEY_FORM_LOW.to_bits();
-    let mut vel_q = vel_q;
-    if !L::quats::<LOW>(rotations, h, dh, f.rate, out_q, vel_q.as_deref_mut()) {
+    if !L::quats::<LOW>(rotations, h, dh, f.rate, out_q, vel_q) {
         return false;
     }
-    turn_centered::<L>(g, out_q, vel_q);
     // Vectors: the reference's controls and kernel formula.
     let rows = before.iter().zip(pa).zip(pb.iter().zip(after));
     let planes = rows.zip(&g.weights).zip(out_v);
@@ -441,9 +427,10 @@ fn block_start_keys<I: Copy + Add<Output = I>>(start: I, delta: I, keys: usize) 
     [start, if keys > 1 { start + delta } else { start }]
 }
 
-/// Rebuild `w` of the rotations that store three components in the rows
-/// `rows` (`planes` vectors each). Returns whether every key's `|q|^2`
-/// is at most [`KEY_LENGTH2`] (not NaN).
+/// Rebuild `w` of the rotations that store three components, and turn
+/// the keys of rotations with a center by it (`PackTrack::value`), in the
+/// rows `rows` (`planes` vectors each). Returns whether every key's
+/// `|q|^2` before its center is at most [`KEY_LENGTH2`] (not NaN).
 #[inline(always)]
 fn rebuild_rows<L: Plane>(g: &PackedKeys, rows: &mut [f32x8]) -> bool {
     if g.rebuild_all {
@@ -464,59 +451,37 @@ fn rebuild_rows_on<L: Plane, const ALL: bool>(g: &PackedKeys, rows: &mut [f32x8]
         let rot = &mut row[g.rot_from..];
         for (block, mask) in rot.chunks_exact_mut(4).zip(&g.rebuild) {
             let [x, y, z] = [L::load(&block[0]), L::load(&block[1]), L::load(&block[2])];
-            let xyz = x * x + y * y + z * z;
             let rebuilt = tcb_core::quat::rebuild_w(x, y, z);
-            if ALL {
-                // `w^2` is `1 - |xyz|^2` or 0: `|q|^2` is at most
-                // `KEY_LENGTH2` (above 1) where `|xyz|^2` is.
-                block[3] = rebuilt.store();
-                bounded = bounded & xyz.le(limit);
+            let w = if ALL {
+                rebuilt
             } else {
-                let w = L::blend(mask, rebuilt, L::load(&block[3]));
-                block[3] = w.store();
-                bounded = bounded & (xyz + w * w).le(limit);
+                L::blend(mask, rebuilt, L::load(&block[3]))
+            };
+            block[3] = w.store();
+            bounded = bounded & (x * x + y * y + z * z + w * w).le(limit);
+        }
+        for (b, c) in &g.center {
+            if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
+                let c = [
+                    L::load(&c[0]),
+                    L::load(&c[1]),
+                    L::load(&c[2]),
+                    L::load(&c[3]),
+                ];
+                let q = [
+                    L::load(&block[0]),
+                    L::load(&block[1]),
+                    L::load(&block[2]),
+                    L::load(&block[3]),
+                ];
+                let q = tcb_core::quat::mul(&c, &q);
+                for (o, q) in block.iter_mut().zip(q) {
+                    *o = q.store();
+                }
             }
         }
     }
     bounded.all()
-}
-
-/// Turn the played rotation blocks that have a center by it (`c q`,
-/// [`tcb_core::quat::mul`]): `out` and `vel` are the group's rotation
-/// planes. The decoder keeps keys relative to their centers and turns the
-/// curve it played instead of each key: the kernels are linear in the
-/// keys and normalize, and `|c| = 1`, so that this is `PackTrack::value`'s
-/// curve in other roundings (a frame turns one block where decoding
-/// turned two keys of it).
-#[inline(always)]
-fn turn_centered<L: Plane>(g: &PackedKeys, out: &mut [f32x8], vel: Option<&mut [f32x8]>) {
-    #[inline(always)]
-    fn turn<L: Plane>(c: &[L; 4], block: &mut [f32x8]) {
-        let q = [
-            L::load(&block[0]),
-            L::load(&block[1]),
-            L::load(&block[2]),
-            L::load(&block[3]),
-        ];
-        for (o, q) in block.iter_mut().zip(tcb_core::quat::mul(c, &q)) {
-            *o = q.store();
-        }
-    }
-    let mut vel = vel;
-    for (b, c) in &g.center {
-        let c = [
-            L::load(&c[0]),
-            L::load(&c[1]),
-            L::load(&c[2]),
-            L::load(&c[3]),
-        ];
-        if let Some(block) = out.get_mut(4 * b..4 * b + 4) {
-            turn(&c, block);
-        }
-        if let Some(block) = vel.as_deref_mut().and_then(|v| v.get_mut(4 * b..4 * b + 4)) {
-            turn(&c, block);
-        }
-    }
 }
 
 /// Eight `f32` lanes the decoder computes on, kept as `f32x8` in the rows:
@@ -561,6 +526,11 @@ impl Plane for f32x8 {
 /// residuals are unpacked 16 at a time, from row 2 at a block's start).
 const BEFORE: usize = 3;
 const ROWS: usize = BEFORE + SEGMENT_KEYS + 2;
+// The baseline unpacks 16 residuals a lane at a time, from row 2 at a
+// block's start: whole passes of 16 must end inside the rows.
+const _: () = assert!(
+    SEGMENT_KEYS.is_multiple_of(16) && ROWS >= BEFORE + 2 + (SEGMENT_KEYS - 2).next_multiple_of(16)
+);
 
 /// One instance's decoding state for a [`PackedKeys`] group.
 #[derive(Clone, Debug)]
