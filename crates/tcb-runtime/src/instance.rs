@@ -357,13 +357,12 @@ fn sample_packed(
 fn sample_rest_packed(
     clip: &Clip,
     time: f64,
-    (cursors, caches): (&mut [Cursor], &mut [KeyCache]),
+    rest: (&mut [Cursor], &mut [KeyCache]),
     loose: &mut LooseState,
     loose_rot: &mut LooseState,
     values: &mut [f32x8],
     velocities: &mut Option<Vec<f32x8>>,
 ) {
-    let rest = (cursors, caches);
     sample_rest(clip, 1, time, rest, loose, loose_rot, values, velocities);
 }
 

@@ -263,6 +263,23 @@ fn skeleton_round_trip_and_other_versions() {
         );
     }
 
+    // A file of another segment length (16-key segments, as before
+    // 2026-12-07): the body's name and note, start, interval, keys and
+    // keys per block come first.
+    let mut b = packed.to_bytes();
+    let mut at = 24;
+    for _ in 0..2 {
+        at += 4 + u32::from_le_bytes(b[at..at + 4].try_into().unwrap()) as usize;
+    }
+    at += 8 + 8 + 4 + 4;
+    assert_eq!(b[at..at + 4], 32u32.to_le_bytes());
+    b[at..at + 4].copy_from_slice(&16u32.to_le_bytes());
+    let msg = Packed::from_bytes(&reseal(b)).unwrap_err().to_string();
+    assert!(
+        msg.starts_with("segments of 16 keys; this build reads 32") && !msg.contains('\n'),
+        "{msg}"
+    );
+
     // The first joint's parent set to itself, then its rest's x to NaN.
     let first = bytes.len() - skeleton_bytes(&skeleton);
     let name = skeleton.joints()[0].name.len();

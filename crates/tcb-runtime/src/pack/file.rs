@@ -544,7 +544,7 @@ impl Packed {
         let (block, seg) = (r.u32("keys per block")?, r.u32("keys per segment")?);
         if seg as usize != SEGMENT_KEYS {
             return err(format!(
-                "segments of {seg} keys; this build reads {SEGMENT_KEYS}"
+                "segments of {seg} keys; this build reads {SEGMENT_KEYS} (compress the source again)"
             ));
         }
         let block = block as usize;
