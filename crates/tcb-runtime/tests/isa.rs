@@ -267,6 +267,27 @@ fn packed_clips_decode_to_the_same_bits() {
             &times,
         );
     }
+    // Residuals of assorted widths, each lane its own and changing from
+    // segment to segment (noise of 0 to 23 bits: second-order residuals of
+    // up to about 25 bits, mostly in the gathers' reach), so that a plane's
+    // widest lane and the keys its low words hold vary.
+    let (_, mut noisy) = common::quantized_cmu();
+    let mut seed = 0x9e37_79b9_u32;
+    let lanes = noisy.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
+    for (l, v) in lanes.enumerate() {
+        for (k, x) in v.iter_mut().enumerate() {
+            let bits = (l * 7 + k / 32 * 5) % 24;
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            let noise = match bits {
+                0 => 0,
+                b => (seed >> (32 - b)) as i32 - (1 << (b - 1)),
+            };
+            *x = (*x + noise).clamp(1 - (1 << 24), (1 << 24) - 1);
+        }
+    }
+    packed_same_bits("packed cmu, residuals of many widths", &noisy, &times);
     // Blocks with step factors (every third block at 1 + 40 / 64).
     let (clip, plain) = common::quantized_cmu();
     let steps: Vec<f32> = plain.tracks.iter().map(|t| t.step).collect();

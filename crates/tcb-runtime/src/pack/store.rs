@@ -14,8 +14,11 @@
 //! the AVX2 instance runs (`crate::isa`), the first two passes are one:
 //! each plane's residuals come straight from the stream, 64 bits gathered
 //! at each lane's byte for as many keys as every lane has in them, then
-//! shifted and masked per lane key by key (segments whose widths are all at
-//! most 25 bits; wider ones unpack first), and a
+//! shifted and masked per lane key by key, from the windows' low 32 bits
+//! while they hold the keys (segments whose widths are all at most 25
+//! bits; wider ones unpack first); planes whose lanes all predict from
+//! the last two keys run a loop of their own, one instruction shorter a
+//! key; and a
 //! block's start values and deltas are gathered a plane at a time too
 //! (`PackedKeys::start_gather`). Forward
 //! playback decodes each key once; playing backwards re-decodes from the
@@ -458,7 +461,16 @@ fn rebuild_rows_on<L: Plane, const ALL: bool>(g: &PackedKeys, rows: &mut [f32x8]
                 L::blend(mask, rebuilt, L::load(&block[3]))
             };
             block[3] = w.store();
-            bounded = bounded & (x * x + y * y + z * z + w * w).le(limit);
+            // Where every lane rebuilds `w` (`w^2` is `1 - |xyz|^2`, or 0
+            // where that is below 0), `|q|^2` is at most the bound
+            // where `|xyz|^2` is: the sum `rebuild_w` took, two
+            // instructions rather than four.
+            let length2 = if ALL {
+                x * x + y * y + z * z
+            } else {
+                x * x + y * y + z * z + w * w
+            };
+            bounded = bounded & length2.le(limit);
         }
         for (b, c) in &g.center {
             if let Some(block) = rot.get_mut(4 * b..4 * b + 4) {
@@ -1082,11 +1094,11 @@ macro_rules! decoder_instance {
                 _mm_shuffle_epi32, _mm256_add_epi32, _mm256_and_si256, _mm256_castps_si256,
                 _mm256_castsi256_ps, _mm256_castsi256_si128, _mm256_cvtepi32_ps,
                 _mm256_cvtepu8_epi32, _mm256_extracti128_si256, _mm256_i32gather_epi32,
-                _mm256_i64gather_epi64, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_or_si256,
-                _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256, _mm256_shuffle_ps,
-                _mm256_slli_epi32, _mm256_sllv_epi32, _mm256_srli_epi32, _mm256_srlv_epi32,
-                _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
-                _mm256_xor_si256, _pdep_u64,
+                _mm256_i64gather_epi64, _mm256_movemask_ps, _mm256_mul_ps, _mm256_mullo_epi32,
+                _mm256_or_si256, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_si256,
+                _mm256_shuffle_ps, _mm256_slli_epi32, _mm256_sllv_epi32, _mm256_srli_epi32,
+                _mm256_srlv_epi32, _mm256_srlv_epi64, _mm256_sub_epi32, _mm256_unpackhi_epi32,
+                _mm256_unpacklo_epi32, _mm256_xor_si256, _pdep_u64,
             };
             use tcb_core::simd::w8::{I8, W8};
             use wide::{f32x8, i32x8};
@@ -1364,10 +1376,18 @@ macro_rules! decoder_instance {
                     let (low, bias) = width_lanes(width);
                     let code = [trend, low, bias];
                     let width = width.0;
+                    let widest = widest(width) as usize & 31;
                     // Keys whose residuals every lane has in the 57 bits after the
                     // first one's byte: one 8-byte read per lane serves them all.
-                    let per = KEYS_IN_57_BITS[widest(width) as usize & 31] as usize;
-                    let width_q = halves(width);
+                    let per = KEYS_IN_57_BITS[widest] as usize;
+                    // Keys whose residuals every lane has in the low 32 bits
+                    // of its window: taken from one set of low words, each
+                    // key shifting them on by its width (one instruction
+                    // where moving the two halves of the 64-bit windows and
+                    // taking their low words again is three).
+                    let group = KEYS_IN_32_BITS[widest] as usize;
+                    let group_q =
+                        halves(_mm256_mullo_epi32(width, _mm256_set1_epi32(group as i32)));
                     // The bits a chunk of `per` keys takes (each chunk that
                     // ends before the last key has `per`).
                     let chunk_bits = _mm256_mullo_epi32(width, _mm256_set1_epi32(per as i32));
@@ -1381,18 +1401,15 @@ macro_rules! decoder_instance {
                     // SAFETY: `p < np <= rows.len()` (`n >= 1` above).
                     #[allow(unsafe_code)]
                     let mut out = unsafe { rows.as_mut_ptr().add(p) };
-                    // One key: the prediction, the residuals' window on, the
-                    // key written. SAFETY (of `out`'s write): before key `r`
-                    // (`r < n`: the chunks' keys add up to `n`), `out` is
+                    // One key from the low words `low`: the prediction and
+                    // the key written. SAFETY (of `out`'s write): before key `r`
+                    // (`r < n`: the groups' keys add up to `n`), `out` is
                     // `rows[r * np + p]`, inside `rows`. After the last key
                     // it points `p` vectors past the end and is not read:
                     // `wrapping_add` makes no claim about where it points.
                     macro_rules! key {
-                        () => {
-                            (x, d) = predict(x, d, V(low_words(words)), code);
-                            for (w, s) in words.iter_mut().zip(width_q) {
-                                *w = _mm256_srlv_epi64(*w, s);
-                            }
+                        ($low:expr, $code:expr) => {
+                            (x, d) = predict(x, d, V($low), $code);
                             #[allow(unsafe_code)]
                             unsafe {
                                 out.write(bytemuck::cast(dequantize_lanes(x, step).0));
@@ -1400,31 +1417,57 @@ macro_rules! decoder_instance {
                             }
                         };
                     }
-                    let mut left = n;
-                    loop {
-                        let k = per.min(left);
-                        left -= k;
-                        // Two keys an iteration: the loop's count and branch
-                        // once for both.
-                        for _ in 0..k / 2 {
-                            key!();
-                            key!();
-                        }
-                        if k % 2 == 1 {
-                            key!();
-                        }
-                        if left == 0 {
-                            break;
-                        }
-                        debug_assert_eq!(k, per, "a chunk before the last");
-                        bit = _mm256_add_epi32(bit, chunk_bits);
-                        // SAFETY: every lane's bit is below the bound of
-                        // `predict_gathered_here`'s contract, 64 bits before the
-                        // end of `bytes`, so each 8-byte read is inside it.
-                        #[allow(unsafe_code)]
-                        {
-                            words = unsafe { read_shifted(bytes, bit) };
-                        }
+                    // The plane's keys, chunk by chunk, with the coding `$code`.
+                    macro_rules! keys {
+                        ($code:expr) => {
+                            let mut left = n;
+                            loop {
+                                let k = per.min(left);
+                                left -= k;
+                                // The chunk's keys, `group` at a time (the last group
+                                // may have fewer): each group's last key leaves its
+                                // low words unshifted, and the chunk's last group its
+                                // windows (the next chunk reads its own).
+                                let mut rest = k;
+                                loop {
+                                    let keys = group.min(rest);
+                                    rest -= keys;
+                                    let mut low = low_words(words);
+                                    for _ in 1..keys {
+                                        key!(low, $code);
+                                        low = _mm256_srlv_epi32(low, width);
+                                    }
+                                    key!(low, $code);
+                                    if rest == 0 {
+                                        break;
+                                    }
+                                    for (w, s) in words.iter_mut().zip(group_q) {
+                                        *w = _mm256_srlv_epi64(*w, s);
+                                    }
+                                }
+                                if left == 0 {
+                                    break;
+                                }
+                                debug_assert_eq!(k, per, "a chunk before the last");
+                                bit = _mm256_add_epi32(bit, chunk_bits);
+                                // SAFETY: every lane's bit is below the bound of
+                                // `predict_gathered_here`'s contract, 64 bits before the
+                                // end of `bytes`, so each 8-byte read is inside it.
+                                #[allow(unsafe_code)]
+                                {
+                                    words = unsafe { read_shifted(bytes, bit) };
+                                }
+                            }
+                        };
+                    }
+                    // Where every lane predicts from the last two keys (order
+                    // 2, about half of CMU's planes and segments), its step
+                    // `d & trend` is `d`: a constant mask LLVM folds, one
+                    // instruction less a key and a shorter chain from key to key.
+                    if _mm256_movemask_ps(_mm256_castsi256_ps(trend.0)) == 0xff {
+                        keys!([V(_mm256_set1_epi32(-1)), low, bias]);
+                    } else {
+                        keys!(code);
                     }
                     (x0[p], x1[p]) = (bytemuck::cast((x - d).0), bytemuck::cast(x.0));
                 }
@@ -1613,6 +1656,18 @@ macro_rules! decoder_instance {
                 let mut w = 1;
                 while w < 32 {
                     t[w] = (57 / w) as u8;
+                    w += 1;
+                }
+                t
+            };
+
+            /// How many residuals of a width 32 bits hold (a segment's
+            /// keys for width 0).
+            const KEYS_IN_32_BITS: [u8; 32] = {
+                let mut t = [SEGMENT_KEYS as u8; 32];
+                let mut w = 1;
+                while w < 32 {
+                    t[w] = (32 / w) as u8;
                     w += 1;
                 }
                 t
