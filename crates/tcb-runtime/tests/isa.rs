@@ -268,9 +268,8 @@ fn packed_clips_decode_to_the_same_bits() {
         );
     }
     // Residuals of assorted widths, each lane its own and changing from
-    // segment to segment (noise of 0 to 23 bits: second-order residuals of
-    // up to about 25 bits, mostly in the gathers' reach), so that a plane's
-    // widest lane and the keys its low words hold vary.
+    // segment to segment (noise of 0 to 23 bits), so that a plane's lanes
+    // differ (its widest lane is 15 or 17 to 24 bits here).
     let (_, mut noisy) = common::quantized_cmu();
     let mut seed = 0x9e37_79b9_u32;
     let lanes = noisy.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
@@ -288,6 +287,41 @@ fn packed_clips_decode_to_the_same_bits() {
         }
     }
     packed_same_bits("packed cmu, residuals of many widths", &noisy, &times);
+    // Every width the gathers take, plane by plane (a segment's noise of
+    // 0 to 24 bits, about the same in every lane, and every 26th segment
+    // constant: widest 0 and 2 to 25), and short last segments (4, 17 and
+    // 21 keys).
+    for keys in [100, 2741, 2707] {
+        let (_, mut sweep) = common::quantized_cmu();
+        sweep.keys = keys;
+        let mut seed = 0x1234_5679_u32;
+        let lanes = sweep.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
+        for (l, v) in lanes.enumerate() {
+            v.truncate(keys);
+            let c = v[0];
+            for (k, x) in v.iter_mut().enumerate() {
+                let s = k / 32;
+                let bits = (s * 3 + l % 3) % 25;
+                seed ^= seed << 13;
+                seed ^= seed >> 17;
+                seed ^= seed << 5;
+                let noise = match bits {
+                    _ if s % 26 == 25 => 0,
+                    0 => 0,
+                    b => (seed >> (32 - b)) as i32 - (1 << (b - 1)),
+                };
+                *x = (c + noise).clamp(1 - (1 << 24), (1 << 24) - 1);
+            }
+        }
+        let times: Vec<f64> = (0..=2 * keys)
+            .map(|f| sweep.start + f as f64 * 0.5 * sweep.interval)
+            .collect();
+        packed_same_bits(
+            &format!("packed, widths 0 to 25, {keys} keys"),
+            &sweep,
+            &times,
+        );
+    }
     // Blocks with step factors (every third block at 1 + 40 / 64).
     let (clip, plain) = common::quantized_cmu();
     let steps: Vec<f32> = plain.tracks.iter().map(|t| t.step).collect();

@@ -461,10 +461,10 @@ fn rebuild_rows_on<L: Plane, const ALL: bool>(g: &PackedKeys, rows: &mut [f32x8]
                 L::blend(mask, rebuilt, L::load(&block[3]))
             };
             block[3] = w.store();
-            // Where every lane rebuilds `w` (`w^2` is `1 - |xyz|^2`, or 0
-            // where that is below 0), `|q|^2` is at most the bound
-            // where `|xyz|^2` is: the sum `rebuild_w` took, two
-            // instructions rather than four.
+            // Where every lane rebuilds `w`, `|q|^2` passes the bound
+            // exactly where `|xyz|^2` does (`w` is 0 where `|xyz|^2` is at
+            // least 1, and `|q|^2` about 1 elsewhere): the sum `rebuild_w`
+            // took, two instructions rather than four.
             let length2 = if ALL {
                 x * x + y * y + z * z
             } else {
