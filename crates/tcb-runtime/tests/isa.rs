@@ -271,21 +271,9 @@ fn packed_clips_decode_to_the_same_bits() {
     // segment to segment (noise of 0 to 23 bits), so that a plane's lanes
     // differ (its widest lane is 15 or 17 to 24 bits here).
     let (_, mut noisy) = common::quantized_cmu();
-    let mut seed = 0x9e37_79b9_u32;
-    let lanes = noisy.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
-    for (l, v) in lanes.enumerate() {
-        for (k, x) in v.iter_mut().enumerate() {
-            let bits = (l * 7 + k / 32 * 5) % 24;
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            let noise = match bits {
-                0 => 0,
-                b => (seed >> (32 - b)) as i32 - (1 << (b - 1)),
-            };
-            *x = (*x + noise).clamp(1 - (1 << 24), (1 << 24) - 1);
-        }
-    }
+    add_noise(&mut noisy, 0x9e37_79b9, false, |l, k| {
+        (l * 7 + k / 32 * 5) % 24
+    });
     packed_same_bits("packed cmu, residuals of many widths", &noisy, &times);
     // Every width the gathers take, plane by plane (a segment's noise of
     // 0 to 24 bits, about the same in every lane, and every 26th segment
@@ -294,25 +282,13 @@ fn packed_clips_decode_to_the_same_bits() {
     for keys in [100, 2741, 2707] {
         let (_, mut sweep) = common::quantized_cmu();
         sweep.keys = keys;
-        let mut seed = 0x1234_5679_u32;
-        let lanes = sweep.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
-        for (l, v) in lanes.enumerate() {
-            v.truncate(keys);
-            let c = v[0];
-            for (k, x) in v.iter_mut().enumerate() {
-                let s = k / 32;
-                let bits = (s * 3 + l % 3) % 25;
-                seed ^= seed << 13;
-                seed ^= seed >> 17;
-                seed ^= seed << 5;
-                let noise = match bits {
-                    _ if s % 26 == 25 => 0,
-                    0 => 0,
-                    b => (seed >> (32 - b)) as i32 - (1 << (b - 1)),
-                };
-                *x = (c + noise).clamp(1 - (1 << 24), (1 << 24) - 1);
-            }
+        for t in &mut sweep.tracks {
+            t.values.iter_mut().for_each(|v| v.truncate(keys));
         }
+        add_noise(&mut sweep, 0x1234_5679, true, |l, k| match k / 32 {
+            s if s % 26 == 25 => 0,
+            s => (s * 3 + l % 3) % 25,
+        });
         let times: Vec<f64> = (0..=2 * keys)
             .map(|f| sweep.start + f as f64 * 0.5 * sweep.interval)
             .collect();
@@ -350,6 +326,32 @@ fn packed_clips_decode_to_the_same_bits() {
         .collect();
     times.extend(times.clone().into_iter().rev());
     packed_same_bits("packed cmu, 129 keys", &short, &times);
+}
+
+/// Noise of `bits(lane, key)` bits (0: none; xorshift from `seed`) added
+/// to each stored lane's integers, or with `flat` to its first one, kept
+/// below 2^24 in magnitude.
+fn add_noise(
+    source: &mut tcb_runtime::PackSource,
+    mut seed: u32,
+    flat: bool,
+    bits: impl Fn(usize, usize) -> usize,
+) {
+    let lanes = source.tracks.iter_mut().flat_map(|t| t.values.iter_mut());
+    for (l, v) in lanes.enumerate() {
+        let first = v[0];
+        for (k, x) in v.iter_mut().enumerate() {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            let noise = match bits(l, k) {
+                0 => 0,
+                b => (seed >> (32 - b)) as i32 - (1 << (b - 1)),
+            };
+            let base = if flat { first } else { *x };
+            *x = (base + noise).clamp(1 - (1 << 24), (1 << 24) - 1);
+        }
+    }
 }
 
 /// The decoder's instances on `source`, packed, at `times`: AVX2, and

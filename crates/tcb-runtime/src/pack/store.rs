@@ -544,6 +544,19 @@ const _: () = assert!(
     SEGMENT_KEYS.is_multiple_of(16) && ROWS >= BEFORE + 2 + (SEGMENT_KEYS - 2).next_multiple_of(16)
 );
 
+/// Per residual width (the index), how many residuals `bits` bits hold; a
+/// segment's keys for width 0 (the AVX2 decoder's chunks and groups).
+#[cfg(target_arch = "x86_64")]
+const fn keys_in(bits: usize) -> [u8; 32] {
+    let mut t = [SEGMENT_KEYS as u8; 32];
+    let mut w = 1;
+    while w < 32 {
+        t[w] = (bits / w) as u8;
+        w += 1;
+    }
+    t
+}
+
 /// One instance's decoding state for a [`PackedKeys`] group.
 #[derive(Clone, Debug)]
 pub(crate) struct PackCache {
@@ -1083,7 +1096,6 @@ macro_rules! decoder_instance {
     ($name:ident, $features:literal, $detected:path) => {
         mod $name {
             use crate::grid::FrameBasis;
-            use crate::pack::SEGMENT_KEYS;
             use crate::pack::store::{
                 Headers, PackedKeys, block_start_keys, entry_fields, interior_tangents,
                 play_keys_on, predict, rebuild_rows,
@@ -1651,27 +1663,10 @@ macro_rules! decoder_instance {
 
             /// How many residuals of a width (at most 25) 57 bits hold: 64 bits
             /// read from the byte of the first one's bit hold at least 57 after it.
-            const KEYS_IN_57_BITS: [u8; 32] = {
-                let mut t = [SEGMENT_KEYS as u8; 32];
-                let mut w = 1;
-                while w < 32 {
-                    t[w] = (57 / w) as u8;
-                    w += 1;
-                }
-                t
-            };
+            const KEYS_IN_57_BITS: [u8; 32] = super::keys_in(57);
 
-            /// How many residuals of a width 32 bits hold (a segment's
-            /// keys for width 0).
-            const KEYS_IN_32_BITS: [u8; 32] = {
-                let mut t = [SEGMENT_KEYS as u8; 32];
-                let mut w = 1;
-                while w < 32 {
-                    t[w] = (32 / w) as u8;
-                    w += 1;
-                }
-                t
-            };
+            /// How many residuals of a width the low 32 bits of a window hold.
+            const KEYS_IN_32_BITS: [u8; 32] = super::keys_in(32);
 
             /// The largest of the 8 lanes of `x` (as u32).
             #[inline]
